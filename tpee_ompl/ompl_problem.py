@@ -1,0 +1,198 @@
+"""OMPL problem set-up for the wearer + arm: state space, validity checking, motion checking.
+
+The state space is ``ob.RealVectorStateSpace(4)`` bounded by the URDF joint limits; its metric
+(the Euclidean norm of joint differences, radians) is the path-length metric for every planner.
+
+Motion-check guarantee
+----------------------
+A motion is checked at states no more than ``robot.max_joint_step()`` apart (Euclidean, rad),
+which moves no point of the arm more than the security margin m (lever-arm bound, see
+:meth:`WearerArm.max_joint_step`).  Every checked state keeps all pairs at least m apart, so any
+state in between is within m/2 of a checked one: **every point of an accepted motion keeps at
+least m/2 (1 cm by default) from the wearer and from the arm's own non-adjacent links.**
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+from ompl import base as ob
+from ompl import geometric as og
+
+from .robot import WearerArm
+
+__all__ = [
+    "WearerValidityChecker",
+    "BatchedMotionValidator",
+    "make_space",
+    "make_simple_setup",
+    "state_to_array",
+    "set_state",
+    "path_to_array",
+    "array_to_path",
+    "motion_states",
+]
+
+
+def state_to_array(state: ob.State, n: int) -> np.ndarray:
+    """Copy the first n values of a RealVector state into a numpy array."""
+    return np.array([state[i] for i in range(n)], dtype=float)
+
+
+def set_state(state: ob.State, values: Sequence[float]) -> ob.State:
+    """Write values into a RealVector state and return it."""
+    state[0 : len(values)] = [float(v) for v in values]
+    return state
+
+
+def path_to_array(path: og.PathGeometric, n: int) -> np.ndarray:
+    """Waypoints of a geometric path as an array (K, n)."""
+    return np.array([[s[i] for i in range(n)] for s in path.getStates()], dtype=float)
+
+
+def array_to_path(si: ob.SpaceInformation, waypoints: np.ndarray) -> og.PathGeometric:
+    """An ``og.PathGeometric`` through the given (K, n) waypoints."""
+    path = og.PathGeometric(si)
+    for w in np.asarray(waypoints, dtype=float):
+        s = si.allocState()
+        set_state(s, w)
+        path.append(s)
+    return path
+
+
+def motion_states(a: np.ndarray, b: np.ndarray, step: float, include_start: bool = False) -> np.ndarray:
+    """States checked along the straight motion a -> b, as OMPL's DiscreteMotionValidator picks them.
+
+    ``ceil(|b - a| / step)`` segments; the end state is included, the start only on request.
+    """
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    n = max(1, math.ceil(float(np.linalg.norm(b - a)) / step))
+    t = np.arange(0 if include_start else 1, n + 1) / n
+    return a + t[:, None] * (b - a)
+
+
+class WearerValidityChecker(ob.StateValidityChecker):
+    """State validity for OMPL: joint limits plus collision checking by the :class:`WearerArm`.
+
+    ``are_valid`` offers the batched check to planners that know about it (dimension-RRT).
+    """
+
+    def __init__(self, si: ob.SpaceInformation, robot: WearerArm) -> None:
+        super().__init__(si)
+        self.robot = robot
+        self._n = robot.nq
+
+    def isValid(self, state: ob.State) -> bool:  # noqa: N802 (OMPL override)
+        """True if the state is collision-free with the security margin."""
+        return self.robot.is_valid(np.array([state[i] for i in range(self._n)]))
+
+    def are_valid(self, Q: np.ndarray) -> np.ndarray:
+        """Batched validity of configurations Q (N, nq)."""
+        return self.robot.are_valid(Q)
+
+
+class BatchedMotionValidator(ob.MotionValidator):
+    """Checks a whole straight motion with one batched Pinocchio call.
+
+    Same states as OMPL's ``DiscreteMotionValidator`` at the same resolution, so results agree;
+    native planners call it through ``si.checkMotion``.
+    """
+
+    def __init__(self, si: ob.SpaceInformation, robot: WearerArm, step: float) -> None:
+        super().__init__(si)
+        self.robot = robot
+        self.step = float(step)
+        self._n = robot.nq
+        self.motions_checked = 0
+
+    def checkMotion(self, s1: ob.State, s2: ob.State) -> bool:  # noqa: N802 (OMPL override)
+        """True if every state along s1 -> s2 (excluding s1) is valid."""
+        n = self._n
+        a = np.array([s1[i] for i in range(n)])
+        b = np.array([s2[i] for i in range(n)])
+        self.motions_checked += 1
+        return bool(self.robot.are_valid(motion_states(a, b, self.step)).all())
+
+    def check_motions(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
+        """Validity of many motions A[k] -> B[k] (each excluding its start), one batched call."""
+        A, B = np.atleast_2d(A), np.atleast_2d(B)
+        chunks = [motion_states(a, b, self.step) for a, b in zip(A, B)]
+        self.motions_checked += len(chunks)
+        if not chunks:
+            return np.zeros(0, dtype=bool)
+        ok = self.robot.are_valid(np.concatenate(chunks))
+        bounds = np.cumsum([0] + [len(c) for c in chunks])
+        return np.array([ok[bounds[k] : bounds[k + 1]].all() for k in range(len(chunks))], dtype=bool)
+
+
+def make_space(robot: WearerArm) -> ob.RealVectorStateSpace:
+    """A RealVector state space bounded by the URDF joint limits (radians)."""
+    space = ob.RealVectorStateSpace(robot.nq)
+    bounds = ob.RealVectorBounds(robot.nq)
+    for i in range(robot.nq):
+        bounds.setLow(i, float(robot.lower[i]))
+        bounds.setHigh(i, float(robot.upper[i]))
+    space.setBounds(bounds)
+    return space
+
+
+def make_simple_setup(
+    robot: WearerArm,
+    start: Sequence[float] | None = None,
+    goal: Sequence[float] | None = None,
+    *,
+    joint_step: float | None = None,
+    batched_motion_validator: bool = True,
+    check_endpoints: bool = True,
+) -> og.SimpleSetup:
+    """Build an ``og.SimpleSetup`` for the arm, optionally with start and goal configurations.
+
+    Parameters
+    ----------
+    robot : WearerArm
+    start, goal : sequence of 4 floats, radians, optional
+    joint_step : float, radians
+        Longest joint-space step between checked states (default ``robot.max_joint_step()``,
+        the guarantee in the module docstring).
+    batched_motion_validator : bool
+        Check each motion with one batched call (default) instead of OMPL's per-state
+        ``DiscreteMotionValidator``; both check the same states.
+    check_endpoints : bool
+        Raise ValueError when start or goal is out of limits or in collision.
+
+    The objective is path length in the joint-space Euclidean metric.  The setup's
+    ``getSpaceInformation()`` is fully set up on return.
+    """
+    step = robot.max_joint_step() if joint_step is None else float(joint_step)
+    if not (math.isfinite(step) and step > 0):
+        raise ValueError(f"joint_step must be a finite number > 0, got {joint_step!r}")
+    space = make_space(robot)
+    ss = og.SimpleSetup(space)
+    si = ss.getSpaceInformation()
+    checker = WearerValidityChecker(si, robot)
+    ss.setStateValidityChecker(checker)
+    si.setStateValidityCheckingResolution(step / space.getMaximumExtent())
+    if batched_motion_validator:
+        si.setMotionValidator(BatchedMotionValidator(si, robot, step))
+    ss.setOptimizationObjective(ob.PathLengthOptimizationObjective(si))
+    # Python objects referenced only from C++ would be collected: keep them on the setup.
+    ss._tpee_refs = (robot, checker, si.getMotionValidator())  # type: ignore[attr-defined]
+    if start is not None or goal is not None:
+        if start is None or goal is None:
+            raise ValueError("give both start and goal, or neither")
+        q0, q1 = robot.check_config(start), robot.check_config(goal)
+        if check_endpoints:
+            for name, q in (("start", q0), ("goal", q1)):
+                if not robot.within_limits(q):
+                    raise ValueError(f"{name} {np.round(q, 4).tolist()} is outside the joint limits")
+                if not robot.is_valid(q):
+                    a, b, d = robot.closest_pair(q)
+                    raise ValueError(f"{name} {np.round(q, 4).tolist()} is in collision ({a} vs {b}, distance {d:.3f} m)")
+        s0, s1 = si.allocState(), si.allocState()
+        set_state(s0, q0)
+        set_state(s1, q1)
+        ss.setStartAndGoalStates(s0, s1, 1e-9)
+    si.setup()
+    return ss

@@ -1,0 +1,386 @@
+"""The wearer + 4-DOF arm model: loading, forward kinematics and collision checking.
+
+One :class:`WearerArm` loads the URDF and SRDF once (the packaged default or user files),
+turns the URDF cylinders into Coal capsules, and answers the questions every planner asks:
+is this configuration valid, how far is it from collision, where does the muzzle point,
+and is the line of sight from the muzzle to a target clear of the wearer.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+from pathlib import Path
+
+import coal
+import numpy as np
+import pinocchio as pin
+
+__all__ = [
+    "ARM_JOINTS",
+    "DEFAULT_SECURITY_MARGIN",
+    "DEFAULT_SRDF",
+    "DEFAULT_URDF",
+    "WearerArm",
+    "default_robot",
+    "find_model_file",
+]
+
+log = logging.getLogger(__name__)
+
+ARM_JOINTS = ("j1", "j2", "j3", "j4")
+"""Joint names in configuration order: DOF1 (about x), DOF2 (about -y), pan, tilt."""
+ARM_LINKS = ("link1", "link2", "link3", "link4")
+BOOM_LINKS = ("link1", "link2")
+MUZZLE_FRAME = "muzzle"
+DEFAULT_SECURITY_MARGIN = 0.02
+"""Metres. A configuration is valid only if every checked pair is at least this far apart."""
+
+
+def find_model_file(name: str) -> Path:
+    """Path of a packaged model file (wheel: inside the package; source tree: ``urdf/``)."""
+    here = Path(__file__).resolve().parent
+    for candidate in (here / "urdf" / name, here.parent / "urdf" / name):
+        if candidate.is_file():
+            return candidate
+    raise FileNotFoundError(f"packaged model file {name!r} not found next to {here}")
+
+
+DEFAULT_URDF = "wearer_arm.urdf"
+DEFAULT_SRDF = "wearer_arm.srdf"
+
+
+def _as_config_batch(Q: np.ndarray, nq: int) -> np.ndarray:
+    Q = np.asarray(Q, dtype=float)
+    if Q.ndim == 1:
+        Q = Q[None, :]
+    if Q.ndim != 2 or Q.shape[1] != nq:
+        raise ValueError(f"configurations must have shape (N, {nq}); got {Q.shape}")
+    if not np.all(np.isfinite(Q)):
+        raise ValueError("configurations contain NaN or inf")
+    return Q
+
+
+def _bounding_radius(geom: coal.CollisionGeometry) -> float:
+    if isinstance(geom, coal.Capsule):
+        return geom.radius + geom.halfLength
+    if isinstance(geom, coal.Sphere):
+        return geom.radius
+    if isinstance(geom, coal.Box):
+        return float(np.linalg.norm(geom.halfSide))
+    if isinstance(geom, coal.Cylinder):
+        return float(np.hypot(geom.radius, geom.halfLength))
+    geom.computeLocalAABB()
+    return float(geom.aabb_radius)
+
+
+@dataclass(frozen=True)
+class _LoadedFiles:
+    urdf: Path
+    srdf: Path | None
+
+
+class WearerArm:
+    """A standing wearer made of collision primitives, with the paper's 4-DOF arm on the back.
+
+    Parameters
+    ----------
+    urdf_path, srdf_path : path or None
+        Model files; ``None`` loads the packaged default.  ``srdf_path=False`` uses no SRDF.
+    security_margin : float, metres
+        Pairs closer than this count as colliding (Coal security margin).
+    n_threads : int or None
+        Threads for batched checks (default: all cores, at most 2).
+    """
+
+    def __init__(
+        self,
+        urdf_path: str | os.PathLike | None = None,
+        srdf_path: str | os.PathLike | None | bool = None,
+        security_margin: float = DEFAULT_SECURITY_MARGIN,
+        n_threads: int | None = None,
+    ) -> None:
+        if not np.isfinite(security_margin) or security_margin < 0:
+            raise ValueError(f"security_margin must be a finite number >= 0, got {security_margin!r}")
+        urdf = Path(urdf_path) if urdf_path is not None else find_model_file(DEFAULT_URDF)
+        if srdf_path is None:
+            srdf = find_model_file(DEFAULT_SRDF) if urdf_path is None else None
+        elif srdf_path is False:
+            srdf = None
+        else:
+            srdf = Path(srdf_path)
+        self.files = _LoadedFiles(urdf, srdf)
+        self.security_margin = float(security_margin)
+        self.n_threads = int(n_threads or min(2, os.cpu_count() or 1))
+        if self.n_threads < 1:
+            raise ValueError("n_threads must be >= 1")
+        self.collision_checks = 0
+        """Configurations checked for collision so far (single and batched)."""
+        self._load()
+
+    # ------------------------------------------------------------------ loading
+    def _load(self) -> None:
+        urdf, srdf = self.files.urdf, self.files.srdf
+        if not urdf.is_file():
+            raise FileNotFoundError(f"URDF file not found: {urdf}")
+        text = urdf.read_text()
+        try:
+            root = ET.fromstring(text)
+        except ET.ParseError as exc:
+            raise ValueError(f"malformed URDF {urdf}: {exc}") from exc
+        if root.tag != "robot":
+            raise ValueError(f"malformed URDF {urdf}: root element is <{root.tag}>, expected <robot>")
+        if any(c.tag == "capsule" for c in root.iter()):
+            raise ValueError(f"URDF {urdf} uses <capsule>, which urdfdom drops silently; use <cylinder> (loaded as capsules)")
+        joints = {j.get("name"): j.get("type") for j in root.iter("joint")}
+        for name in ARM_JOINTS:
+            if joints.get(name) != "revolute":
+                raise ValueError(f"URDF {urdf} lacks revolute joint {name!r} (found: {sorted(k for k in joints if k)})")
+        if MUZZLE_FRAME not in {link.get("name") for link in root.iter("link")}:
+            raise ValueError(f"URDF {urdf} lacks the {MUZZLE_FRAME!r} link")
+        self._n_collision_elements = sum(1 for _ in root.iter("collision"))
+
+        try:
+            self.model = pin.buildModelFromXML(text)
+            self.gmodel = pin.buildGeomFromUrdfString(self.model, text, pin.GeometryType.COLLISION)
+        except Exception as exc:  # the bindings raise RuntimeError/ValueError with C++ text
+            raise ValueError(f"Pinocchio could not load URDF {urdf}: {exc}") from exc
+        if tuple(self.model.names[1:]) != ARM_JOINTS:
+            raise ValueError(f"URDF {urdf}: moving joints must be exactly {ARM_JOINTS}, got {tuple(self.model.names[1:])}")
+        if self.gmodel.ngeoms != self._n_collision_elements:
+            raise ValueError(
+                f"URDF {urdf}: {self._n_collision_elements} <collision> elements but only "
+                f"{self.gmodel.ngeoms} geometries were loaded (unsupported shape?)"
+            )
+        for go in self.gmodel.geometryObjects:  # every URDF cylinder is a capsule (urdf/README.md)
+            if isinstance(go.geometry, coal.Cylinder):
+                go.geometry = coal.Capsule(go.geometry.radius, 2.0 * go.geometry.halfLength)
+
+        self.gmodel.addAllCollisionPairs()
+        if srdf is not None:
+            self._apply_srdf(srdf)
+        self.data = self.model.createData()
+        self._prune_unreachable_pairs()
+        self._rebuild_geometry_data()
+        self.muzzle_frame_id = self.model.getFrameId(MUZZLE_FRAME)
+        self.lower = self.model.lowerPositionLimit.copy()
+        self.upper = self.model.upperPositionLimit.copy()
+        self._build_line_of_sight_shapes()
+        log.debug("loaded %s: %d geometries, %d pairs", urdf, self.gmodel.ngeoms, len(self.gmodel.collisionPairs))
+
+    def _apply_srdf(self, srdf: Path) -> None:
+        if not srdf.is_file():
+            raise FileNotFoundError(f"SRDF file not found: {srdf}")
+        try:
+            root = ET.fromstring(srdf.read_text())
+        except ET.ParseError as exc:
+            raise ValueError(f"malformed SRDF {srdf}: {exc}") from exc
+        links = {f.name for f in self.model.frames}
+        for dc in root.iter("disable_collisions"):
+            for key in ("link1", "link2"):
+                if dc.get(key) not in links:
+                    raise ValueError(f"SRDF {srdf} names unknown link {dc.get(key)!r}")
+        pin.removeCollisionPairs(self.model, self.gmodel, str(srdf))
+
+    def _prune_unreachable_pairs(self) -> None:
+        """Drop arm-wearer pairs whose wearer part lies beyond the arm's reach from joint 1 (plus margin).
+
+        Removing a pair that can never come within the margin changes no answer; it only saves time.
+        """
+        pin.forwardKinematics(self.model, self.data, pin.neutral(self.model))
+        pivot = self.data.oMi[1].translation.copy()
+        reach = self.lever_arms()[0] + self.security_margin
+        removed = []
+        for cp in list(self.gmodel.collisionPairs):
+            a, b = self.gmodel.geometryObjects[cp.first], self.gmodel.geometryObjects[cp.second]
+            wearer = a if a.parentJoint == 0 else b if b.parentJoint == 0 else None
+            if wearer is None:
+                continue
+            gap = np.linalg.norm(wearer.placement.translation - pivot) - _bounding_radius(wearer.geometry)
+            if gap > reach:
+                removed.append(cp)
+        for cp in removed:
+            self.gmodel.removeCollisionPair(cp)
+        self.pruned_pairs = len(removed)
+
+    def _rebuild_geometry_data(self) -> None:
+        self.gdata = pin.GeometryData(self.gmodel)
+        ng = self.gmodel.ngeoms
+        self.gdata.setSecurityMargins(self.gmodel, np.full((ng, ng), self.security_margin))
+        for req in self.gdata.collisionRequests:
+            req.enable_contact = True  # Coal misses edge/corner contacts otherwise
+        self.pool = pin.GeometryPool(self.model, self.gmodel, self.n_threads)
+        self.pool.update(self.gdata)
+
+    def _build_line_of_sight_shapes(self) -> None:
+        """Wearer geometries (static) and boom geometries (moving) that may block the line of sight."""
+        boom_joints = {self.model.getJointId(j) for j in ("j1", "j2")}
+        self._los_static = []
+        self._los_boom = []
+        for i, go in enumerate(self.gmodel.geometryObjects):
+            if go.parentJoint == 0:
+                self._los_static.append(coal.CollisionObject(go.geometry, coal.Transform3s(go.placement)))
+            elif go.parentJoint in boom_joints:
+                self._los_boom.append(i)
+        self._los_manager = coal.DynamicAABBTreeCollisionManager()
+        for obj in self._los_static:
+            self._los_manager.registerObject(obj)
+        self._los_manager.setup()
+
+    # ------------------------------------------------------------------ facts
+    @property
+    def nq(self) -> int:
+        """Number of joints (4)."""
+        return self.model.nq
+
+    @property
+    def joint_names(self) -> tuple[str, ...]:
+        """Joint names in configuration order."""
+        return tuple(self.model.names[1:])
+
+    def geometry_names(self, joint: str | int = 0) -> list[str]:
+        """Names of the geometries attached to a joint (0 = the wearer)."""
+        jid = joint if isinstance(joint, int) else self.model.getJointId(joint)
+        return [go.name for go in self.gmodel.geometryObjects if go.parentJoint == jid]
+
+    def lever_arms(self) -> np.ndarray:
+        """Upper bound, per joint, on the distance from that joint's axis to any arm point it moves (metres).
+
+        Used to bound how far the arm can move for a given joint step (see :meth:`max_joint_step`).
+        """
+        n = self.nq
+        reach = np.zeros(n)
+        for j in range(1, n + 1):
+            best = 0.0
+            for go in self.gmodel.geometryObjects:
+                k = go.parentJoint
+                if k < j:
+                    continue
+                # chain of joint offsets from joint j down to the geometry's joint, then the shape itself
+                dist = sum(np.linalg.norm(self.model.jointPlacements[m].translation) for m in range(j + 1, k + 1))
+                dist += np.linalg.norm(go.placement.translation) + _bounding_radius(go.geometry)
+                best = max(best, dist)
+            for f in self.model.frames:  # the muzzle tip too
+                if f.parentJoint >= j and f.name == MUZZLE_FRAME:
+                    dist = sum(np.linalg.norm(self.model.jointPlacements[m].translation) for m in range(j + 1, f.parentJoint + 1))
+                    best = max(best, dist + np.linalg.norm(f.placement.translation))
+            reach[j - 1] = best
+        return reach
+
+    def max_joint_step(self, displacement: float | None = None) -> float:
+        """Largest Euclidean joint step (radians) that moves no point of the arm more than ``displacement``.
+
+        A step dq moves any arm point at most sum_i |dq_i| r_i <= ||dq||_2 ||r||_2 (Cauchy-Schwarz),
+        with r the lever arms.  Default displacement: the security margin.
+        """
+        d = self.security_margin if displacement is None else float(displacement)
+        if not d > 0:
+            raise ValueError("displacement must be > 0 (a zero security margin gives no motion-check guarantee)")
+        return d / float(np.linalg.norm(self.lever_arms()))
+
+    # ------------------------------------------------------------------ kinematics
+    def check_config(self, q: np.ndarray) -> np.ndarray:
+        """Return q as a float array of shape (nq,), or raise ValueError naming the problem."""
+        q = np.asarray(q, dtype=float)
+        if q.shape != (self.nq,):
+            raise ValueError(f"configuration must have shape ({self.nq},); got {q.shape}")
+        if not np.all(np.isfinite(q)):
+            raise ValueError(f"configuration contains NaN or inf: {q}")
+        return q
+
+    def within_limits(self, q: np.ndarray) -> bool:
+        """True if q is inside the URDF joint limits."""
+        q = self.check_config(q)
+        return bool(np.all(q >= self.lower) and np.all(q <= self.upper))
+
+    def frame_placement(self, q: np.ndarray, frame: str) -> pin.SE3:
+        """World placement of a named frame at configuration q."""
+        q = self.check_config(q)
+        fid = self.model.getFrameId(frame)
+        if fid >= self.model.nframes:
+            raise ValueError(f"unknown frame {frame!r}")
+        pin.forwardKinematics(self.model, self.data, q)
+        return pin.updateFramePlacement(self.model, self.data, fid)
+
+    def joint_placement(self, q: np.ndarray, joint: str) -> pin.SE3:
+        """World placement of a joint frame at configuration q."""
+        q = self.check_config(q)
+        pin.forwardKinematics(self.model, self.data, q)
+        return self.data.oMi[self.model.getJointId(joint)].copy()
+
+    def muzzle(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Muzzle point (m) and unit pointing direction (+x of the barrel) in the world frame."""
+        M = self.frame_placement(q, MUZZLE_FRAME)
+        return M.translation.copy(), M.rotation[:, 0].copy()
+
+    # ------------------------------------------------------------------ collision
+    def is_valid(self, q: np.ndarray) -> bool:
+        """True if q is within limits and no checked pair (arm-wearer, arm-arm) is closer than the margin."""
+        q = self.check_config(q)
+        if not (np.all(q >= self.lower) and np.all(q <= self.upper)):
+            return False
+        self.collision_checks += 1
+        return not pin.computeCollisions(self.model, self.data, self.gmodel, self.gdata, q, True)
+
+    def are_valid(self, Q: np.ndarray) -> np.ndarray:
+        """Batched :meth:`is_valid` for Q of shape (N, nq): one Pinocchio call; returns bool (N,)."""
+        Q = _as_config_batch(Q, self.nq)
+        ok = np.all((Q >= self.lower) & (Q <= self.upper), axis=1)
+        if ok.any():
+            Qin = np.ascontiguousarray(Q[ok].T)  # Pinocchio wants (nq, N)
+            self.collision_checks += Qin.shape[1]
+            collides = pin.computeCollisionsInParallel(self.n_threads, self.pool, Qin, True, False)
+            ok[ok] = ~np.asarray(collides, dtype=bool)
+        return ok
+
+    def clearance(self, q: np.ndarray) -> float:
+        """Smallest distance (m, negative when penetrating) over all checked pairs at q."""
+        q = self.check_config(q)
+        k = pin.computeDistances(self.model, self.data, self.gmodel, self.gdata, q)
+        return float(self.gdata.distanceResults[k].min_distance)
+
+    def closest_pair(self, q: np.ndarray) -> tuple[str, str, float]:
+        """The two geometry names of the closest checked pair at q, and their distance (m)."""
+        q = self.check_config(q)
+        k = pin.computeDistances(self.model, self.data, self.gmodel, self.gdata, q)
+        cp = self.gmodel.collisionPairs[k]
+        names = self.gmodel.geometryObjects
+        return names[cp.first].name, names[cp.second].name, float(self.gdata.distanceResults[k].min_distance)
+
+    def line_of_sight_clear(self, q: np.ndarray, target: np.ndarray) -> bool:
+        """True if the segment muzzle -> target touches neither the wearer nor the arm's boom."""
+        target = np.asarray(target, dtype=float)
+        if target.shape != (3,) or not np.all(np.isfinite(target)):
+            raise ValueError(f"target must be 3 finite numbers, got {target!r}")
+        p, _ = self.muzzle(q)
+        d = target - p
+        length = float(np.linalg.norm(d))
+        if length < 1e-9:
+            return True
+        R = pin.Quaternion.FromTwoVectors(np.array([0.0, 0.0, 1.0]), d / length).matrix()
+        seg = coal.CollisionObject(coal.Capsule(0.0, length), coal.Transform3s(R, p + d / 2))
+        cb = coal.CollisionCallBackDefault()
+        self._los_manager.collide(seg, cb)
+        if cb.data.result.isCollision():
+            return False
+        pin.updateGeometryPlacements(self.model, self.data, self.gmodel, self.gdata)  # boom moved with q
+        req, res = coal.CollisionRequest(), coal.CollisionResult()
+        for i in self._los_boom:
+            res.clear()
+            if coal.collide(seg.collisionGeometry(), seg.getTransform(), self.gmodel.geometryObjects[i].geometry,
+                            coal.Transform3s(self.gdata.oMg[i]), req, res):
+                return False
+        return True
+
+
+_DEFAULT: WearerArm | None = None
+
+
+def default_robot() -> WearerArm:
+    """The packaged model, loaded once per process (read-only use; build your own to change settings)."""
+    global _DEFAULT
+    if _DEFAULT is None:
+        _DEFAULT = WearerArm()
+    return _DEFAULT
