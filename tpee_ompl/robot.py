@@ -8,6 +8,7 @@ and is the line of sight from the muzzle to a target clear of the wearer.
 
 from __future__ import annotations
 
+import hashlib
 import logging
 import os
 import xml.etree.ElementTree as ET
@@ -141,6 +142,11 @@ class WearerArm:
         if MUZZLE_FRAME not in {link.get("name") for link in root.iter("link")}:
             raise ValueError(f"URDF {urdf} lacks the {MUZZLE_FRAME!r} link")
         self._n_collision_elements = sum(1 for _ in root.iter("collision"))
+        digest = hashlib.sha256(text.encode())
+        if srdf is not None and srdf.is_file():
+            digest.update(srdf.read_bytes())
+        self.model_hash = digest.hexdigest()[:16]
+        """Short SHA-256 of the URDF (+ SRDF) text: stored with query sets and path libraries."""
 
         try:
             self.model = pin.buildModelFromXML(text)
