@@ -110,20 +110,20 @@ def build() -> str:
     tx, ty, tz = T_OFFSET
     lo = LIMITS
     out.append(f'''  <joint name="j1" type="revolute"><parent link="mount"/><child link="link1"/>
-    <origin xyz="{_f(MOUNT)}"/><axis xyz="1 0 0"/><limit lower="{lo["j1"][0]:.6f}" upper="{lo["j1"][1]:.6f}" effort="50" velocity="2"/></joint>
+    <origin xyz="{_f(MOUNT)}"/><axis xyz="1 0 0"/><limit lower="{lo["j1"][0]:.12f}" upper="{lo["j1"][1]:.12f}" effort="50" velocity="2"/></joint>
   <link name="link1">
     <collision><geometry><sphere radius="0.04"/></geometry></collision>
   </link>
   <joint name="j2" type="revolute"><parent link="link1"/><child link="link2"/>
-    <origin xyz="0 0 0"/><axis xyz="0 -1 0"/><limit lower="{lo["j2"][0]:.6f}" upper="{lo["j2"][1]:.6f}" effort="50" velocity="2"/></joint>
+    <origin xyz="0 0 0"/><axis xyz="0 -1 0"/><limit lower="{lo["j2"][0]:.12f}" upper="{lo["j2"][1]:.12f}" effort="50" velocity="2"/></joint>
   <link name="link2">
 {_capsule((0, 0, 0), (tx, 0, 0), BOOM_R, "    ")}{_capsule((tx, 0, 0), (tx, ty, tz), BOOM_R, "    ")}  </link>
   <joint name="j3" type="revolute"><parent link="link2"/><child link="link3"/>
-    <origin xyz="{_f(T_OFFSET)}"/><axis xyz="0 0 1"/><limit lower="{lo["j3"][0]:.6f}" upper="{lo["j3"][1]:.6f}" effort="20" velocity="3"/></joint>
+    <origin xyz="{_f(T_OFFSET)}"/><axis xyz="0 0 1"/><limit lower="{lo["j3"][0]:.12f}" upper="{lo["j3"][1]:.12f}" effort="20" velocity="3"/></joint>
   <link name="link3">
 {_capsule((0, 0, 0), (0, L3, 0), 0.03, "    ")}  </link>
   <joint name="j4" type="revolute"><parent link="link3"/><child link="link4"/>
-    <origin xyz="0 {L3} 0"/><axis xyz="0 -1 0"/><limit lower="{lo["j4"][0]:.6f}" upper="{lo["j4"][1]:.6f}" effort="20" velocity="3"/></joint>
+    <origin xyz="0 {L3} 0"/><axis xyz="0 -1 0"/><limit lower="{lo["j4"][0]:.12f}" upper="{lo["j4"][1]:.12f}" effort="20" velocity="3"/></joint>
   <link name="link4">
 {_capsule((-0.04, 0, 0), (L4 - BARREL_R, 0, 0), BARREL_R, "    ")}  </link>
   <joint name="muzzle_fixed" type="fixed"><parent link="link4"/><child link="muzzle"/><origin xyz="{L4} 0 0"/></joint>

@@ -1,0 +1,117 @@
+"""OMPL set-up: bounds, resolution, motion-check guarantee, RRT* end to end."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from ompl import base as ob
+from ompl import geometric as og
+from ompl import util as ou
+
+from tpee_ompl.ompl_problem import BatchedMotionValidator, make_simple_setup, motion_states, path_to_array, set_state
+from tpee_ompl.robot import WearerArm
+from tpee_ompl.sectors import posture_preset
+
+
+def preset(k: int, pan: float = 0.0, tilt: float = 0.0) -> np.ndarray:
+    return np.r_[posture_preset(k), pan, tilt]
+
+
+def test_setup_bounds_come_from_the_urdf_limits(robot):
+    ss = make_simple_setup(robot)
+    b = ss.getStateSpace().getBounds()
+    np.testing.assert_allclose([b.low[i] for i in range(4)], robot.lower)
+    np.testing.assert_allclose([b.high[i] for i in range(4)], robot.upper)
+
+
+def test_default_resolution_is_the_safe_joint_step(robot):
+    ss = make_simple_setup(robot)
+    si = ss.getSpaceInformation()
+    step = si.getStateValidityCheckingResolution() * si.getMaximumExtent()
+    assert step == pytest.approx(robot.max_joint_step())
+    assert isinstance(si.getMotionValidator(), BatchedMotionValidator)
+
+
+def test_lever_arm_bound_holds_for_every_arm_point(robot, rng):
+    """No sampled arm point moves more than ||dq|| * ||lever arms|| for a joint step dq."""
+    R = float(np.linalg.norm(robot.lever_arms()))
+    worst = 0.0
+    for _ in range(300):
+        q = rng.uniform(robot.lower, robot.upper)
+        dq = rng.normal(size=4)
+        dq *= 1e-3 / np.linalg.norm(dq)
+        moved = max(
+            np.linalg.norm(robot.frame_placement(q + dq, f).translation - robot.frame_placement(q, f).translation)
+            for f in ("muzzle", "link4", "link3", "link2")
+        )
+        worst = max(worst, moved / (1e-3 * R))
+    assert worst <= 1.0
+
+
+def test_accepted_motions_keep_half_the_margin_under_a_much_denser_check(robot, rng):
+    """Every motion that checkMotion accepts keeps >= margin/2 clearance when re-checked 10x denser."""
+    ss = make_simple_setup(robot)
+    si = ss.getSpaceInformation()
+    half = WearerArm(security_margin=robot.security_margin / 2)
+    a, b = si.allocState(), si.allocState()
+    accepted = 0
+    while accepted < 150:
+        q0 = rng.uniform(robot.lower, robot.upper)
+        q1 = q0 + rng.normal(scale=0.4, size=4)
+        if not (robot.within_limits(q1) and robot.is_valid(q0)):
+            continue
+        if si.checkMotion(set_state(a, q0), set_state(b, q1)):
+            accepted += 1
+            dense = motion_states(q0, q1, robot.max_joint_step() / 10)
+            assert half.are_valid(dense).all()
+
+
+@pytest.mark.parametrize("batched", [True, False])
+def test_batched_and_discrete_motion_validators_agree(robot, rng, batched):
+    ss_b = make_simple_setup(robot, batched_motion_validator=True)
+    ss_d = make_simple_setup(robot, batched_motion_validator=False)
+    sb, sd = ss_b.getSpaceInformation(), ss_d.getSpaceInformation()
+    a, b = sb.allocState(), sb.allocState()
+    for _ in range(200):
+        q0 = rng.uniform(robot.lower, robot.upper)
+        q1 = np.clip(q0 + rng.normal(scale=0.5, size=4), robot.lower, robot.upper)
+        set_state(a, q0), set_state(b, q1)
+        assert sb.checkMotion(a, b) == sd.checkMotion(a, b)
+
+
+def test_rrtstar_between_two_presets_returns_an_exact_path_whose_every_segment_passes_check_motion(robot):
+    ou.RNG.setSeed(7) if ou.RNG.getSeed() == 0 else None
+    ss = make_simple_setup(robot, preset(1), preset(4))
+    si = ss.getSpaceInformation()
+    planner = og.RRTstar(si)
+    ss.setPlanner(planner)
+    status = ss.solve(ob.PlannerTerminationCondition(lambda: planner.numIterations() >= 300))
+    assert status == ob.PlannerStatus.EXACT_SOLUTION
+    assert ss.haveExactSolutionPath()
+    path = ss.getSolutionPath()
+    states = path.getStates()
+    assert all(si.checkMotion(s0, s1) for s0, s1 in zip(states[:-1], states[1:]))
+    W = path_to_array(path, 4)
+    np.testing.assert_allclose(W[0], preset(1))
+    np.testing.assert_allclose(W[-1], preset(4))
+
+
+def test_start_in_collision_is_refused_with_the_colliding_parts(robot):
+    with pytest.raises(ValueError, match=r"start .* in collision \(.*helmet"):
+        make_simple_setup(robot, [-0.085, 0.299, -0.799, -1.202], preset(4))
+
+
+def test_goal_outside_limits_is_refused(robot):
+    with pytest.raises(ValueError, match="goal .* outside the joint limits"):
+        make_simple_setup(robot, preset(1), [0.0, 4.0, 0.0, 0.0])
+
+
+@pytest.mark.parametrize("step", [0.0, -1.0, float("nan")])
+def test_bad_joint_step_raises(robot, step):
+    with pytest.raises(ValueError, match="joint_step"):
+        make_simple_setup(robot, joint_step=step)
+
+
+def test_motion_states_match_ompl_subdivision():
+    s = motion_states(np.zeros(4), np.array([1.0, 0, 0, 0]), 0.3)
+    np.testing.assert_allclose(s[:, 0], [0.25, 0.5, 0.75, 1.0])
