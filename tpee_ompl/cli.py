@@ -1,0 +1,203 @@
+"""The ``tpee-ompl`` command line: plan, aim, bench, library, track, show, animate, view.
+
+Every subcommand is one function; errors from bad input are printed as one line on stderr with
+exit code 2, never a traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import gc
+import json
+import logging
+import math
+import sys
+from collections.abc import Callable, Sequence
+
+import numpy as np
+
+__all__ = ["get_argument_parser", "main", "PLANNERS", "CliError"]
+
+log = logging.getLogger(__name__)
+
+
+class CliError(Exception):
+    """A user-facing error: printed as one line, exit code 2."""
+
+
+PLANNERS = ("dimension-rrt", "rrtstar", "informedrrtstar", "rrtconnect", "aorrtc", "bitstar")
+
+
+def _finite(text: str) -> float:
+    v = float(text)
+    if not math.isfinite(v):
+        raise argparse.ArgumentTypeError(f"not a finite number: {text}")
+    return v
+
+
+def _positive_int(text: str) -> int:
+    v = int(text)
+    if v <= 0:
+        raise argparse.ArgumentTypeError(f"must be a positive integer: {text}")
+    return v
+
+
+def _positive_float(text: str) -> float:
+    v = _finite(text)
+    if v <= 0:
+        raise argparse.ArgumentTypeError(f"must be > 0: {text}")
+    return v
+
+
+def _sector(text: str) -> int:
+    from .sectors import check_sector
+
+    try:
+        return check_sector(int(text))
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+# ---------------------------------------------------------------------------------------- plan
+def _make_planner(name: str, si, from_sector: int, to_sector: int, samples: int | None, seed: int):
+    """Planner instance and a termination-condition factory for it."""
+    from ompl import base as ob
+    from ompl import geometric as og
+
+    if name == "dimension-rrt":
+        from .dimension_rrt import tpee_dimension_rrt
+
+        planner = tpee_dimension_rrt(si, from_sector, to_sector, max_samples=samples, seed=seed)
+        return planner, None
+    cls = {
+        "rrtstar": og.RRTstar,
+        "informedrrtstar": og.InformedRRTstar,
+        "rrtconnect": og.RRTConnect,
+        "aorrtc": og.AORRTC,
+        "bitstar": og.BITstar,
+    }[name]
+    planner = cls(si)
+    if samples is not None:
+        if not hasattr(planner, "numIterations"):
+            raise CliError(f"--samples needs a planner that counts iterations; {name} does not (use --time)")
+        return planner, lambda: ob.PlannerTerminationCondition(lambda: planner.numIterations() >= samples)
+    return planner, None
+
+
+def cmd_plan(args: argparse.Namespace) -> int:
+    """Plan one cross-sector motion and print the path, its validity and length."""
+    from ompl import base as ob
+    from ompl import util as ou
+
+    from .ompl_problem import make_simple_setup, path_to_array
+    from .robot import WearerArm
+
+    ou.setLogLevel(ou.LOG_WARN)
+    if args.seed is not None:
+        ou.RNG.setSeed(args.seed)
+    robot = WearerArm(args.urdf, args.srdf) if args.urdf else WearerArm()
+    if args.start is not None and args.goal is not None:
+        start, goal, qid = np.array(args.start), np.array(args.goal), None
+    elif args.start is None and args.goal is None:
+        from .queries import load_queries
+
+        matching = [q for q in load_queries(args.queries) if (q.from_sector, q.to_sector) == (args.from_sector, args.to_sector)]
+        if not matching:
+            raise CliError(f"query set {args.queries!r} has no query from sector {args.from_sector} to {args.to_sector}")
+        if args.query_index >= len(matching):
+            raise CliError(f"--query-index {args.query_index}: the set has {len(matching)} queries for that pair")
+        q = matching[args.query_index]
+        start, goal, qid = np.asarray(q.start), np.asarray(q.goal), q.id
+    else:
+        raise CliError("give both --start and --goal, or neither")
+    ss = make_simple_setup(robot, start, goal)
+    si = ss.getSpaceInformation()
+    planner, ptc_factory = _make_planner(args.planner, si, args.from_sector, args.to_sector, args.samples, args.seed or 0)
+    ss.setPlanner(planner)
+    checks0 = robot.collision_checks
+    if ptc_factory is not None:
+        status = ss.solve(ob.plannerOrTerminationCondition(ptc_factory(), ob.timedPlannerTerminationCondition(args.time)))
+    else:
+        status = ss.solve(args.time)
+    exact = bool(ss.haveExactSolutionPath())
+    result: dict = {"planner": args.planner, "from_sector": args.from_sector, "to_sector": args.to_sector,
+                    "query_id": qid, "status": str(status), "exact": exact,
+                    "time_s": ss.getLastPlanComputationTime(), "collision_checks": robot.collision_checks - checks0}
+    if ss.haveSolutionPath():
+        path = ss.getSolutionPath()
+        states = path.getStates()
+        result["valid"] = bool(all(si.checkMotion(a, b) for a, b in zip(states[:-1], states[1:])))
+        result["length_rad"] = float(path.length())
+        result["path"] = path_to_array(path, robot.nq).round(6).tolist()
+    if args.json:
+        print(json.dumps(result))
+    else:
+        print(f"{args.planner}: sector {args.from_sector} -> {args.to_sector}, status {result['status']}, "
+              f"{result['time_s']:.3f} s, {result['collision_checks']} collision checks")
+        if "path" in result:
+            print(f"valid (checkMotion on every segment): {result['valid']}, length {result['length_rad']:.4f} rad, "
+                  f"{len(result['path'])} waypoints (DOF1..DOF4, rad):")
+            for w in result["path"]:
+                print("  " + " ".join(f"{v:+.4f}" for v in w))
+    return 0 if exact else 1
+
+
+# ---------------------------------------------------------------------------------------- parser
+def _add_model_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--urdf", default=None, help="URDF file (default: the packaged wearer + arm)")
+    p.add_argument("--srdf", default=None, help="SRDF file with disabled collision pairs (with --urdf)")
+
+
+def get_argument_parser() -> argparse.ArgumentParser:
+    """The full ``tpee-ompl`` argument parser."""
+    parser = argparse.ArgumentParser(prog="tpee-ompl", description=__doc__.split("\n")[0])
+    parser.add_argument("-v", "--verbose", action="store_true", help="log at INFO level")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    fmt = argparse.RawDescriptionHelpFormatter
+
+    p = sub.add_parser("plan", help="plan one cross-sector motion", formatter_class=fmt,
+                       description="Plan a cross-sector motion between the first stored query of a sector pair "
+                                   "(or --start/--goal).\n\nexample:\n  tpee-ompl plan --from 1 --to 4 --planner dimension-rrt"
+                                   "\n  tpee-ompl plan --from 2 --to 3 --planner rrtstar --samples 1000 --json")
+    p.add_argument("--from", dest="from_sector", type=_sector, required=True, help="start posture sector (1-4)")
+    p.add_argument("--to", dest="to_sector", type=_sector, required=True, help="goal posture sector (1-4)")
+    p.add_argument("--planner", choices=PLANNERS, default="dimension-rrt")
+    p.add_argument("--time", type=_positive_float, default=5.0, help="time limit in seconds (default 5)")
+    p.add_argument("--samples", type=_positive_int, default=None, help="sample / iteration cap")
+    p.add_argument("--seed", type=int, default=1)
+    p.add_argument("--queries", default="planning_necessary", help="query set name or JSON file")
+    p.add_argument("--query-index", type=int, default=0, help="which query of that pair (default 0)")
+    p.add_argument("--start", type=_finite, nargs=4, default=None, metavar="Q", help="start DOF1..DOF4 (rad)")
+    p.add_argument("--goal", type=_finite, nargs=4, default=None, metavar="Q", help="goal DOF1..DOF4 (rad)")
+    p.add_argument("--json", action="store_true", help="machine-readable output")
+    _add_model_args(p)
+    p.set_defaults(func=cmd_plan)
+
+    for register in _EXTRA_COMMANDS:
+        register(sub, fmt)
+    return parser
+
+
+_EXTRA_COMMANDS: list[Callable[[argparse._SubParsersAction, type], None]] = []
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of ``tpee-ompl``; returns the exit code."""
+    parser = get_argument_parser()
+    args = parser.parse_args(argv)
+    logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
+    try:
+        return int(args.func(args) or 0)
+    except (CliError, ValueError, FileNotFoundError, ImportError, KeyError) as exc:
+        msg = exc.args[0] if isinstance(exc, KeyError) and exc.args else exc
+        print(f"tpee-ompl {args.command}: error: {msg}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"tpee-ompl {args.command}: interrupted", file=sys.stderr)
+        return 130
+    finally:
+        gc.collect()  # break si <-> Python checker cycles before exit (nanobind leak warnings otherwise)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
