@@ -1,4 +1,4 @@
-"""Posture sectors (paper Table 1) and the DOF1/DOF2 cross-sector trajectories (Table 3).
+"""Posture sectors (paper Table 1), pointing sectors (Table 2) and the DOF1/DOF2 cross-sector trajectories (Table 3).
 
 Degrees appear only in the two tables below, exactly as printed in the paper (with the one
 correction noted); everything exported is in radians.
@@ -15,6 +15,15 @@ __all__ = [
     "posture_preset",
     "cross_sector_trajectory",
     "check_sector",
+    "POLAR_CAP",
+    "POSTURE_AZIMUTH",
+    "POINTING_AZIMUTH",
+    "sector_origin",
+    "target_direction",
+    "posture_sector",
+    "in_pointing_sector",
+    "pointing_sectors",
+    "select_sector",
 ]
 
 SECTORS = (1, 2, 3, 4)
@@ -69,3 +78,125 @@ def cross_sector_trajectory(i: int, j: int) -> np.ndarray:
     if i == j:
         raise ValueError(f"no cross-sector trajectory from sector {i} to itself")
     return CROSS_SECTOR_TRAJECTORIES[(i, j)].copy()
+
+
+# ---------------------------------------------------------------------------------------------
+# Pointing sectors (Table 2, re-derived for this model; see docs/pointing.md)
+# ---------------------------------------------------------------------------------------------
+#
+# Directions are taken from the DOF1/DOF2 pivot (the origin of the paper's eq. 6), as azimuth
+# alpha = atan2(y, x) (0 = ahead, +90 deg = the wearer's left) and elevation epsilon above the
+# horizontal.  Posture sectors are the four azimuth quadrants, disjoint and covering the sphere:
+#
+#   3: front-left   0 <= alpha <  90    (posture 3 sits over the left shoulder)
+#   4: front-right -90 <= alpha <  0    (posture 4 sits over the right shoulder)
+#   2: rear-left   90 <= alpha <= 180   (posture 2 sits low behind, left)
+#   1: rear-right -180 < alpha < -90    (posture 1 sits low behind, right)
+#
+# Pointing sector k is posture sector k widened by a margin on each side (the hysteresis band),
+# plus the cap epsilon >= POLAR_CAP where every posture aims freely and azimuth is ill-defined.
+# The margins are as wide as posture k's collision-free, line-of-sight pointing range allows
+# (measured, docs/pointing.md): the rifle held at the chest and the arms block low targets on
+# the far side of the front, so the front margin is narrow; the sides and rear are wide.
+
+_FRONT_MARGIN_DEG = 5.0
+_SIDE_MARGIN_DEG = 20.0
+_REAR_MARGIN_DEG = 20.0
+_POLAR_CAP_DEG = 60.0
+
+_POSTURE_AZIMUTH_DEG = {1: (-180.0, -90.0), 2: (90.0, 180.0), 3: (0.0, 90.0), 4: (-90.0, 0.0)}
+_POINTING_AZIMUTH_DEG = {
+    1: (-180.0 - _REAR_MARGIN_DEG, -90.0 + _SIDE_MARGIN_DEG),
+    2: (90.0 - _SIDE_MARGIN_DEG, 180.0 + _REAR_MARGIN_DEG),
+    3: (0.0 - _FRONT_MARGIN_DEG, 90.0 + _SIDE_MARGIN_DEG),
+    4: (-90.0 - _SIDE_MARGIN_DEG, 0.0 + _FRONT_MARGIN_DEG),
+}
+
+POLAR_CAP = float(np.deg2rad(_POLAR_CAP_DEG))
+"""Radians. Directions at least this far above the horizontal belong to every pointing sector."""
+
+POSTURE_AZIMUTH: dict[int, tuple[float, float]] = {
+    k: (float(np.deg2rad(a)), float(np.deg2rad(b))) for k, (a, b) in _POSTURE_AZIMUTH_DEG.items()
+}
+"""Sector -> azimuth interval [lo, hi), radians, of the posture sector (disjoint, covering)."""
+
+POINTING_AZIMUTH: dict[int, tuple[float, float]] = {
+    k: (float(np.deg2rad(a)), float(np.deg2rad(b))) for k, (a, b) in _POINTING_AZIMUTH_DEG.items()
+}
+"""Sector -> azimuth interval [lo, hi], radians (may extend past +-pi), of the pointing sector."""
+
+_DEFAULT_ORIGIN: np.ndarray | None = None
+
+
+def sector_origin() -> np.ndarray:
+    """World position (3,), metres, that sector directions are measured from: the packaged model's j1 pivot."""
+    global _DEFAULT_ORIGIN
+    if _DEFAULT_ORIGIN is None:
+        from .robot import default_robot  # late import: the tables above need no model
+
+        _DEFAULT_ORIGIN = default_robot().model.jointPlacements[1].translation.copy()
+        _DEFAULT_ORIGIN.setflags(write=False)
+    return _DEFAULT_ORIGIN
+
+
+def target_direction(targets: np.ndarray, origin: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Azimuth (N,) in (-pi, pi] and elevation (N,) in [-pi/2, pi/2], radians, of targets (N, 3) from origin.
+
+    Raises ValueError for non-finite targets or a target at the origin (no direction).
+    """
+    t = np.asarray(targets, dtype=float)
+    single = t.ndim == 1
+    t = np.atleast_2d(t)
+    if t.ndim != 2 or t.shape[1] != 3:
+        raise ValueError(f"targets must have shape (3,) or (N, 3); got {np.shape(targets)}")
+    if not np.all(np.isfinite(t)):
+        raise ValueError("targets contain NaN or inf")
+    d = t - (sector_origin() if origin is None else np.asarray(origin, dtype=float))
+    dist = np.linalg.norm(d, axis=1)
+    if np.any(dist < 1e-9):
+        raise ValueError("a target at the sector origin (the DOF1/DOF2 pivot) has no direction")
+    az = np.arctan2(d[:, 1], d[:, 0])
+    az = np.where(az <= -np.pi, np.pi, az)
+    el = np.arcsin(np.clip(d[:, 2] / dist, -1.0, 1.0))
+    return (az[0], el[0]) if single else (az, el)
+
+
+def _in_azimuth(az: np.ndarray, lo: float, hi: float) -> np.ndarray:
+    """az in [lo, hi] modulo 2*pi (interval length < 2*pi)."""
+    return np.mod(az - lo, 2.0 * np.pi) <= (hi - lo) + 1e-12
+
+
+def posture_sector(targets: np.ndarray, origin: np.ndarray | None = None) -> np.ndarray | int:
+    """The posture sector (1-4) of each target (3,) or (N, 3): the azimuth quadrant seen from the pivot."""
+    az, _ = target_direction(targets, origin)
+    az_arr = np.atleast_1d(az)
+    out = np.where(az_arr >= np.pi / 2, 2, np.where(az_arr >= 0, 3, np.where(az_arr >= -np.pi / 2, 4, 1)))
+    return int(out[0]) if np.ndim(az) == 0 else out
+
+
+def in_pointing_sector(targets: np.ndarray, k: int, origin: np.ndarray | None = None) -> np.ndarray | bool:
+    """True where a target (3,) or (N, 3) lies in pointing sector k (Table 2, re-derived)."""
+    k = check_sector(k)
+    az, el = target_direction(targets, origin)
+    lo, hi = POINTING_AZIMUTH[k]
+    inside = _in_azimuth(np.atleast_1d(az), lo, hi) | (np.atleast_1d(el) >= POLAR_CAP)
+    return bool(inside[0]) if np.ndim(az) == 0 else inside
+
+
+def pointing_sectors(target: np.ndarray, origin: np.ndarray | None = None) -> tuple[int, ...]:
+    """All pointing sectors that contain one target (3,), in increasing order (never empty)."""
+    return tuple(k for k in SECTORS if in_pointing_sector(target, k, origin))
+
+
+def select_sector(target: np.ndarray, current: int | None = None, origin: np.ndarray | None = None) -> int:
+    """Sector to aim at target from, with hysteresis (Fig. 10).
+
+    Keep ``current`` while the target stays in its pointing sector; otherwise (or with no current
+    sector) return the target's posture sector.  Because every pointing sector contains its posture
+    sector with a margin, a target moving along a posture-sector boundary causes at most one switch.
+    """
+    if current is not None:
+        current = check_sector(current)
+        if in_pointing_sector(target, current, origin):
+            return current
+    return int(posture_sector(target, origin))
