@@ -1,0 +1,15 @@
+#!/usr/bin/env python
+"""Run a benchmark campaign: dimension-RRT vs OMPL planners (Table 4 + anytime). See experiments/README.md.
+
+Thin wrapper: the logic is ``tpee_ompl.benchmark`` (``run_campaign``, ``build_parser``, ``main``).
+"""
+
+import gc
+import sys
+
+from tpee_ompl.benchmark import main
+
+if __name__ == "__main__":
+    code = main(sys.argv[1:])
+    gc.collect()
+    sys.exit(code)

@@ -1,0 +1,148 @@
+"""Headless PNG plots of a campaign database (matplotlib Agg).
+
+* ``fig15_ratios.png``: per-query ratios dimension-RRT / RRT* vs sample count (mean with the
+  quartile band, median dashed) with the paper's Table-4 values overlaid, like the paper's Fig. 15.
+* ``box_time.png`` / ``box_length.png``: time and raw path length per planner and sample cap.
+* ``anytime_cost.png``: median cost of successful runs vs time budget per planner, and the median
+  best cost over time from the ``progress`` table.
+"""
+
+from __future__ import annotations
+
+import math
+import sqlite3
+from collections import defaultdict
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["make_plots"]
+
+
+def _pyplot():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def make_plots(db_path: str | Path, directory: str | Path, planner: str | None = None,
+               reference: str | None = None) -> list[Path]:
+    """Write the PNGs into ``directory`` and return their paths (only the plots the data allow)."""
+    from .report import PAPER_TABLE4, RATIO_METRICS, _resolve, load_runs, ratio_table
+
+    directory = Path(directory)
+    directory.mkdir(parents=True, exist_ok=True)
+    plt = _pyplot()
+    runs = load_runs(db_path)
+    out: list[Path] = []
+    it = [r for r in runs if r["comparison"] == "iterations"]
+    seen = sorted({r["planner"] for r in it})
+    planner = planner or _resolve("DimensionRRT", seen)
+    reference = reference or _resolve("RRTstar", seen)
+    if it:
+        ratios = ratio_table(runs, planner, reference)
+        for chk in sorted({r["checker"] for r in ratios}):
+            fig, ax = plt.subplots(figsize=(7, 4.5))
+            for k, (key, (_, label)) in enumerate(RATIO_METRICS.items()):
+                rows = sorted((r for r in ratios if r["checker"] == chk and r["metric"] == key), key=lambda r: r["sample_cap"])
+                caps = [r["sample_cap"] for r in rows]
+                color = f"C{k}"
+                ax.plot(caps, [r["mean"] for r in rows], "o-", color=color, label=f"{label} (mean)")
+                ax.fill_between(caps, [r["q1"] for r in rows], [r["q3"] for r in rows], color=color, alpha=0.15)
+                pc = sorted(PAPER_TABLE4)
+                ax.plot(pc, [PAPER_TABLE4[c][key] for c in pc], "x:", color=color, alpha=0.8)
+            ax.axhline(1.0, color="grey", lw=0.8)
+            ax.set_xlabel("samples (dimension-RRT) = iterations (RRT*)")
+            ax.set_ylabel(f"{planner} / {reference}")
+            ax.set_title(f"Per-query ratios ({chk} motion validator); dotted x: paper Table 4; band: Q1-Q3")
+            ax.title.set_fontsize(9)
+            ax.legend(fontsize=7)
+            fig.tight_layout()
+            p = directory / f"fig15_ratios_{chk}.png"
+            fig.savefig(p, dpi=120)
+            plt.close(fig)
+            out.append(p)
+        for col, label, fname in (("time", "time (s)", "box_time.png"), ("solution_length", "raw path length (rad)", "box_length.png")):
+            groups = defaultdict(list)
+            for r in it:
+                if r["success"]:
+                    groups[(int(r["sample_cap"]), r["motion_validator"], r["planner"])].append(float(r[col]))
+            if not groups:
+                continue
+            keys = sorted(groups)
+            fig, ax = plt.subplots(figsize=(max(6, 0.8 * len(keys)), 4.5))
+            ax.boxplot([groups[k] for k in keys], showfliers=True)
+            ax.set_xticks(range(1, len(keys) + 1), [f"{p}\nN={n}\n{c}" for n, c, p in keys], fontsize=7)
+            ax.set_ylabel(label)
+            if col == "time":
+                ax.set_yscale("log")
+            ax.set_title(f"Iteration-matched runs: {label} of successful runs")
+            fig.tight_layout()
+            p = directory / fname
+            fig.savefig(p, dpi=120)
+            plt.close(fig)
+            out.append(p)
+    any_runs = [r for r in runs if r["comparison"] == "anytime"]
+    if any_runs:
+        fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4.5))
+        for k, pl in enumerate(sorted({r["planner"] for r in any_runs})):
+            budgets = sorted({float(r["time_budget"]) for r in any_runs})
+            med = []
+            for b in budgets:
+                v = [float(r["solution_length"]) for r in any_runs if r["planner"] == pl and float(r["time_budget"]) == b and r["success"]]
+                med.append(float(np.median(v)) if v else math.nan)
+            ax1.plot(budgets, med, "o-", color=f"C{k}", label=pl)
+            t, c = _progress_median(db_path, pl)
+            if t is not None:
+                ax2.step(t, c, where="post", color=f"C{k}", label=pl)
+        ax1.set_xscale("log")
+        ax1.set_xlabel("time budget (s)")
+        ax1.set_ylabel("median raw cost of successful runs (rad)")
+        ax1.legend(fontsize=7)
+        ax2.set_xlabel("time (s)")
+        ax2.set_ylabel("median best cost (progress rows, rad)")
+        ax2.set_title("longest budget", fontsize=9)
+        ax2.legend(fontsize=7)
+        fig.tight_layout()
+        p = directory / "anytime_cost.png"
+        fig.savefig(p, dpi=120)
+        plt.close(fig)
+        out.append(p)
+    return out
+
+
+def _progress_median(db_path, planner: str):
+    """Median over runs of the best-cost step function, for the longest anytime budget."""
+    con = sqlite3.connect(str(db_path))
+    try:
+        ecols = {r[1] for r in con.execute("PRAGMA table_info(experiments)")}
+        pcols = {r[1] for r in con.execute("PRAGMA table_info(progress)")}
+        if "comparison" not in ecols or "best_cost" not in pcols:
+            return None, None
+        (bmax,) = con.execute("SELECT MAX(time_budget) FROM experiments WHERE comparison='anytime'").fetchone()
+        rows = con.execute(
+            "SELECT progress.runid, progress.time, progress.best_cost FROM progress "
+            "JOIN runs ON progress.runid = runs.id JOIN experiments ON runs.experimentid = experiments.id "
+            "JOIN plannerConfigs ON runs.plannerid = plannerConfigs.id "
+            "WHERE experiments.comparison='anytime' AND experiments.time_budget=? AND plannerConfigs.name=? "
+            "ORDER BY progress.runid, progress.time", (bmax, f"geometric_{planner}")).fetchall()
+    finally:
+        con.close()
+    if not rows:
+        return None, None
+    series = defaultdict(list)
+    for rid, t, c in rows:
+        series[rid].append((t, math.inf if c is None else c))
+    grid = np.linspace(0, float(bmax), 60)
+    vals = []
+    for pts in series.values():
+        ts = np.array([p[0] for p in pts])
+        cs = np.array([p[1] for p in pts])
+        idx = np.searchsorted(ts, grid, side="right") - 1
+        vals.append(np.where(idx >= 0, cs[np.clip(idx, 0, None)], math.inf))
+    med = np.median(np.array(vals), axis=0)
+    med[~np.isfinite(med)] = np.nan
+    return grid, med

@@ -1,0 +1,299 @@
+"""Campaign report: the paper's Table-4 ratios and honest length figures, as Markdown and CSV.
+
+Everything is read back from the campaign's SQLite database (Planner Arena format, see
+:mod:`tpee_ompl.benchmark`).  A run *succeeds* when it is solved exactly, OMPL's
+``correct_solution`` is 1 and every raw-path segment passes ``si.checkMotion`` again
+(``path_valid_dense``).  Failed and missing runs are counted, never dropped silently: the ratio of
+a query is computed only when both planners succeed on it, and ``n`` says how many queries that is.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import sqlite3
+from collections import defaultdict
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+
+__all__ = [
+    "PAPER_TABLE4",
+    "RATIO_METRICS",
+    "anytime_table",
+    "length_quality_table",
+    "load_runs",
+    "ratio_table",
+    "success_table",
+    "summarize",
+    "write_report",
+]
+
+PAPER_TABLE4: dict[int, dict[str, float]] = {
+    500: {"time": 0.523, "length": 0.500, "length_dof34": 0.409, "length_dof12": 0.582},
+    1000: {"time": 0.492, "length": 0.566, "length_dof34": 0.464, "length_dof12": 0.651},
+    1500: {"time": 0.462, "length": 0.636, "length_dof34": 0.531, "length_dof12": 0.714},
+    2000: {"time": 0.401, "length": 0.666, "length_dof34": 0.565, "length_dof12": 0.737},
+    2500: {"time": 0.377, "length": 0.684, "length_dof34": 0.585, "length_dof12": 0.745},
+}
+"""Zou et al. 2022, Table 4: dimension-RRT / RRT*, mean of 120 per-query ratios.  The paper's
+"second DOF group" is DOF3/DOF4 (``length_dof34``), its "first DOF group" DOF1/DOF2."""
+
+RATIO_METRICS = {
+    "time": ("time", "Time"),
+    "length": ("solution_length", "4-D path length"),
+    "length_dof34": ("length_dof34", "DOF3/DOF4-group length"),
+    "length_dof12": ("length_dof12", "DOF1/DOF2-group length"),
+}
+"""Metric key -> (runs column, label)."""
+
+
+def _columns(con: sqlite3.Connection, table: str) -> set[str]:
+    return {r[1] for r in con.execute(f"PRAGMA table_info({table})")}
+
+
+def load_runs(db_path: str | Path) -> list[dict]:
+    """One dict per run: planner, experiment parameters and the run's measurements."""
+    con = sqlite3.connect(str(db_path))
+    try:
+        rcols, ecols = _columns(con, "runs"), _columns(con, "experiments")
+        want_r = ["id", "time", "solved", "status", "approximate_solution", "correct_solution", "solution_length",
+                  "simplified_solution_length", "best_cost", "iterations", "samples", "collision_checks",
+                  "length_dof12", "length_dof34", "path_valid_dense", "first_solution_time", "planner_error"]
+        want_e = ["comparison", "query_set", "query_id", "query_index", "from_sector", "to_sector", "sample_cap",
+                  "time_budget", "motion_validator", "straight_length"]
+        sel = [f"runs.{c}" if c in rcols else f"NULL AS {c}" for c in want_r]
+        sel += [f"experiments.{c}" if c in ecols else f"NULL AS {c}" for c in want_e]
+        sql = (f"SELECT plannerConfigs.name AS planner, experiments.name AS experiment, {', '.join(sel)} "
+               "FROM runs JOIN experiments ON runs.experimentid = experiments.id "
+               "JOIN plannerConfigs ON runs.plannerid = plannerConfigs.id ORDER BY runs.id")
+        cur = con.execute(sql)
+        names = [d[0] for d in cur.description]
+        rows = [dict(zip(names, r)) for r in cur.fetchall()]
+    finally:
+        con.close()
+    for r in rows:
+        r["planner"] = r["planner"].split("_", 1)[1] if r["planner"].startswith("geometric_") else r["planner"]
+        r["success"] = _success(r)
+    return rows
+
+
+def _success(r: dict) -> bool:
+    return bool(
+        r["solved"] == 1
+        and not r["approximate_solution"]
+        and r["correct_solution"] == 1
+        and r["path_valid_dense"] == 1
+        and r["solution_length"] is not None
+        and math.isfinite(float(r["solution_length"]))
+    )
+
+
+def summarize(values: Sequence[float]) -> dict:
+    """n, mean, median and quartiles of finite values (NaN when empty)."""
+    v = np.asarray([x for x in values if x is not None and math.isfinite(x)], dtype=float)
+    if v.size == 0:
+        return {"n": 0, "mean": math.nan, "median": math.nan, "q1": math.nan, "q3": math.nan}
+    q1, med, q3 = np.percentile(v, [25, 50, 75])
+    return {"n": int(v.size), "mean": float(v.mean()), "median": float(med), "q1": float(q1), "q3": float(q3)}
+
+
+def _per_query_mean(rows: list[dict], col: str) -> dict:
+    acc = defaultdict(list)
+    for r in rows:
+        if r["success"] and r[col] is not None:
+            acc[r["query_id"]].append(float(r[col]))
+    return {k: float(np.mean(v)) for k, v in acc.items()}
+
+
+def ratio_table(runs: list[dict], planner: str, reference: str, checker: str | None = None) -> list[dict]:
+    """Per sample cap and metric: summary of per-query ratios planner / reference (Table 4).
+
+    Only the iteration comparison; ``checker`` picks the motion validator (default: every one,
+    separately, as the ``checker`` field).
+    """
+    out = []
+    it = [r for r in runs if r["comparison"] == "iterations"]
+    checkers = sorted({r["motion_validator"] for r in it}) if checker is None else [checker]
+    for chk in checkers:
+        for cap in sorted({int(r["sample_cap"]) for r in it if r["motion_validator"] == chk}):
+            sel = [r for r in it if r["motion_validator"] == chk and int(r["sample_cap"]) == cap]
+            a = [r for r in sel if r["planner"] == planner]
+            b = [r for r in sel if r["planner"] == reference]
+            queries = sorted({r["query_id"] for r in sel}, key=str)
+            for key, (col, label) in RATIO_METRICS.items():
+                pa, pb = _per_query_mean(a, col), _per_query_mean(b, col)
+                ratios = [pa[q] / pb[q] for q in queries if q in pa and q in pb and pb[q] > 0]
+                s = summarize(ratios)
+                out.append({"checker": chk, "sample_cap": cap, "metric": key, "label": label, **s,
+                            "queries": len(queries), "paper": PAPER_TABLE4.get(cap, {}).get(key, math.nan)})
+    return out
+
+
+def success_table(runs: list[dict], expected: dict | None = None) -> list[dict]:
+    """Runs and successes per comparison, validator, cap/budget and planner.
+
+    ``expected`` (the campaign's ``campaign.json``) adds the experiments that never finished as
+    ``missing`` runs (e.g. after Ctrl-C or a crash).
+    """
+    groups = defaultdict(list)
+    for r in runs:
+        key = (r["comparison"], r["motion_validator"], _setting(r), r["planner"])
+        groups[key].append(r)
+    n_queries = len(expected["queries"]) if expected else None
+    out = []
+    for (comp, chk, setting, planner), rs in sorted(groups.items(), key=lambda kv: tuple(map(str, kv[0]))):
+        ids = {r["query_id"] for r in rs}
+        row = {"comparison": comp, "checker": chk, "setting": setting, "planner": planner, "runs": len(rs),
+               "success": sum(r["success"] for r in rs),
+               "invalid_path": sum(1 for r in rs if r["solved"] == 1 and not r["success"]),
+               "unsolved": sum(1 for r in rs if r["solved"] != 1),
+               "queries": len(ids), "missing_queries": None}
+        if n_queries is not None and comp == "iterations" and chk == (expected["config"]["checkers"] or [None])[0]:
+            row["missing_queries"] = n_queries - len(ids)
+        out.append(row)
+    return out
+
+
+def _setting(r: dict) -> str:
+    if r["comparison"] == "iterations":
+        return f"N={int(r['sample_cap'])}"
+    return f"T={float(r['time_budget']):g}s"
+
+
+def length_quality_table(runs: list[dict]) -> list[dict]:
+    """Each planner's raw length relative to the straight start-goal segment and to the best path found.
+
+    ``best`` is the shortest successful raw path any planner found for that query anywhere in the
+    campaign.  Per comparison, validator, cap/budget and planner: median and quartiles.
+    """
+    best: dict = {}
+    for r in runs:
+        if r["success"]:
+            q = r["query_id"]
+            best[q] = min(best.get(q, math.inf), float(r["solution_length"]))
+    groups = defaultdict(list)
+    for r in runs:
+        groups[(r["comparison"], r["motion_validator"], _setting(r), r["planner"])].append(r)
+    out = []
+    for (comp, chk, setting, planner), rs in sorted(groups.items(), key=lambda kv: tuple(map(str, kv[0]))):
+        ok = [r for r in rs if r["success"]]
+        lb = summarize([float(r["solution_length"]) / float(r["straight_length"]) for r in ok
+                        if r["straight_length"] and float(r["straight_length"]) > 0])
+        bf = summarize([float(r["solution_length"]) / best[r["query_id"]] for r in ok if best.get(r["query_id"])])
+        tm = summarize([float(r["time"]) for r in ok])
+        out.append({"comparison": comp, "checker": chk, "setting": setting, "planner": planner,
+                    "success": len(ok), "runs": len(rs),
+                    "vs_straight_median": lb["median"], "vs_straight_q1": lb["q1"], "vs_straight_q3": lb["q3"],
+                    "vs_best_median": bf["median"], "vs_best_q1": bf["q1"], "vs_best_q3": bf["q3"],
+                    "time_median": tm["median"]})
+    return out
+
+
+def anytime_table(runs: list[dict]) -> list[dict]:
+    """Per budget and planner: successes and the median raw cost (rad) of successful runs."""
+    groups = defaultdict(list)
+    for r in runs:
+        if r["comparison"] == "anytime":
+            groups[(float(r["time_budget"]), r["planner"])].append(r)
+    out = []
+    for (b, planner), rs in sorted(groups.items()):
+        s = summarize([float(r["solution_length"]) for r in rs if r["success"]])
+        out.append({"budget": b, "planner": planner, "runs": len(rs), "success": s["n"], "cost_median": s["median"],
+                    "cost_q1": s["q1"], "cost_q3": s["q3"]})
+    return out
+
+
+def _f(x: float, nd: int = 3) -> str:
+    return "–" if x is None or (isinstance(x, float) and math.isnan(x)) else f"{x:.{nd}f}"
+
+
+def _markdown(ratios: list[dict], succ: list[dict], quality: list[dict], anytime: list[dict],
+              planner: str, reference: str, headline: str | None) -> str:
+    lines = [f"## Table 4: {planner} / {reference} at equal sample counts", ""]
+    lines.append("Mean of per-query ratios (paper in brackets), then median [Q1, Q3]; n = queries where both succeeded. "
+                 "Lengths are raw planner output in joint space (rad).")
+    checkers = sorted({r["checker"] for r in ratios}, key=lambda c: (c != headline, c))
+    for chk in checkers:
+        tag = " (headline)" if chk == headline else ""
+        lines += ["", f"Motion validator: **{chk}**{tag}", ""]
+        lines.append("| N | n | " + " | ".join(lbl for _, lbl in RATIO_METRICS.values()) + " |")
+        lines.append("|---|---|" + "---|" * len(RATIO_METRICS))
+        for cap in sorted({r["sample_cap"] for r in ratios if r["checker"] == chk}):
+            cells, n = [], 0
+            for key in RATIO_METRICS:
+                r = next(x for x in ratios if x["checker"] == chk and x["sample_cap"] == cap and x["metric"] == key)
+                n = max(n, r["n"])
+                cells.append(f"{_f(r['mean'])} ({_f(r['paper'])}) med {_f(r['median'])} [{_f(r['q1'])}, {_f(r['q3'])}]")
+            lines.append(f"| {cap} | {n}/{r['queries']} | " + " | ".join(cells) + " |")
+    lines += ["", "## Success counts", "",
+              "| comparison | validator | setting | planner | success / runs | solved but invalid | unsolved | missing queries |",
+              "|---|---|---|---|---|---|---|---|"]
+    for r in succ:
+        miss = "" if r["missing_queries"] is None else str(r["missing_queries"])
+        lines.append(f"| {r['comparison']} | {r['checker']} | {r['setting']} | {r['planner']} | {r['success']} / {r['runs']} "
+                     f"| {r['invalid_path']} | {r['unsolved']} | {miss} |")
+    lines += ["", "## Path length relative to the straight start-goal segment (lower bound) and to the best path found",
+              "", "| comparison | validator | setting | planner | success | length / straight, median [Q1, Q3] "
+              "| length / best found, median [Q1, Q3] | median time (s) |", "|---|---|---|---|---|---|---|---|"]
+    for r in quality:
+        lines.append(f"| {r['comparison']} | {r['checker']} | {r['setting']} | {r['planner']} | {r['success']}/{r['runs']} "
+                     f"| {_f(r['vs_straight_median'])} [{_f(r['vs_straight_q1'])}, {_f(r['vs_straight_q3'])}] "
+                     f"| {_f(r['vs_best_median'])} [{_f(r['vs_best_q1'])}, {_f(r['vs_best_q3'])}] | {_f(r['time_median'])} |")
+    if anytime:
+        lines += ["", "## Anytime comparison: median raw cost (rad) of successful runs", "",
+                  "| budget (s) | planner | success / runs | cost median [Q1, Q3] |", "|---|---|---|---|"]
+        for r in anytime:
+            lines.append(f"| {r['budget']:g} | {r['planner']} | {r['success']}/{r['runs']} "
+                         f"| {_f(r['cost_median'])} [{_f(r['cost_q1'])}, {_f(r['cost_q3'])}] |")
+    return "\n".join(lines) + "\n"
+
+
+def _write_csv(path: Path, rows: list[dict]) -> None:
+    with open(path, "w", newline="") as f:
+        if not rows:
+            return
+        w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
+        w.writeheader()
+        w.writerows(rows)
+
+
+def write_report(db_path: str | Path, directory: str | Path, expected: dict | None = None,
+                 planner: str | None = None, reference: str | None = None) -> dict:
+    """Write ``report.md``, ``table4.csv``, ``success.csv``, ``length_quality.csv``, ``anytime.csv``.
+
+    ``planner``/``reference`` default to the campaign's first two iteration planners (or
+    DimensionRRT / RRTstar).  Returns the paths and the Markdown text.
+    """
+    directory = Path(directory)
+    runs = load_runs(db_path)
+    cfg = (expected or {}).get("config", {})
+    names = list(cfg.get("iteration_planners") or ["DimensionRRT", "RRTstar"])
+    seen = sorted({r["planner"] for r in runs if r["comparison"] == "iterations"})
+    planner = planner or _resolve(names[0], seen)
+    reference = reference or _resolve(names[1] if len(names) > 1 else "RRTstar", seen)
+    headline = (cfg.get("checkers") or ["batched"])[0]
+    ratios = ratio_table(runs, planner, reference)
+    succ = success_table(runs, expected)
+    quality = length_quality_table(runs)
+    anytime = anytime_table(runs)
+    text = _markdown(ratios, succ, quality, anytime, planner, reference, headline)
+    paths = {"markdown": directory / "report.md", "csv": directory / "table4.csv"}
+    paths["markdown"].write_text(text)
+    _write_csv(paths["csv"], ratios)
+    for name, rows in (("success", succ), ("length_quality", quality), ("anytime", anytime)):
+        paths[name] = directory / f"{name}.csv"
+        _write_csv(paths[name], rows)
+    return {**paths, "markdown_text": text, "planner": planner, "reference": reference}
+
+
+def _resolve(name: str, seen: Sequence[str]) -> str:
+    """Planner names in the DB come from getName(); map a factory key (or module:function) onto them."""
+    if name in seen:
+        return name
+    short = name.rsplit(":", 1)[-1]
+    for s in seen:
+        if s.lower() == short.lower() or short.lower().endswith(s.lower()) or s.lower() in short.lower():
+            return s
+    return name
