@@ -60,3 +60,39 @@ def test_start_in_collision_is_one_line_on_stderr(capsys):
 def test_missing_urdf_is_one_line_on_stderr(capsys, tmp_path):
     assert main(_args("--urdf", str(tmp_path / "missing.urdf"))) == 2
     assert "URDF file not found" in capsys.readouterr().err
+
+
+def _is_nonblank_png(path) -> bool:
+    import matplotlib.image as mpimg
+
+    return path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and float(mpimg.imread(path)[..., :3].std()) > 0.02
+
+
+def test_show_without_arguments_draws_the_default_scene(tmp_path, capsys):
+    out = tmp_path / "scene.png"
+    assert main(["show", "-o", str(out)]) == 0
+    assert _is_nonblank_png(out) and out.stat().st_size > 20_000
+
+
+def test_animate_writes_a_gif_of_a_planned_motion(tmp_path):
+    out = tmp_path / "m.gif"
+    assert main(["animate", "--planner", "rrtconnect", "--time", "2", "--start", *map(str, START),
+                 "--goal", *map(str, GOAL), "--frames", "6", "-o", str(out)]) == 0
+    assert out.read_bytes()[:6] in (b"GIF89a", b"GIF87a")
+
+
+def test_animate_with_unreadable_path_file_is_one_line(tmp_path, capsys):
+    bad = tmp_path / "p.json"
+    bad.write_text("{not json")
+    assert main(["animate", "--path", str(bad), "-o", str(tmp_path / "m.gif")]) == 2
+    assert "cannot read a path" in capsys.readouterr().err
+
+
+def test_view_without_meshcat_says_what_to_install(capsys):
+    try:
+        import meshcat  # noqa: F401
+    except ImportError:
+        assert main(["view", "--no-browser"]) == 2
+        assert "pip install" in capsys.readouterr().err
+    else:
+        pytest.skip("meshcat is installed: the viewer would block")

@@ -84,18 +84,25 @@ def _make_planner(name: str, si, from_sector: int, to_sector: int, samples: int 
     return planner, None
 
 
-def cmd_plan(args: argparse.Namespace) -> int:
-    """Plan one cross-sector motion and print the path, its validity and length."""
+def _load_robot(args: argparse.Namespace):
+    from .robot import WearerArm
+
+    if getattr(args, "srdf", None) and not getattr(args, "urdf", None):
+        raise CliError("--srdf needs --urdf")
+    return WearerArm(args.urdf, args.srdf) if getattr(args, "urdf", None) else WearerArm()
+
+
+def _plan(args: argparse.Namespace) -> dict:
+    """Plan the motion the arguments describe; returns a JSON-ready result."""
     from ompl import base as ob
     from ompl import util as ou
 
     from .ompl_problem import make_simple_setup, path_to_array
-    from .robot import WearerArm
 
     ou.setLogLevel(ou.LOG_WARN)
     if args.seed is not None:
         ou.RNG.setSeed(args.seed)
-    robot = WearerArm(args.urdf, args.srdf) if args.urdf else WearerArm()
+    robot = _load_robot(args)
     if args.start is not None and args.goal is not None:
         start, goal, qid = np.array(args.start), np.array(args.goal), None
     elif args.start is None and args.goal is None:
@@ -129,6 +136,15 @@ def cmd_plan(args: argparse.Namespace) -> int:
         result["valid"] = bool(all(si.checkMotion(a, b) for a, b in zip(states[:-1], states[1:])))
         result["length_rad"] = float(path.length())
         result["path"] = path_to_array(path, robot.nq).round(6).tolist()
+    result["_robot"] = robot
+    return result
+
+
+def cmd_plan(args: argparse.Namespace) -> int:
+    """Plan one cross-sector motion and print the path, its validity and length."""
+    result = _plan(args)
+    result.pop("_robot")
+    exact = result["exact"]
     if args.json:
         print(json.dumps(result))
     else:
@@ -142,10 +158,126 @@ def cmd_plan(args: argparse.Namespace) -> int:
     return 0 if exact else 1
 
 
+# ---------------------------------------------------------------------------------------- pictures
+DEFAULT_SCENE_Q = (50.0, 20.0, 17.0, -37.0)  # degrees: sector 4 preset aiming forward-left-up
+DEFAULT_SCENE_TARGET = (4.0, 1.5, 1.9)
+
+
+def cmd_show(args: argparse.Namespace) -> int:
+    """Draw the wearer, the arm at q and the line of sight to the target into a PNG."""
+    from . import render
+
+    robot = _load_robot(args)
+    q = np.array(args.q) if args.q is not None else np.radians(DEFAULT_SCENE_Q)
+    target = np.array(args.target) if args.target is not None else (np.array(DEFAULT_SCENE_TARGET) if args.q is None else None)
+    out = render.save_scene(robot, robot.check_config(q), args.output, target=target, sectors=args.sectors)
+    print(f"wrote {out} (q = {np.round(q, 4).tolist()} rad, valid: {robot.is_valid(q)})")
+    return 0
+
+
+def cmd_animate(args: argparse.Namespace) -> int:
+    """Plan a cross-sector motion (or read one from --path JSON) and write an animation."""
+    from . import render
+
+    if args.path:
+        try:
+            with open(args.path) as fh:
+                W = np.asarray(json.load(fh)["path"], dtype=float)
+        except (OSError, KeyError, json.JSONDecodeError, TypeError) as exc:
+            raise CliError(f"cannot read a path from {args.path}: {exc}") from None
+        robot = _load_robot(args)
+    else:
+        result = _plan(args)
+        robot = result.pop("_robot")
+        if not result["exact"]:
+            raise CliError(f"{args.planner} found no exact path ({result['status']}); nothing to animate")
+        W = np.asarray(result["path"])
+    (pa, ua), (pb, ub) = robot.muzzle(W[0]), robot.muzzle(W[-1])
+    out = render.animate_path(robot, W, args.output, target_a=pa + 3 * ua, target_b=pb + 3 * ub, frames=args.frames)
+    print(f"wrote {out} ({len(W)} waypoints, {args.frames} frames)")
+    return 0
+
+
+def cmd_workspace(args: argparse.Namespace) -> int:
+    """Monte-Carlo pointing workspace (the paper's Fig. 4) into a PNG."""
+    from . import render
+
+    robot = _load_robot(args)
+    render.pointing_workspace(robot, args.samples, np.random.default_rng(args.seed), args.output)
+    print(f"wrote {args.output} ({args.samples} samples, seed {args.seed})")
+    return 0
+
+
+def cmd_view(args: argparse.Namespace) -> int:
+    """Interactive 3-D view in meshcat (optional extra `viewer`)."""
+    from . import render
+
+    robot = _load_robot(args)
+    q = np.array(args.q) if args.q is not None else np.radians(DEFAULT_SCENE_Q)
+    render.view_meshcat(robot, robot.check_config(q), open_browser=not args.no_browser)
+    print("meshcat viewer running; press Ctrl-C to stop")
+    import time
+
+    while True:
+        time.sleep(1.0)
+
+
+def _register_pictures(sub: argparse._SubParsersAction, fmt: type) -> None:
+    p = sub.add_parser("show", help="draw a scene into a PNG", formatter_class=fmt,
+                       description="Draw the wearer, the arm and the line of sight.\n\nexample:\n"
+                                   "  tpee-ompl show -o scene.png\n  tpee-ompl show --q 0.87 0.35 0.3 -0.6 --target 4 1.5 1.9 --sectors -o s.png")
+    p.add_argument("--q", type=_finite, nargs=4, metavar="Q", help="DOF1..DOF4 in radians (default: a sector-4 scene)")
+    p.add_argument("--target", type=_finite, nargs=3, metavar=("X", "Y", "Z"), help="target point (m, world frame)")
+    p.add_argument("--sectors", action="store_true", help="overlay the posture sectors")
+    p.add_argument("-o", "--output", default="scene.png")
+    _add_model_args(p)
+    p.set_defaults(func=cmd_show)
+
+    p = sub.add_parser("animate", help="animate a cross-sector motion (GIF/MP4)", formatter_class=fmt,
+                       description="Plan a cross-sector motion and animate it, muzzle trace drawn.\n\nexample:\n"
+                                   "  tpee-ompl animate --from 1 --to 4 --planner dimension-rrt -o motion.gif\n"
+                                   "  tpee-ompl plan --from 2 --to 3 --json > p.json && tpee-ompl animate --path p.json -o m.gif")
+    _add_plan_args(p)
+    p.add_argument("--path", help="JSON file with a 'path' list of waypoints (e.g. from plan --json)")
+    p.add_argument("--frames", type=_positive_int, default=40)
+    p.add_argument("-o", "--output", default="motion.gif")
+    p.set_defaults(func=cmd_animate)
+
+    p = sub.add_parser("workspace", help="Monte-Carlo pointing workspace (Fig. 4)", formatter_class=fmt,
+                       description="Sample collision-free configurations and draw where the barrel can point.\n\n"
+                                   "example:\n  tpee-ompl workspace --samples 4000 -o workspace.png")
+    p.add_argument("--samples", type=_positive_int, default=4000)
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("-o", "--output", default="workspace.png")
+    _add_model_args(p)
+    p.set_defaults(func=cmd_workspace)
+
+    p = sub.add_parser("view", help="interactive meshcat view (pip install 'tpee_ompl[viewer]')", formatter_class=fmt,
+                       description="Open the model in Pinocchio's MeshcatVisualizer.\n\nexample:\n  tpee-ompl view --q 0.87 0.35 0 0")
+    p.add_argument("--q", type=_finite, nargs=4, metavar="Q")
+    p.add_argument("--no-browser", action="store_true")
+    _add_model_args(p)
+    p.set_defaults(func=cmd_view)
+
+
 # ---------------------------------------------------------------------------------------- parser
 def _add_model_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--urdf", default=None, help="URDF file (default: the packaged wearer + arm)")
     p.add_argument("--srdf", default=None, help="SRDF file with disabled collision pairs (with --urdf)")
+
+
+def _add_plan_args(p: argparse.ArgumentParser, required: bool = False) -> None:
+    p.add_argument("--from", dest="from_sector", type=_sector, required=required, default=1, help="start posture sector (1-4)")
+    p.add_argument("--to", dest="to_sector", type=_sector, required=required, default=4, help="goal posture sector (1-4)")
+    p.add_argument("--planner", choices=PLANNERS, default="dimension-rrt")
+    p.add_argument("--time", type=_positive_float, default=5.0, help="time limit in seconds (default 5)")
+    p.add_argument("--samples", type=_positive_int, default=None, help="sample / iteration cap")
+    p.add_argument("--seed", type=int, default=1)
+    p.add_argument("--queries", default="planning_necessary", help="query set name or JSON file")
+    p.add_argument("--query-index", type=int, default=0, help="which query of that pair (default 0)")
+    p.add_argument("--start", type=_finite, nargs=4, default=None, metavar="Q", help="start DOF1..DOF4 (rad)")
+    p.add_argument("--goal", type=_finite, nargs=4, default=None, metavar="Q", help="goal DOF1..DOF4 (rad)")
+    _add_model_args(p)
 
 
 def get_argument_parser() -> argparse.ArgumentParser:
@@ -159,18 +291,8 @@ def get_argument_parser() -> argparse.ArgumentParser:
                        description="Plan a cross-sector motion between the first stored query of a sector pair "
                                    "(or --start/--goal).\n\nexample:\n  tpee-ompl plan --from 1 --to 4 --planner dimension-rrt"
                                    "\n  tpee-ompl plan --from 2 --to 3 --planner rrtstar --samples 1000 --json")
-    p.add_argument("--from", dest="from_sector", type=_sector, required=True, help="start posture sector (1-4)")
-    p.add_argument("--to", dest="to_sector", type=_sector, required=True, help="goal posture sector (1-4)")
-    p.add_argument("--planner", choices=PLANNERS, default="dimension-rrt")
-    p.add_argument("--time", type=_positive_float, default=5.0, help="time limit in seconds (default 5)")
-    p.add_argument("--samples", type=_positive_int, default=None, help="sample / iteration cap")
-    p.add_argument("--seed", type=int, default=1)
-    p.add_argument("--queries", default="planning_necessary", help="query set name or JSON file")
-    p.add_argument("--query-index", type=int, default=0, help="which query of that pair (default 0)")
-    p.add_argument("--start", type=_finite, nargs=4, default=None, metavar="Q", help="start DOF1..DOF4 (rad)")
-    p.add_argument("--goal", type=_finite, nargs=4, default=None, metavar="Q", help="goal DOF1..DOF4 (rad)")
+    _add_plan_args(p, required=True)
     p.add_argument("--json", action="store_true", help="machine-readable output")
-    _add_model_args(p)
     p.set_defaults(func=cmd_plan)
 
     for register in _EXTRA_COMMANDS:
@@ -178,7 +300,7 @@ def get_argument_parser() -> argparse.ArgumentParser:
     return parser
 
 
-_EXTRA_COMMANDS: list[Callable[[argparse._SubParsersAction, type], None]] = []
+_EXTRA_COMMANDS: list[Callable[[argparse._SubParsersAction, type], None]] = [_register_pictures]
 
 
 def main(argv: Sequence[str] | None = None) -> int:
