@@ -1,0 +1,130 @@
+"""Tests of the DMP maths (eqs. 12-17): reproduction, exact goal convergence, goal == start, speed."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+
+from tpee_ompl.dmp import (
+    DMPOptions,
+    basis_functions,
+    blend_forward_reverse,
+    canonical_phase,
+    generate,
+    generate_blended,
+    integrate,
+    learn_dmp,
+)
+
+
+def _demo(rng: np.random.Generator, steps: int = 7, per_step: int = 100, scale: float = 0.6) -> np.ndarray:
+    """A 2-D demo like the library's: random waypoints, straight segments, quintic in fake time."""
+    W = np.cumsum(rng.uniform(-scale, scale, (steps, 2)), axis=0)
+    u = np.arange(per_step) / per_step
+    s = u**3 * (10 - 15 * u + 6 * u**2)
+    return np.vstack([W[k] + s[:, None] * (W[k + 1] - W[k]) for k in range(steps - 1)] + [W[-1:]])
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_dmp_reproduces_its_demonstration_within_1e3_rad(seed: int) -> None:
+    demo = _demo(np.random.default_rng(seed))
+    dmp = learn_dmp(demo)
+    assert np.abs(generate(dmp, demo[0], demo[-1]) - demo).max() < 1e-3
+
+
+def test_closed_form_rollout_equals_step_by_step_integration(rng: np.random.Generator) -> None:
+    demo = _demo(rng)
+    dmp = learn_dmp(demo)
+    x = canonical_phase(dmp.n_steps, dmp.options.alpha_x)
+    phi = basis_functions(x, dmp.weights.shape[1], dmp.options.alpha_x, dmp.options.width, normalized=True)
+    start, goal = demo[0] + [0.2, -0.1], demo[-1] + [-0.3, 0.4]
+    S = np.where(dmp.scaled, goal - start, 1.0)
+    reference = integrate(start, goal, (phi @ dmp.weights.T) * x[:, None] * S, dmp.options)
+    np.testing.assert_allclose(generate(dmp, start, goal), reference, atol=1e-7)
+
+
+@pytest.mark.parametrize("scaling", ["amplitude", "none"])
+def test_rollout_ends_exactly_at_a_new_goal(rng: np.random.Generator, scaling: str) -> None:
+    dmp = learn_dmp(_demo(rng), DMPOptions(scaling=scaling))
+    starts = rng.uniform(-1.5, 1.5, (50, 2))
+    goals = rng.uniform(-1.5, 1.5, (50, 2))
+    Y = generate(dmp, starts, goals)
+    assert Y.shape == (50, dmp.n_steps, 2)
+    assert np.array_equal(Y[:, 0], starts)
+    assert np.array_equal(Y[:, -1], goals)
+    # the assignment of the end point only removes a residual the dynamics already made tiny
+    x = canonical_phase(dmp.n_steps, dmp.options.alpha_x)
+    phi = basis_functions(x, dmp.weights.shape[1], dmp.options.alpha_x, dmp.options.width, normalized=True)
+    S = np.where(dmp.scaled, goals - starts, 1.0)
+    raw = integrate(starts, goals, (phi @ dmp.weights.T) * x[:, None] * S[:, None, :], dmp.options)
+    assert np.abs(raw[:, -1] - goals).max() < 1e-7
+
+
+def test_goal_equal_to_start_is_finite_and_returns_to_start(rng: np.random.Generator) -> None:
+    demo = _demo(rng)
+    q = np.array([0.3, -0.2])
+    Y = generate(learn_dmp(demo), q, q)
+    assert np.all(np.isfinite(Y))
+    assert np.array_equal(Y[0], q) and np.array_equal(Y[-1], q)
+
+
+def test_demo_that_returns_to_its_start_is_learned_without_division_by_zero() -> None:
+    t = np.linspace(0.0, 1.0, 301)
+    demo = np.stack([0.4 + 0.8 * np.sin(np.pi * t) ** 2, np.full_like(t, -0.3)], axis=1)  # g == y0 in both DOFs
+    dmp = learn_dmp(demo)
+    assert not dmp.scaled.any()
+    assert np.all(np.isfinite(dmp.weights))
+    assert np.abs(generate(dmp, demo[0], demo[-1]) - demo).max() < 1e-3
+    shifted = generate(dmp, demo[0] + 0.1, demo[-1] + 0.1)  # the excursion is kept, not scaled away
+    assert np.ptp(shifted[:, 0]) == pytest.approx(np.ptp(demo[:, 0]), abs=0.05)
+
+
+def test_scaling_is_used_only_where_the_demo_mostly_moves_start_to_goal() -> None:
+    t = np.linspace(0.0, 1.0, 201)
+    s = t**3 * (10 - 15 * t + 6 * t**2)
+    demo = np.stack([s, 0.05 * s + np.sin(np.pi * t)], axis=1)  # DOF 2: small net motion, big excursion
+    dmp = learn_dmp(demo, DMPOptions(min_amplitude_ratio=0.5))
+    assert dmp.scaled.tolist() == [True, False]
+    assert not learn_dmp(demo, DMPOptions(scaling="none")).scaled.any()
+
+
+def test_blended_path_starts_at_real_start_and_ends_at_real_goal(rng: np.random.Generator) -> None:
+    demo = _demo(rng)
+    fwd, rev = learn_dmp(demo), learn_dmp(demo[::-1])
+    start, goal = demo[0] + [0.15, -0.2], demo[-1] + [-0.1, 0.25]
+    Y = generate_blended(fwd, rev, start, goal)
+    assert np.array_equal(Y[0], start) and np.array_equal(Y[-1], goal)
+    # at the demo's own endpoints the blend reproduces the demo
+    assert np.abs(generate_blended(fwd, rev, demo[0], demo[-1]) - demo).max() < 1e-3
+
+
+def test_blend_requires_matching_shapes() -> None:
+    with pytest.raises(ValueError, match="shapes differ"):
+        blend_forward_reverse(np.zeros((10, 2)), np.zeros((11, 2)))
+
+
+def test_bad_inputs_raise_with_a_message() -> None:
+    with pytest.raises(ValueError, match="shape"):
+        learn_dmp(np.zeros((2, 2)))
+    with pytest.raises(ValueError, match="NaN"):
+        learn_dmp(np.full((10, 2), np.nan))
+    with pytest.raises(ValueError, match="scaling"):
+        DMPOptions(scaling="log")
+    with pytest.raises(ValueError, match="settled"):
+        learn_dmp(np.linspace(0, 1, 50)[:, None], DMPOptions(alpha_y=5.0))
+    dmp = learn_dmp(np.linspace(0, 1, 50)[:, None])
+    with pytest.raises(ValueError, match="shape"):
+        generate(dmp, np.zeros(2), np.zeros(2))
+
+
+def test_generating_one_600_point_path_takes_well_under_a_millisecond(rng: np.random.Generator) -> None:
+    demo = _demo(rng)
+    fwd, rev = learn_dmp(demo), learn_dmp(demo[::-1])
+    start, goal = demo[0] + 0.1, demo[-1] - 0.1
+    n = 200
+    t0 = time.perf_counter()
+    for _ in range(n):
+        generate_blended(fwd, rev, start, goal)
+    assert (time.perf_counter() - t0) / n < 0.5e-3

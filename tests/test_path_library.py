@@ -1,0 +1,197 @@
+"""Tests of the path library (sections 4.2.2-4.2.3) with stand-ins for the sampler and dimension-RRT."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from ompl import geometric as og
+from ompl import util as ou
+
+from tpee_ompl.ompl_problem import make_simple_setup, path_to_array
+from tpee_ompl.path_library import (
+    N_FAKE_TIME_STEPS,
+    LibraryFileError,
+    PathLibrary,
+    motion_is_valid,
+    resample_waypoints,
+)
+from tpee_ompl.robot import WearerArm
+from tpee_ompl.sectors import cross_sector_trajectory, posture_preset
+
+PAIRS = ((1, 2), (2, 3))  # straight stand-in paths are often valid here (never for 3 <-> 4)
+
+
+def _sampler(robot: WearerArm):
+    """Stand-in for the query generator: sector presets for DOF1/2, random valid pan/tilt."""
+
+    def sample(rng: np.random.Generator, i: int, j: int) -> tuple[np.ndarray, np.ndarray]:
+        out = []
+        for k in (i, j):
+            while True:
+                q = np.concatenate([posture_preset(k), rng.uniform(robot.lower[2:], robot.upper[2:])])
+                if robot.is_valid(q):
+                    out.append(q)
+                    break
+        return out[0], out[1]
+
+    return sample
+
+
+def _straight_plan(robot: WearerArm):
+    """Stand-in for dimension-RRT: Table 3 DOF1/2, linear DOF3/4, returned only if it passes the motion check."""
+
+    def plan(start: np.ndarray, goal: np.ndarray, i: int, j: int) -> np.ndarray | None:
+        u = np.linspace(0.0, 1.0, N_FAKE_TIME_STEPS)[:, None]
+        W = np.hstack([cross_sector_trajectory(i, j), start[2:] + u * (goal[2:] - start[2:])])
+        W[0], W[-1] = start, goal
+        return W if motion_is_valid(robot, W) else None
+
+    return plan
+
+
+def _rrt_plan(robot: WearerArm):
+    """The straight stand-in, else OMPL RRTConnect (simplified, re-spaced to 7 waypoints on the same segments)."""
+    straight = _straight_plan(robot)
+    ou.setLogLevel(ou.LOG_WARN)
+
+    def plan(start: np.ndarray, goal: np.ndarray, i: int, j: int) -> np.ndarray | None:
+        W = straight(start, goal, i, j)
+        if W is not None:
+            return W
+        ss = make_simple_setup(robot, start, goal)
+        ss.setPlanner(og.RRTConnect(ss.getSpaceInformation()))
+        if not ss.solve(2.0) or not ss.haveExactSolutionPath():
+            return None
+        ss.simplifySolution(0.5)
+        path = ss.getSolutionPath()
+        if path.getStateCount() > N_FAKE_TIME_STEPS:
+            return None
+        path.interpolate(N_FAKE_TIME_STEPS)  # adds states on the existing segments only
+        W = path_to_array(path, 4)
+        return W if W.shape == (N_FAKE_TIME_STEPS, 4) else None
+
+    return plan
+
+
+@pytest.fixture(scope="module")
+def library(robot: WearerArm) -> PathLibrary:
+    return PathLibrary.build(robot, _sampler(robot), _straight_plan(robot), pairs=PAIRS, per_pair=4,
+                             min_difference=0.3, seed=7)
+
+
+def test_resampling_keeps_waypoints_and_segment_geometry() -> None:
+    W = np.array([[0.0, 0.0], [1.0, 2.0], [3.0, 2.0]])
+    R = resample_waypoints(W, per_step=10)
+    assert R.shape == (21, 2)
+    assert np.array_equal(R[::10], W)
+    # every sample of the first segment is on the line y = 2x, between the waypoints
+    np.testing.assert_allclose(R[:11, 1], 2 * R[:11, 0])
+    assert np.all(np.diff(R[:11, 0]) >= 0)
+
+
+def test_build_stores_distinct_demonstrations_per_pair(library: PathLibrary) -> None:
+    assert set(library.pairs) == set(PAIRS)
+    for pd in library.pairs.values():
+        assert 1 <= len(pd.starts) <= 4
+        keys = pd.keys
+        d = np.linalg.norm(keys[:, None] - keys[None], axis=-1) + np.eye(len(keys)) * 1e9
+        assert d.min() >= 0.3
+        assert len(pd.forward) == len(pd.reverse) == len(pd.starts)
+    s = library.stats()
+    assert s["build_stored"] == len(library)
+    assert s["build_sampled"] == s["build_stored"] + s["build_rejected_similar"] + s["build_plan_failed"]
+
+
+def test_seeded_build_is_deterministic(robot: WearerArm, library: PathLibrary) -> None:
+    again = PathLibrary.build(robot, _sampler(robot), _straight_plan(robot), pairs=PAIRS, per_pair=4,
+                              min_difference=0.3, seed=7)
+    for key, pd in library.pairs.items():
+        other = again.pairs[key]
+        assert np.array_equal(pd.waypoints, other.waypoints)
+        for a, b in zip(pd.forward + pd.reverse, other.forward + other.reverse):
+            assert np.array_equal(a.weights, b.weights)
+
+
+def test_query_paths_start_and_end_exactly_and_pass_the_motion_check(robot: WearerArm, library: PathLibrary) -> None:
+    library.plan = _rrt_plan(robot)
+    sample = _sampler(robot)
+    rng = np.random.default_rng(3)
+    before = library.stats()["queries"]
+    outcomes = []
+    for i, j in PAIRS:
+        for _ in range(4):
+            start, goal = sample(rng, i, j)
+            res = library.query(start, goal, i, j)
+            outcomes.append(res.outcome)
+            if res.outcome == "failed":
+                assert res.path is None
+                continue
+            assert np.array_equal(res.path[0], start) and np.array_equal(res.path[-1], goal)
+            assert motion_is_valid(robot, res.path)
+    s = library.stats()
+    assert s["queries"] - before == len(outcomes)
+    assert sum(s[k] for k in ("dmp", "repaired", "fallback", "failed")) == s["queries"]
+    assert "dmp" in outcomes
+
+
+def test_query_at_a_demonstration_reproduces_it(library: PathLibrary) -> None:
+    (i, j), pd = next(iter(library.pairs.items()))
+    path = library.generate(pd.starts[0], pd.goals[0], i, j, 0)
+    demo = resample_waypoints(pd.waypoints[0], library.per_step)
+    assert np.abs(path - demo).max() < 1e-3
+
+
+def test_colliding_dmp_path_is_never_returned(robot: WearerArm, library: PathLibrary, monkeypatch) -> None:
+    import tpee_ompl.path_library as pl
+
+    calls = {"n": 0}
+
+    def reject_dmp_paths(robot_, path, step=None):  # every DMP candidate "collides"; the fallback is checked for real
+        calls["n"] += 1
+        return calls["n"] > library.n_candidates and motion_is_valid(robot_, path, step)
+
+    (i, j), pd = next(iter(library.pairs.items()))
+    library.plan = _straight_plan(robot)
+    monkeypatch.setattr(pl, "motion_is_valid", reject_dmp_paths)
+    res = library.query(pd.starts[0], pd.goals[0], i, j)
+    assert res.outcome == "fallback" and res.candidates_tried == min(library.n_candidates, len(pd.starts))
+    assert motion_is_valid(robot, res.path)
+    library.plan = None
+    calls["n"] = -10**9  # everything "collides", no planner: failed, no path
+    res = library.query(pd.starts[0], pd.goals[0], i, j)
+    assert res.outcome == "failed" and res.path is None
+
+
+def test_library_round_trips_through_disk(robot: WearerArm, library: PathLibrary, tmp_path) -> None:
+    f = library.save(tmp_path / "lib.npz")
+    loaded = PathLibrary.load(f, robot)
+    assert set(loaded.pairs) == set(library.pairs) and len(loaded) == len(library)
+    (i, j), pd = next(iter(library.pairs.items()))
+    rng = np.random.default_rng(0)
+    start = pd.starts[0] + np.r_[0, 0, rng.uniform(-0.1, 0.1, 2)]
+    goal = pd.goals[-1]
+    for k in range(len(pd.starts)):
+        assert np.array_equal(loaded.generate(start, goal, i, j, k), library.generate(start, goal, i, j, k))
+
+
+def test_truncated_library_file_is_refused(robot: WearerArm, library: PathLibrary, tmp_path) -> None:
+    f = library.save(tmp_path / "lib.npz")
+    data = f.read_bytes()
+    f.write_bytes(data[: len(data) // 2])
+    with pytest.raises(LibraryFileError, match="truncated"):
+        PathLibrary.load(f, robot)
+
+
+def test_library_from_another_model_or_version_is_refused(robot: WearerArm, library: PathLibrary, tmp_path, monkeypatch) -> None:
+    import tpee_ompl.path_library as pl
+
+    f = library.save(tmp_path / "lib.npz")
+
+    class OtherModel:
+        model_hash = "0123456789abcdef"
+
+    with pytest.raises(LibraryFileError, match="built for model"):
+        PathLibrary.load(f, OtherModel())  # type: ignore[arg-type]
+    monkeypatch.setattr(pl, "FORMAT_VERSION", pl.FORMAT_VERSION + 1)
+    with pytest.raises(LibraryFileError, match="format version"):
+        PathLibrary.load(f, robot)
