@@ -27,6 +27,7 @@ import zipfile
 from collections import Counter
 from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field
+from itertools import pairwise
 from pathlib import Path
 
 import numpy as np
@@ -88,7 +89,7 @@ def motion_is_valid(robot: WearerArm, path: np.ndarray, step: float | None = Non
     """
     path = np.asarray(path, dtype=float)
     step = robot.max_joint_step() if step is None else float(step)
-    chunks = [path[:1]] + [motion_states(a, b, step) for a, b in zip(path[:-1], path[1:])]
+    chunks = [path[:1]] + [motion_states(a, b, step) for a, b in pairwise(path)]
     return bool(robot.are_valid(np.concatenate(chunks)).all())
 
 
