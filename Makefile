@@ -18,8 +18,18 @@ $(STAMP): pyproject.toml
 test: $(STAMP)
 	MPLBACKEND=Agg $(PY) -m pytest -q
 
+# Default campaign (<= 10 min on 2 cores): 24 queries at 500 and 2500 samples (batched motion
+# validator; OMPL's per-state validator on 4 queries at 500 beside it) plus a short anytime run.
 bench: $(STAMP)
-	MPLBACKEND=Agg $(PY) experiments/collision_throughput.py
+	MPLBACKEND=Agg $(PY) experiments/run_benchmark.py --queries planning_necessary --name bench \
+		--max-queries 24 --samples 500 2500 --alt-checker-queries 4 --alt-checker-samples 500 \
+		--anytime 0.1 0.5 1 --anytime-queries 6 --workers 2
+
+# Full campaign: all 120 queries, 500..2500 samples, anytime 0.1..2 s, both named query sets.
+bench-full: $(STAMP)
+	MPLBACKEND=Agg $(PY) experiments/run_benchmark.py --queries planning_necessary --name full --workers 2
+	MPLBACKEND=Agg $(PY) experiments/run_benchmark.py --queries paper_random --name full_random --workers 2 \
+		--anytime
 
 clean-env:
 	rm -rf $(VENV)

@@ -66,6 +66,7 @@ __all__ = [
     "package_versions",
     "run_campaign",
     "run_query_task",
+    "stratified_subset",
 ]
 
 log = logging.getLogger(__name__)
@@ -103,7 +104,7 @@ class CampaignConfig:
     anytime_queries: int | None = None
     """Queries (first k) of the anytime comparison; None = all."""
     max_queries: int | None = None
-    """Use only the first k queries of the set (None = all)."""
+    """Use k queries, round-robin over sector pairs (:func:`stratified_subset`; None = all)."""
     runs: int = 1
     """Runs per planner per experiment."""
     workers: int = 1
@@ -398,6 +399,22 @@ def load_query_set(name_or_path: str) -> tuple[str, list[dict]]:
     return data.get("name", name), rows
 
 
+def stratified_subset(queries: list[dict], k: int | None) -> list[dict]:
+    """All queries reordered round-robin over (from, to) sector pairs, then the first k.
+
+    The first k of a set ordered pair by pair would cover only a few pairs; round-robin keeps every
+    pair represented (24 of the 120 planning-necessary queries = 2 per ordered pair).
+    """
+    groups: dict[tuple[int, int], list[dict]] = {}
+    for q in queries:
+        groups.setdefault((q["from_sector"], q["to_sector"]), []).append(q)
+    out: list[dict] = []
+    lists = list(groups.values())
+    for i in range(max((len(g) for g in lists), default=0)):
+        out += [g[i] for g in lists if i < len(g)]
+    return out if k is None else out[:k]
+
+
 # --------------------------------------------------------------------------- one query, in a worker
 _SEEDED: list[int] = []
 
@@ -523,6 +540,7 @@ def _run_experiment(robot, cfg: dict, task: dict, spec: dict, target: Path) -> N
             "length_dof34 REAL": None,
             "raw_length REAL": None,
             "path_valid_dense INTEGER": 0,
+            "reaches_goal INTEGER": 0,
             "planner_error INTEGER": int(rec["error"] is not None),
         }
         if W is not None and len(W) >= 1:
@@ -532,7 +550,8 @@ def _run_experiment(robot, cfg: dict, task: dict, spec: dict, target: Path) -> N
             best = rec["best_cost"]
             if best is None or not math.isfinite(float(best)):
                 best = l4
-            props.update({"best_cost REAL": best, "length_dof12 REAL": l12, "length_dof34 REAL": l34,
+            ends = bool(np.allclose(W[0], start, atol=1e-6) and np.allclose(W[-1], goal, atol=1e-6))
+            props.update({"reaches_goal INTEGER": int(ends), "best_cost REAL": best, "length_dof12 REAL": l12, "length_dof34 REAL": l34,
                           "raw_length REAL": l4, "path_valid_dense INTEGER": int(ok)})
         records[planner.getName()].append({"props": props, "progress": rec["progress"]})
 
@@ -663,8 +682,7 @@ def run_campaign(
     from tqdm import tqdm
 
     set_name, queries = load_query_set(config.queries)
-    if config.max_queries is not None:
-        queries = queries[: config.max_queries]
+    queries = stratified_subset(queries, config.max_queries)
     if not queries:
         raise ValueError(f"query set {config.queries!r} has no queries")
     directory = make_results_dir(config.out, config.name)
@@ -758,7 +776,7 @@ def build_parser(prog: str | None = None) -> argparse.ArgumentParser:
     p.add_argument("--alt-checker-samples", type=int, nargs="+", default=None,
                    help="caps for the non-headline validators (default: all --samples)")
     p.add_argument("--anytime-queries", type=int, default=None, help="anytime comparison on the first k queries only")
-    p.add_argument("--max-queries", type=int, default=None, help="use the first N queries of the set")
+    p.add_argument("--max-queries", type=int, default=None, help="use N queries, round-robin over the ordered sector pairs")
     p.add_argument("--runs", type=int, default=1, help="runs per planner per experiment (default: %(default)s)")
     p.add_argument("--workers", type=int, default=max(1, min(2, os.cpu_count() or 1)),
                    help="worker processes, one fresh process per query; 0 = in this process (default: %(default)s)")

@@ -1,9 +1,11 @@
 """Campaign report: the paper's Table-4 ratios and honest length figures, as Markdown and CSV.
 
 Everything is read back from the campaign's SQLite database (Planner Arena format, see
-:mod:`tpee_ompl.benchmark`).  A run *succeeds* when it is solved exactly, OMPL's
-``correct_solution`` is 1 and every raw-path segment passes ``si.checkMotion`` again
-(``path_valid_dense``).  Failed and missing runs are counted, never dropped silently: the ratio of
+:mod:`tpee_ompl.benchmark`).  A run *succeeds* when its status is an exact solution,
+OMPL's ``correct_solution`` is 1, the raw path starts at the start and ends at the goal
+(``reaches_goal``; OMPL 2.0.1's AORRTC sometimes returns a zero-length path with status "Invalid
+goal" that Benchmark still marks solved) and every raw-path segment passes ``si.checkMotion``
+again (``path_valid_dense``).  Failed and missing runs are counted, never dropped silently: the ratio of
 a query is computed only when both planners succeed on it, and ``n`` says how many queries that is.
 """
 
@@ -60,7 +62,7 @@ def load_runs(db_path: str | Path) -> list[dict]:
         rcols, ecols = _columns(con, "runs"), _columns(con, "experiments")
         want_r = ["id", "time", "solved", "status", "approximate_solution", "correct_solution", "solution_length",
                   "simplified_solution_length", "best_cost", "iterations", "samples", "collision_checks",
-                  "length_dof12", "length_dof34", "path_valid_dense", "first_solution_time", "planner_error"]
+                  "length_dof12", "length_dof34", "path_valid_dense", "reaches_goal", "first_solution_time", "planner_error"]
         want_e = ["comparison", "query_set", "query_id", "query_index", "from_sector", "to_sector", "sample_cap",
                   "time_budget", "motion_validator", "straight_length"]
         sel = [f"runs.{c}" if c in rcols else f"NULL AS {c}" for c in want_r]
@@ -82,6 +84,8 @@ def load_runs(db_path: str | Path) -> list[dict]:
 def _success(r: dict) -> bool:
     return bool(
         r["solved"] == 1
+        and r["status"] == 6  # exact solution
+        and r["reaches_goal"] == 1
         and not r["approximate_solution"]
         and r["correct_solution"] == 1
         and r["path_valid_dense"] == 1
