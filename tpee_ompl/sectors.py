@@ -93,23 +93,22 @@ def cross_sector_trajectory(i: int, j: int) -> np.ndarray:
 #   2: rear-left   90 <= alpha <= 180   (posture 2 sits low behind, left)
 #   1: rear-right -180 < alpha < -90    (posture 1 sits low behind, right)
 #
-# Pointing sector k is posture sector k widened by a margin on each side (the hysteresis band),
-# plus the cap epsilon >= POLAR_CAP where every posture aims freely and azimuth is ill-defined.
-# The margins are as wide as posture k's collision-free, line-of-sight pointing range allows
-# (measured, docs/pointing.md): the rifle held at the chest and the arms block low targets on
-# the far side of the front, so the front margin is narrow; the sides and rear are wide.
+# Pointing sector k is the azimuth range that posture k can aim into collision-free with a clear
+# line of sight (>= 99% of targets, measured in docs/pointing.md), which contains posture sector
+# k with a margin of at least 5 deg on every side (the hysteresis band), plus the cap
+# epsilon >= POLAR_CAP, where every posture aims freely and azimuth is ill-defined.  As in the
+# paper's Table 2, each side's stowed and shoulder pointing sectors both cover the front on their
+# side; the rifle held at the chest and the arms block low targets across the front, so the
+# margins past straight ahead are narrow (5-10 deg), those past the rear wide (20-50 deg).
 
-_FRONT_MARGIN_DEG = 5.0
-_SIDE_MARGIN_DEG = 20.0
-_REAR_MARGIN_DEG = 20.0
 _POLAR_CAP_DEG = 60.0
 
 _POSTURE_AZIMUTH_DEG = {1: (-180.0, -90.0), 2: (90.0, 180.0), 3: (0.0, 90.0), 4: (-90.0, 0.0)}
 _POINTING_AZIMUTH_DEG = {
-    1: (-180.0 - _REAR_MARGIN_DEG, -90.0 + _SIDE_MARGIN_DEG),
-    2: (90.0 - _SIDE_MARGIN_DEG, 180.0 + _REAR_MARGIN_DEG),
-    3: (0.0 - _FRONT_MARGIN_DEG, 90.0 + _SIDE_MARGIN_DEG),
-    4: (-90.0 - _SIDE_MARGIN_DEG, 0.0 + _FRONT_MARGIN_DEG),
+    1: (-200.0, -5.0),  # the right half, 20 deg past the rear, to 5 deg short of straight ahead
+    2: (10.0, 200.0),  # the left half, 20 deg past the rear, to 10 deg left of straight ahead
+    3: (-5.0, 230.0),  # the left half, 5 deg past straight ahead, 50 deg into the rear-right
+    4: (-230.0, 5.0),  # the right half, 5 deg past straight ahead, 50 deg into the rear-left
 }
 
 POLAR_CAP = float(np.deg2rad(_POLAR_CAP_DEG))

@@ -1,0 +1,49 @@
+"""Regenerate the named cross-sector query sets in experiments/queries/ (paper section 5.1).
+
+Usage: python experiments/make_queries.py [--seed N] [--n-per-pair N] [--out DIR]
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+from pathlib import Path
+
+from tpee_ompl.queries import QUERY_DIR, generate_queries, planning_necessity, save_queries
+from tpee_ompl.robot import default_robot
+
+
+def get_argument_parser() -> argparse.ArgumentParser:
+    """Command-line options."""
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--seed", type=int, default=2022, help="seed of the planning_necessary set (paper_random: seed + 1)")
+    p.add_argument("--n-per-pair", type=int, default=10, help="queries per ordered sector pair (12 pairs)")
+    p.add_argument("--out", type=Path, default=QUERY_DIR, help="output directory")
+    return p
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Generate both sets, save them, and log their planning-necessity rates."""
+    args = get_argument_parser().parse_args(argv)
+    logging.basicConfig(level=logging.INFO, format="%(message)s")
+    robot = default_robot()
+    for name, seed, require in (("planning_necessary", args.seed, True), ("paper_random", args.seed + 1, False)):
+        queries, stats = generate_queries(robot, n_per_pair=args.n_per_pair, seed=seed, require_planning=require)
+        rate, per_pair = planning_necessity(robot, queries)
+        extra = {
+            "generator": "tpee_ompl.queries.generate_queries",
+            "n_per_pair": args.n_per_pair,
+            "require_planning": require,
+            "straight_motion_step_rad": 0.01,
+            "planning_necessity_rate": rate,
+            "planning_necessary_per_pair": {f"{i}->{j}": n for (i, j), n in sorted(per_pair.items())},
+            "generation_stats": stats,
+        }
+        path = save_queries(args.out / f"{name}.json", queries, name=name, seed=seed,
+                            model_hash=robot.model_hash, extra=extra)
+        logging.info("%s: %d queries, planning necessary for %.1f%% (min per pair %d of %d) -> %s",
+                     name, len(queries), 100 * rate, min(per_pair.values()), args.n_per_pair, path)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,272 @@
+"""Target tracking strategy of Fig. 10: re-aim inside a pointing sector, plan only across sectors.
+
+The :class:`Tracker` consumes a stream of target positions (and "lock a new target" events).
+While the target stays in the current pointing sector it only re-aims with the closed-form IK
+(:func:`tpee_ompl.pointing.aim`), no planning.  When the target leaves the pointing sector, a new
+target lies outside it, or the target falls in the blind area or out of the line of sight, it
+switches to the target's posture sector (or another sector that can aim at it) through a
+cross-sector motion produced by a pluggable planner::
+
+    planner(start_q, goal_q, from_sector, to_sector) -> waypoints, ndarray (K, 4)
+
+Output: a time-stamped joint trajectory plus events (aim, cross-sector, blind-area, unreachable).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .ompl_problem import motion_states
+from .pointing import AimingError, PointingGeometry, aim_batch, check_target
+from .robot import WearerArm
+from .sectors import SECTORS, check_sector, in_pointing_sector, posture_preset, posture_sector
+
+__all__ = [
+    "Planner",
+    "TrackerOptions",
+    "TrackEvent",
+    "TrackResult",
+    "Tracker",
+    "make_default_planner",
+]
+
+log = logging.getLogger(__name__)
+
+Planner = Callable[[np.ndarray, np.ndarray, int, int], np.ndarray]
+"""planner(start_q (4,), goal_q (4,), from_sector, to_sector) -> waypoints (K, 4), radians."""
+
+
+@dataclass(frozen=True)
+class TrackerOptions:
+    """Tracker settings.
+
+    Attributes
+    ----------
+    joint_speed : float, rad/s
+        Largest joint speed used to time-stamp cross-sector motions (max-norm over joints).
+    check_step : float, radians
+        Joint step at which every motion the tracker commands is checked for collision.
+    """
+
+    joint_speed: float = 1.0
+    check_step: float = 0.01
+
+
+@dataclass(frozen=True)
+class TrackEvent:
+    """Something the tracker did or could not do.
+
+    kind is one of ``"aim"`` (re-aimed inside the sector), ``"cross-sector"`` (switched posture),
+    ``"blind-area"`` (the target was in the current posture's blind cylinder), ``"unreachable"``
+    (no sector can aim at it; the arm holds still).
+    """
+
+    time: float
+    kind: str
+    sector: int | None
+    detail: str = ""
+
+
+@dataclass
+class TrackResult:
+    """Time-stamped joint trajectory and events.
+
+    Attributes
+    ----------
+    times : ndarray (M,), seconds
+    configurations : ndarray (M, 4), radians
+    targets : ndarray (M, 3), metres: the target the row aims at, NaN inside cross-sector motions
+        and while holding still on an unreachable target
+    sectors : ndarray (M,), int: the posture sector in use (0 inside cross-sector motions)
+    events : list of TrackEvent
+    """
+
+    times: np.ndarray
+    configurations: np.ndarray
+    targets: np.ndarray
+    sectors: np.ndarray
+    events: list[TrackEvent] = field(default_factory=list)
+
+    def count(self, kind: str) -> int:
+        """Number of events of one kind."""
+        return sum(e.kind == kind for e in self.events)
+
+
+class Tracker:
+    """Fig. 10 tracking with a pluggable cross-sector planner.
+
+    Parameters
+    ----------
+    robot : WearerArm
+    planner : Planner
+    initial : ndarray (4,), optional
+        Starting configuration (default: posture ``initial_sector``'s preset with pan = tilt = 0).
+    initial_sector : int
+    options : TrackerOptions, optional
+    """
+
+    def __init__(
+        self,
+        robot: WearerArm,
+        planner: Planner,
+        *,
+        initial: np.ndarray | None = None,
+        initial_sector: int = 3,
+        options: TrackerOptions | None = None,
+    ) -> None:
+        self.robot = robot
+        self.planner = planner
+        self.options = options or TrackerOptions()
+        self.geometry = PointingGeometry.from_robot(robot)
+        self.sector = check_sector(initial_sector)
+        q0 = np.r_[posture_preset(self.sector), 0.0, 0.0] if initial is None else robot.check_config(initial)
+        if not robot.is_valid(q0):
+            raise ValueError(f"initial configuration {np.round(q0, 4).tolist()} is in collision")
+        self.q = q0.copy()
+        self.time = -math.inf
+        self._times: list[float] = []
+        self._qs: list[np.ndarray] = []
+        self._targets: list[np.ndarray] = []
+        self._sectors: list[int] = []
+        self.events: list[TrackEvent] = []
+
+    # ------------------------------------------------------------------ helpers
+    def _record(self, t: float, q: np.ndarray, target: np.ndarray | None, sector: int) -> None:
+        self._times.append(t)
+        self._qs.append(q.copy())
+        self._targets.append(np.full(3, np.nan) if target is None else target.copy())
+        self._sectors.append(sector)
+
+    def _aim_from(self, target: np.ndarray, k: int) -> np.ndarray | None:
+        """Configuration aiming at target from posture k (pan nearest the current pan), or None if not valid."""
+        q = aim_batch(target[None], k, geometry=self.geometry, pan_reference=self.q[2], strict=False)[0]
+        if not np.all(np.isfinite(q)):
+            return None
+        if not (self.robot.is_valid(q) and self.robot.line_of_sight_clear(q, target)):
+            return None
+        return q
+
+    def _motion_free(self, a: np.ndarray, b: np.ndarray) -> bool:
+        return bool(self.robot.are_valid(motion_states(a, b, self.options.check_step)).all())
+
+    def _candidate_sectors(self, target: np.ndarray) -> list[int]:
+        """Sectors to try after the current one: the posture sector, other pointing sectors, the rest."""
+        home = int(posture_sector(target, self.geometry.pivot))
+        order = [home] + [k for k in SECTORS if k != home and in_pointing_sector(target, k, self.geometry.pivot)]
+        order += [k for k in SECTORS if k not in order]
+        return [k for k in order if k != self.sector]
+
+    def _cross(self, t: float, goal: np.ndarray, k: int, target: np.ndarray, why: str) -> float:
+        """Run the planner from the current configuration to goal in sector k; return the arrival time."""
+        waypoints = np.asarray(self.planner(self.q.copy(), goal.copy(), self.sector, k), dtype=float)
+        if waypoints.ndim != 2 or waypoints.shape[1] != 4 or len(waypoints) < 2:
+            raise ValueError(f"planner returned waypoints of shape {waypoints.shape}, expected (K >= 2, 4)")
+        if not (np.allclose(waypoints[0], self.q, atol=1e-6) and np.allclose(waypoints[-1], goal, atol=1e-6)):
+            raise ValueError("planner path does not start at the current configuration and end at the goal")
+        waypoints[0], waypoints[-1] = self.q, goal
+        for a, b in zip(waypoints[:-1], waypoints[1:]):
+            if not self._motion_free(a, b):
+                raise ValueError(f"planner path {self.sector}->{k} collides (checked every {self.options.check_step} rad)")
+        self.events.append(TrackEvent(t, "cross-sector", k, f"{self.sector}->{k}: {why}, {len(waypoints)} waypoints"))
+        clock = t
+        for a, b in zip(waypoints[:-1], waypoints[1:]):
+            clock += float(np.max(np.abs(b - a))) / self.options.joint_speed
+            last = b is waypoints[-1]
+            self._record(clock, b, target if last else None, k if last else 0)
+        self.sector, self.q = k, goal.copy()
+        return clock
+
+    # ------------------------------------------------------------------ API
+    def step(self, t: float, target: np.ndarray, new_target: bool = False) -> None:
+        """Process one target sample at time t (seconds); ``new_target`` marks a 'lock a new target' event."""
+        t = max(float(t), self.time)
+        try:
+            target = check_target(target, self.robot)
+        except AimingError as exc:
+            self.events.append(TrackEvent(t, "unreachable", self.sector, str(exc)))
+            self._record(t, self.q, None, self.sector)
+            self.time = t
+            return
+        why = "new target outside the pointing sector" if new_target else "target left the pointing sector"
+        if in_pointing_sector(target, self.sector, self.geometry.pivot):
+            try:
+                aim_batch(target[None], self.sector, geometry=self.geometry, pan_reference=self.q[2])
+            except AimingError as exc:
+                kind = "blind-area" if type(exc).__name__ == "BlindAreaError" else "unreachable"
+                self.events.append(TrackEvent(t, kind, self.sector, str(exc)))
+                why = kind
+            else:
+                q = self._aim_from(target, self.sector)
+                if q is not None and self._motion_free(self.q, q):
+                    self.events.append(TrackEvent(t, "aim", self.sector))
+                    self.q = q
+                    self._record(t, q, target, self.sector)
+                    self.time = t
+                    return
+                if q is not None:  # the re-aim itself would collide: plan it inside the sector
+                    self.time = self._cross(t, q, self.sector, target, "re-aim motion collides")
+                    return
+                why = "no collision-free aim with a clear line of sight from this posture"
+        for k in self._candidate_sectors(target):
+            q = self._aim_from(target, k)
+            if q is not None:
+                self.time = self._cross(t, q, k, target, why)
+                return
+        self.events.append(TrackEvent(t, "unreachable", self.sector, "no posture can aim at the target"))
+        self._record(t, self.q, None, self.sector)
+        self.time = t
+
+    def run(self, stream: Iterable[tuple[float, np.ndarray] | tuple[float, np.ndarray, bool]]) -> TrackResult:
+        """Process (time, target[, new_target]) samples and return the whole trajectory so far."""
+        for item in stream:
+            self.step(*item)
+        return self.result()
+
+    def result(self) -> TrackResult:
+        """The trajectory and events recorded so far."""
+        return TrackResult(
+            times=np.array(self._times, dtype=float),
+            configurations=np.array(self._qs, dtype=float).reshape(-1, 4),
+            targets=np.array(self._targets, dtype=float).reshape(-1, 3),
+            sectors=np.array(self._sectors, dtype=int),
+            events=list(self.events),
+        )
+
+
+def make_default_planner(robot: WearerArm, *, timeout: float = 2.0, seed: int | None = 0) -> Planner:
+    """A simple cross-sector planner: Table 3's straight motion when collision-free, else OMPL RRTConnect.
+
+    The straight motion is :func:`tpee_ompl.queries.straight_motion` (sector to itself: a straight
+    joint motion).  RRTConnect runs on :func:`tpee_ompl.ompl_problem.make_simple_setup` for at most
+    ``timeout`` seconds and its path is simplified; raises RuntimeError if it finds none.
+    """
+    from ompl import geometric as og
+    from ompl import util as ou
+
+    from .ompl_problem import make_simple_setup, path_to_array
+    from .queries import straight_motion
+
+    ou.setLogLevel(ou.LOG_WARN)
+    if seed is not None:
+        ou.RNG.setSeed(int(seed))
+    step = min(0.01, robot.max_joint_step())
+
+    def plan(start: np.ndarray, goal: np.ndarray, i: int, j: int) -> np.ndarray:
+        w = straight_motion(start, goal, i, j) if i != j else np.array([start, goal], dtype=float)
+        if all(robot.are_valid(motion_states(a, b, step)).all() for a, b in zip(w[:-1], w[1:])):
+            return w
+        ss = make_simple_setup(robot, start, goal)
+        ss.setPlanner(og.RRTConnect(ss.getSpaceInformation()))
+        if not ss.solve(timeout) or not ss.haveExactSolutionPath():
+            raise RuntimeError(f"RRTConnect found no path {i}->{j} in {timeout} s")
+        ss.simplifySolution()
+        path = ss.getSolutionPath()
+        path.interpolate()
+        return path_to_array(path, robot.nq)
+
+    return plan
