@@ -1,0 +1,72 @@
+"""Seeded TPEE cross-sector test queries for dimension-RRT (independent of the aiming IK).
+
+A query goes from (preset of sector i, pan, tilt) to (preset of sector j, pan, tilt), pan/tilt
+(DOF3, DOF4) drawn uniformly within the joint limits until the configuration is valid.  Queries
+whose *straight* motion (Table 3 for DOF1/DOF2, linear for DOF3/DOF4) collides are preferred, so
+planning is necessary.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..grouped_space import interpolate_waypoints
+from ..ompl_problem import motion_states
+from ..robot import WearerArm
+from ..sectors import cross_sector_trajectory, posture_preset
+
+__all__ = ["PAIR_TYPES", "straight_motion_valid", "cross_sector_query"]
+
+PAIR_TYPES: tuple[tuple[int, int], ...] = tuple((i, j) for i in range(1, 5) for j in range(1, 5) if i != j)
+"""The 12 cross-sector (from, to) pairs of Table 3."""
+
+
+def straight_motion_waypoints(i: int, j: int, start: np.ndarray, goal: np.ndarray) -> np.ndarray:
+    """The 7 waypoints (7, 4): Table 3 for DOF1/DOF2, DOF3/DOF4 linear from start to goal."""
+    W = interpolate_waypoints(start, goal, 7)
+    W[:, :2] = cross_sector_trajectory(i, j)
+    return W
+
+
+def straight_motion_valid(robot: WearerArm, i: int, j: int, start: np.ndarray, goal: np.ndarray) -> bool:
+    """True if the un-planned motion (Table 3 + linear DOF3/DOF4) is collision-free at the guarantee step."""
+    W = straight_motion_waypoints(i, j, start, goal)
+    step = robot.max_joint_step()
+    Q = np.concatenate([W[:1]] + [motion_states(a, b, step) for a, b in zip(W[:-1], W[1:])])
+    return bool(robot.are_valid(Q).all())
+
+
+def cross_sector_query(
+    robot: WearerArm,
+    i: int,
+    j: int,
+    rng: np.random.Generator,
+    need_planning: bool = True,
+    tries: int = 200,
+    limit_margin: float = 0.05,
+) -> tuple[np.ndarray, np.ndarray]:
+    """A valid (start, goal) pair, shape (4,) each, radians, from sector i to sector j.
+
+    With ``need_planning`` the first pair (of up to ``tries``) whose straight motion collides is
+    returned; if none does, the last valid pair.  Pan/tilt keep ``limit_margin`` (fraction of the
+    range) away from the joint limits: at the limit corners (pan near +-3.3, tilt near -1.65) the
+    barrel sits in a pocket that is a separate free-space component of every intermediate Table 3
+    slice, so such queries have no solution along the prescribed DOF1/DOF2 (paper 4.1.3).
+    """
+    if not 0.0 <= limit_margin < 0.5:
+        raise ValueError(f"limit_margin must be in [0, 0.5), got {limit_margin!r}")
+    p0, p1 = posture_preset(i), posture_preset(j)
+    lo, hi = robot.lower[2:], robot.upper[2:]
+    lo, hi = lo + limit_margin * (hi - lo), hi - limit_margin * (hi - lo)
+    last = None
+    for _ in range(tries):
+        q0 = np.r_[p0, rng.uniform(lo, hi)]
+        q1 = np.r_[p1, rng.uniform(lo, hi)]
+        if not (robot.is_valid(q0) and robot.is_valid(q1)):
+            continue
+        last = (q0, q1)
+        if not need_planning or not straight_motion_valid(robot, i, j, q0, q1):
+            return last
+    if last is None:
+        raise RuntimeError(f"no valid query found for sectors {i} -> {j} in {tries} tries")
+    return last

@@ -1,0 +1,300 @@
+"""The fake-time, DOF-grouped view of an OMPL problem used by dimension-RRT (paper sec. 4.1.2).
+
+A path is a stack of ``h`` full configurations ("fake-time" waypoints, rows 0 and ``h-1`` being the
+start and goal).  The DOFs are split into ordered groups; group ``i`` with ``k_i`` DOFs has a
+*path-space point* made of its values at the ``h-2`` intermediate steps, an array of
+``(h-2) * k_i`` numbers.  A group can be *prescribed*: its ``(h, k_i)`` values are given (Table 3
+for DOF1/DOF2 in the TPEE case) and never planned.
+
+The grouped view lives alongside an ordinary OMPL state space, a ``RealVectorStateSpace`` or a
+compound of them: :class:`GroupedSpace` only reads and writes states of that space, so native
+planners (RRT*, ...) run on exactly the same ``SpaceInformation`` with the same validity checker,
+bounds, metric and motion-check resolution.
+
+Metric
+------
+Path length is measured with the state space's own ``distance``, which :meth:`RealVectorLayout.distance`
+reproduces in numpy: the Euclidean norm of the joint differences for a ``RealVectorStateSpace``
+(radians for the wearer arm), and the weighted sum of the subspaces' Euclidean norms for a compound
+space.  It is the metric of ``ob.PathLengthOptimizationObjective`` and of ``PathGeometric.length``,
+so every planner is scored with it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+from ompl import base as ob
+from ompl import geometric as og
+
+__all__ = [
+    "RealVectorLayout",
+    "GroupedSpace",
+    "default_groups",
+    "validate_groups",
+    "validate_prescribed",
+    "interpolate_waypoints",
+]
+
+
+def default_groups(n: int) -> list[list[int]]:
+    """Default DOF groups: consecutive pairs ``[[0, 1], [2, 3], ...]``, a last singleton for odd n."""
+    if n < 1:
+        raise ValueError(f"the space must have at least one dimension, got {n}")
+    return [list(range(i, min(i + 2, n))) for i in range(0, n, 2)]
+
+
+def validate_groups(groups: Sequence[Sequence[int]], n: int) -> list[list[int]]:
+    """Check that groups partition ``range(n)``; return them as lists of int.
+
+    Raises
+    ------
+    ValueError
+        On an empty group, an index out of range, an index in two groups or an index in none.
+    """
+    if isinstance(groups, (str, bytes)) or not isinstance(groups, Sequence) or len(groups) == 0:
+        raise ValueError(f"groups must be a non-empty list of lists of DOF indices, got {groups!r}")
+    out: list[list[int]] = []
+    seen: dict[int, int] = {}
+    for gi, group in enumerate(groups):
+        if isinstance(group, (str, bytes)) or not isinstance(group, Sequence) or len(group) == 0:
+            raise ValueError(f"group {gi} must be a non-empty list of DOF indices, got {group!r}")
+        g: list[int] = []
+        for d in group:
+            if isinstance(d, bool) or not isinstance(d, (int, np.integer)):
+                raise ValueError(f"group {gi}: DOF index {d!r} is not an integer")
+            d = int(d)
+            if not 0 <= d < n:
+                raise ValueError(f"group {gi}: DOF index {d} is out of range for a {n}-D space")
+            if d in seen:
+                raise ValueError(f"DOF index {d} appears in more than one group ({seen[d]} and {gi}): groups overlap")
+            seen[d] = gi
+            g.append(d)
+        out.append(g)
+    missing = sorted(set(range(n)) - set(seen))
+    if missing:
+        raise ValueError(f"DOF indices {missing} are in no group: groups must cover all {n} DOFs")
+    return out
+
+
+def validate_prescribed(
+    prescribed: Mapping[int, np.ndarray] | None, groups: Sequence[Sequence[int]], h: int
+) -> dict[int, np.ndarray]:
+    """Check prescribed group trajectories: keys are group indices, values arrays (h, k_i), finite."""
+    if prescribed is None:
+        return {}
+    if not isinstance(prescribed, Mapping):
+        raise ValueError(f"prescribed must be a dict {{group index: array (h, k)}}, got {type(prescribed).__name__}")
+    out: dict[int, np.ndarray] = {}
+    for key, value in prescribed.items():
+        if isinstance(key, bool) or not isinstance(key, (int, np.integer)) or not 0 <= int(key) < len(groups):
+            raise ValueError(f"prescribed key {key!r} is not a group index (0..{len(groups) - 1})")
+        k = len(groups[int(key)])
+        arr = np.array(value, dtype=float)
+        if arr.ndim == 1 and k == 1:
+            arr = arr[:, None]
+        if arr.shape != (h, k):
+            raise ValueError(f"prescribed trajectory of group {int(key)} must have shape ({h}, {k}), got {arr.shape}")
+        if not np.all(np.isfinite(arr)):
+            raise ValueError(f"prescribed trajectory of group {int(key)} contains NaN or inf")
+        arr.setflags(write=False)
+        out[int(key)] = arr
+    return out
+
+
+def interpolate_waypoints(start: np.ndarray, goal: np.ndarray, h: int) -> np.ndarray:
+    """``h`` evenly spaced waypoints on the straight line start -> goal, shape (h, n), ends included."""
+    start, goal = np.asarray(start, dtype=float), np.asarray(goal, dtype=float)
+    s = np.linspace(0.0, 1.0, h)[:, None]
+    return start + s * (goal - start)
+
+
+class RealVectorLayout:
+    """Reads and writes states of a RealVector space, or of a (nested) compound of RealVector spaces.
+
+    The flat vector of a state concatenates its subspaces' values in subspace order.
+
+    Parameters
+    ----------
+    space : ob.StateSpace
+        ``ob.RealVectorStateSpace`` or ``ob.CompoundStateSpace`` whose leaves are RealVector spaces.
+
+    Raises
+    ------
+    ValueError
+        For any other space (SO2, SE3, ...): dimension-RRT interpolates and samples linearly.
+    """
+
+    def __init__(self, space: ob.StateSpace) -> None:
+        self.space = space
+        # leaves: (access path of subspace indices, dimension, weight, lower, upper)
+        self._leaves: list[tuple[tuple[int, ...], int, float]] = []
+        lows: list[float] = []
+        highs: list[float] = []
+        self._collect(space, (), 1.0, lows, highs)
+        self.n = sum(d for _, d, _ in self._leaves)
+        self.lower = np.array(lows, dtype=float)
+        self.upper = np.array(highs, dtype=float)
+        self.lower.setflags(write=False)
+        self.upper.setflags(write=False)
+        bounds = np.cumsum([0] + [d for _, d, _ in self._leaves])
+        self._slices = [slice(int(bounds[i]), int(bounds[i + 1])) for i in range(len(self._leaves))]
+        self._weights = np.array([w for _, _, w in self._leaves])
+        self.is_plain = len(self._leaves) == 1 and self._leaves[0][0] == () and self._weights[0] == 1.0
+
+    def _collect(self, space: ob.StateSpace, path: tuple[int, ...], weight: float, lows: list, highs: list) -> None:
+        if isinstance(space, ob.RealVectorStateSpace):
+            b = space.getBounds()
+            self._leaves.append((path, int(space.getDimension()), weight))
+            lows.extend(float(v) for v in b.low)
+            highs.extend(float(v) for v in b.high)
+        elif isinstance(space, ob.CompoundStateSpace):
+            for k in range(space.getSubspaceCount()):
+                self._collect(space.getSubspace(k), path + (k,), weight * space.getSubspaceWeight(k), lows, highs)
+        else:
+            raise ValueError(
+                f"dimension-RRT needs a RealVector state space or a compound of them, got {type(space).__name__}"
+            )
+
+    def _leaf(self, state: ob.State, path: tuple[int, ...]) -> ob.State:
+        for k in path:
+            state = state[k]
+        return state
+
+    def read(self, state: ob.State) -> np.ndarray:
+        """The state's values as a flat array (n,)."""
+        out = np.empty(self.n)
+        for (path, d, _), sl in zip(self._leaves, self._slices):
+            leaf = self._leaf(state, path)
+            out[sl] = [leaf[i] for i in range(d)]
+        return out
+
+    def write(self, state: ob.State, values: np.ndarray) -> ob.State:
+        """Write a flat array (n,) into the state; return the state."""
+        values = np.asarray(values, dtype=float)
+        for (path, d, _), sl in zip(self._leaves, self._slices):
+            self._leaf(state, path)[0:d] = [float(v) for v in values[sl]]
+        return state
+
+    def distance(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
+        """The space's metric between rows of A and B (..., n), as ``si.distance`` computes it."""
+        D = np.asarray(A) - np.asarray(B)
+        if self.is_plain:
+            return np.sqrt(np.einsum("...i,...i->...", D, D))
+        return sum(w * np.linalg.norm(D[..., sl], axis=-1) for w, sl in zip(self._weights, self._slices))
+
+    def path_length(self, W: np.ndarray) -> float:
+        """Length of the polyline through waypoints W (K, n) in the space's metric."""
+        return float(self.distance(W[:-1], W[1:]).sum()) if len(W) > 1 else 0.0
+
+    def to_path(self, si: ob.SpaceInformation, W: np.ndarray) -> og.PathGeometric:
+        """An ``og.PathGeometric`` through the waypoints W (K, n)."""
+        path = og.PathGeometric(si)
+        for w in np.asarray(W, dtype=float):
+            s = si.allocState()
+            self.write(s, w)
+            path.append(s)
+        return path
+
+    def from_path(self, path: og.PathGeometric) -> np.ndarray:
+        """Waypoints of a geometric path, shape (K, n)."""
+        return np.array([self.read(s) for s in path.getStates()], dtype=float).reshape(-1, self.n)
+
+
+class GroupedSpace:
+    """A fake-time, DOF-grouped description of a problem over an OMPL RealVector(-compound) space.
+
+    Parameters
+    ----------
+    space : ob.StateSpace or ob.SpaceInformation
+        The ordinary OMPL space the problem is defined on.
+    groups : list of lists of int, optional
+        DOF indices per group, in planning order (default :func:`default_groups`).
+    h : int
+        Number of fake-time steps including start and goal (default 7: start, 5 intermediate, goal).
+    prescribed : dict {group index: array (h, k_i)}, optional
+        Group trajectories taken as given, start and goal rows included (e.g. Table 3).
+
+    Raises
+    ------
+    ValueError
+        Bad groups (overlap, missing or out-of-range DOF), ``h < 3``, badly shaped prescribed rows.
+    """
+
+    def __init__(
+        self,
+        space: ob.StateSpace | ob.SpaceInformation,
+        groups: Sequence[Sequence[int]] | None = None,
+        h: int = 7,
+        prescribed: Mapping[int, np.ndarray] | None = None,
+    ) -> None:
+        if isinstance(space, ob.SpaceInformation):
+            space = space.getStateSpace()
+        self.layout = RealVectorLayout(space)
+        n = self.layout.n
+        if isinstance(h, bool) or not isinstance(h, (int, np.integer)) or h < 3:
+            raise ValueError(f"h (fake-time steps incl. start and goal) must be an integer >= 3, got {h!r}")
+        self.h = int(h)
+        self.groups = validate_groups(default_groups(n) if groups is None else groups, n)
+        self.prescribed = validate_prescribed(prescribed, self.groups, self.h)
+        self.planned = [g for g in range(len(self.groups)) if g not in self.prescribed]
+        """Indices of the groups to plan, in planning order."""
+
+    @property
+    def n(self) -> int:
+        """Dimension of the full configuration."""
+        return self.layout.n
+
+    def group_dims(self, g: int) -> np.ndarray:
+        """DOF indices of group g, int array (k_g,)."""
+        return np.array(self.groups[g], dtype=int)
+
+    def group_bounds(self, g: int) -> tuple[np.ndarray, np.ndarray]:
+        """Lower and upper bounds (k_g,) of group g."""
+        d = self.group_dims(g)
+        return self.layout.lower[d], self.layout.upper[d]
+
+    def endpoint_mismatch(self, start: np.ndarray, goal: np.ndarray, tol: float = 1e-6) -> str | None:
+        """None if start/goal lie on every prescribed trajectory, else "start" or "goal"."""
+        for g, traj in self.prescribed.items():
+            d = self.group_dims(g)
+            if np.max(np.abs(traj[0] - np.asarray(start)[d])) > tol:
+                return "start"
+            if np.max(np.abs(traj[-1] - np.asarray(goal)[d])) > tol:
+                return "goal"
+        return None
+
+    def initial_waypoints(self, start: np.ndarray, goal: np.ndarray) -> np.ndarray:
+        """Initial path (h, n): prescribed groups as given, the others linear from start to goal."""
+        W = interpolate_waypoints(start, goal, self.h)
+        for g, traj in self.prescribed.items():
+            W[:, self.group_dims(g)] = traj
+        W[0], W[-1] = start, goal
+        return W
+
+    def group_point(self, W: np.ndarray, g: int) -> np.ndarray:
+        """Path-space point of group g: its values at the h-2 intermediate steps, flat ((h-2) k_g,)."""
+        return np.asarray(W)[1:-1][:, self.group_dims(g)].reshape(-1).copy()
+
+    def with_group_point(self, W: np.ndarray, g: int, x: np.ndarray) -> np.ndarray:
+        """Copy of W (h, n) whose intermediate group-g values are the path-space point x."""
+        d = self.group_dims(g)
+        x = np.asarray(x, dtype=float)
+        if x.shape != ((self.h - 2) * len(d),):
+            raise ValueError(f"path-space point of group {g} must have shape ({(self.h - 2) * len(d)},), got {x.shape}")
+        out = np.array(W, dtype=float, copy=True)
+        out[1:-1, d] = x.reshape(self.h - 2, len(d))
+        return out
+
+    def to_path(self, si: ob.SpaceInformation, W: np.ndarray) -> og.PathGeometric:
+        """``og.PathGeometric`` through the waypoints W (h, n)."""
+        return self.layout.to_path(si, W)
+
+    def from_path(self, path: og.PathGeometric) -> np.ndarray:
+        """Waypoints (K, n) of an ``og.PathGeometric``."""
+        return self.layout.from_path(path)
+
+    def path_length(self, W: np.ndarray) -> float:
+        """Length of the waypoint polyline in the space's metric (see module docstring)."""
+        return self.layout.path_length(W)
