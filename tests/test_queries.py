@@ -1,0 +1,109 @@
+"""Cross-sector query sets: stored sets, planning necessity, generator determinism, JSON round trip."""
+
+from __future__ import annotations
+
+import json
+from collections import Counter
+
+import numpy as np
+import pytest
+
+from tpee_ompl.pointing import aim_errors
+from tpee_ompl.queries import (
+    FORMAT_VERSION,
+    Query,
+    generate_queries,
+    load_queries,
+    load_query_set,
+    planning_necessity,
+    save_queries,
+    straight_motion,
+)
+from tpee_ompl.sectors import cross_sector_trajectory, in_pointing_sector, posture_preset
+
+
+@pytest.fixture(scope="module")
+def necessary():
+    return load_query_set("planning_necessary")
+
+
+@pytest.fixture(scope="module")
+def paper_random():
+    return load_query_set("paper_random")
+
+
+@pytest.mark.parametrize("name", ["planning_necessary", "paper_random"])
+def test_stored_sets_have_ten_queries_per_ordered_pair(name):
+    queries, header = load_query_set(name)
+    assert header["format_version"] == FORMAT_VERSION and header["name"] == name
+    assert isinstance(header["seed"], int)
+    pairs = Counter((q.from_sector, q.to_sector) for q in queries)
+    assert len(pairs) == 12 and set(pairs.values()) == {10}
+    assert [q.id for q in queries] == list(range(120))
+
+
+@pytest.mark.parametrize("name", ["planning_necessary", "paper_random"])
+def test_stored_queries_aim_at_their_targets_collision_free(robot, name):
+    queries, header = load_query_set(name)
+    assert header["model_hash"] == robot.model_hash
+    for q in queries:
+        for conf, target, k in ((q.start, q.target_a, q.from_sector), (q.goal, q.target_b, q.to_sector)):
+            np.testing.assert_allclose(conf[:2], posture_preset(k), atol=1e-12)
+            perp, along, _ = aim_errors(robot, conf, target)
+            assert perp < 1e-6 and along > 0
+            assert robot.is_valid(conf) and robot.line_of_sight_clear(conf, target)
+            assert in_pointing_sector(target, k) and target[2] >= 0.0
+
+
+def test_default_set_makes_planning_necessary(robot, necessary):
+    queries, header = necessary
+    rate, per_pair = planning_necessity(robot, queries)
+    assert rate >= 0.5 and min(per_pair.values()) >= 3
+    assert rate == pytest.approx(header["planning_necessity_rate"])
+
+
+def test_paper_random_rate_matches_its_header(robot, paper_random):
+    queries, header = paper_random
+    rate, per_pair = planning_necessity(robot, queries)
+    assert rate == pytest.approx(header["planning_necessity_rate"])
+    assert {f"{i}->{j}": n for (i, j), n in per_pair.items()} == header["planning_necessary_per_pair"]
+
+
+def test_straight_motion_follows_table3_and_interpolates_pan_tilt():
+    start = np.r_[posture_preset(1), 0.3, -0.2]
+    goal = np.r_[posture_preset(3), -1.0, 0.4]
+    w = straight_motion(start, goal, 1, 3)
+    np.testing.assert_allclose(w[:, :2], cross_sector_trajectory(1, 3))
+    np.testing.assert_allclose(w[:, 2], np.linspace(0.3, -1.0, 7))
+    np.testing.assert_array_equal(w[0], start)
+    np.testing.assert_array_equal(w[-1], goal)
+
+
+def test_generator_is_deterministic_and_round_trips_through_json(robot, tmp_path):
+    a, stats = generate_queries(robot, n_per_pair=1, seed=7, require_planning=False)
+    b, _ = generate_queries(robot, n_per_pair=1, seed=7, require_planning=False)
+    assert len(a) == 12 and stats["drawn"] >= 12
+    for qa, qb in zip(a, b):
+        np.testing.assert_array_equal(qa.start, qb.start)
+        np.testing.assert_array_equal(qa.target_b, qb.target_b)
+    path = save_queries(tmp_path / "x.json", a, name="x", seed=7, model_hash=robot.model_hash)
+    loaded = load_queries(path)
+    assert [q.to_dict() for q in loaded] == [q.to_dict() for q in a]
+
+
+def test_bad_query_files_and_queries_raise(tmp_path):
+    with pytest.raises(FileNotFoundError, match="not found"):
+        load_queries("no_such_set")
+    p = tmp_path / "old.json"
+    p.write_text(json.dumps({"format_version": 99, "queries": []}))
+    with pytest.raises(ValueError, match="format_version"):
+        load_queries(p)
+    with pytest.raises(ValueError, match="from_sector == to_sector"):
+        Query(0, 2, 2, np.zeros(3), np.zeros(3), np.zeros(4), np.zeros(4))
+    with pytest.raises(ValueError, match="finite"):
+        Query(0, 1, 2, [np.nan, 0, 0], np.zeros(3), np.zeros(4), np.zeros(4))
+    with pytest.raises(ValueError, match="unknown sector"):
+        Query(0, 1, 7, np.zeros(3), np.zeros(3), np.zeros(4), np.zeros(4))
+    q = Query(0, 1, 2, np.zeros(3), np.ones(3), np.zeros(4), np.zeros(4))
+    with pytest.raises(ValueError):
+        q.start[0] = 1.0  # stored arrays are read-only
