@@ -41,7 +41,7 @@ def main(argv: list[str] | None = None) -> None:
         }
         path = save_queries(args.out / f"{name}.json", queries, name=name, seed=seed,
                             model_hash=robot.model_hash, extra=extra)
-        logging.info("%s: %d queries, planning necessary for %.1f%% (min per pair %d of %d) -> %s",
+        logging.getLogger("make_queries").info("%s: %d queries, planning necessary for %.1f%% (min per pair %d of %d) -> %s",
                      name, len(queries), 100 * rate, min(per_pair.values()), args.n_per_pair, path)
 
 

@@ -18,8 +18,8 @@ from tpee_ompl.sectors import (
     pointing_sectors,
     posture_preset,
     posture_sector,
-    select_sector,
     sector_origin,
+    select_sector,
     target_direction,
 )
 

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 
@@ -26,7 +28,7 @@ def _assert_safe_and_aimed(robot, result):
     Q = result.configurations
     assert len(Q) > 0
     assert robot.are_valid(Q).all()
-    for a, b in zip(Q[:-1], Q[1:]):
+    for a, b in itertools.pairwise(Q):
         assert robot.are_valid(motion_states(a, b, 0.01)).all()
     assert np.all(np.diff(result.times) >= 0)
     aiming = ~np.isnan(result.targets[:, 0])

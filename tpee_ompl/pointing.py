@@ -49,15 +49,15 @@ from .sectors import posture_preset
 __all__ = [
     "AimingError",
     "BlindAreaError",
-    "UnreachableTargetError",
     "PointingGeometry",
-    "default_geometry",
-    "pointing_frame",
+    "UnreachableTargetError",
     "aim",
     "aim_batch",
+    "aim_checked",
     "aim_errors",
     "check_target",
-    "aim_checked",
+    "default_geometry",
+    "pointing_frame",
 ]
 
 BLIND_TOLERANCE = 1e-9
@@ -201,7 +201,7 @@ def _as_dof12(posture: int | np.ndarray, n: int) -> np.ndarray:
     if isinstance(posture, (int, np.integer)) and not isinstance(posture, bool):
         return np.broadcast_to(posture_preset(int(posture)), (n, 2))
     if isinstance(posture, bool):
-        raise ValueError(f"unknown sector {posture!r}: sectors are 1, 2, 3, 4")
+        raise ValueError(f"unknown sector {posture!r}: sectors are 1, 2, 3, 4")  # noqa: TRY004 (bad input value)
     d = np.asarray(posture, dtype=float)
     if d.shape == (2,):
         d = np.broadcast_to(d, (n, 2))

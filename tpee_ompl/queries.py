@@ -34,22 +34,21 @@ from .sectors import (
     check_sector,
     cross_sector_trajectory,
     in_pointing_sector,
-    posture_preset,
 )
 
 __all__ = [
     "FORMAT_VERSION",
-    "QUERY_DIR",
     "NECESSITY_REGIONS",
+    "QUERY_DIR",
     "Query",
     "TargetRegion",
-    "straight_motion",
-    "straight_motion_valid",
     "generate_queries",
-    "save_queries",
     "load_queries",
     "load_query_set",
     "planning_necessity",
+    "save_queries",
+    "straight_motion",
+    "straight_motion_valid",
 ]
 
 log = logging.getLogger(__name__)

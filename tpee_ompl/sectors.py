@@ -9,21 +9,21 @@ from __future__ import annotations
 import numpy as np
 
 __all__ = [
-    "SECTORS",
-    "POSTURE_PRESETS",
     "CROSS_SECTOR_TRAJECTORIES",
-    "posture_preset",
-    "cross_sector_trajectory",
-    "check_sector",
+    "POINTING_AZIMUTH",
     "POLAR_CAP",
     "POSTURE_AZIMUTH",
-    "POINTING_AZIMUTH",
-    "sector_origin",
-    "target_direction",
-    "posture_sector",
+    "POSTURE_PRESETS",
+    "SECTORS",
+    "check_sector",
+    "cross_sector_trajectory",
     "in_pointing_sector",
     "pointing_sectors",
+    "posture_preset",
+    "posture_sector",
+    "sector_origin",
     "select_sector",
+    "target_direction",
 ]
 
 SECTORS = (1, 2, 3, 4)

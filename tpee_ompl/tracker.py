@@ -14,6 +14,7 @@ Output: a time-stamped joint trajectory plus events (aim, cross-sector, blind-ar
 
 from __future__ import annotations
 
+import itertools
 import logging
 import math
 from collections.abc import Callable, Iterable
@@ -28,10 +29,10 @@ from .sectors import SECTORS, check_sector, in_pointing_sector, posture_preset, 
 
 __all__ = [
     "Planner",
-    "TrackerOptions",
     "TrackEvent",
     "TrackResult",
     "Tracker",
+    "TrackerOptions",
     "make_default_planner",
 ]
 
@@ -169,12 +170,12 @@ class Tracker:
         if not (np.allclose(waypoints[0], self.q, atol=1e-6) and np.allclose(waypoints[-1], goal, atol=1e-6)):
             raise ValueError("planner path does not start at the current configuration and end at the goal")
         waypoints[0], waypoints[-1] = self.q, goal
-        for a, b in zip(waypoints[:-1], waypoints[1:]):
+        for a, b in itertools.pairwise(waypoints):
             if not self._motion_free(a, b):
                 raise ValueError(f"planner path {self.sector}->{k} collides (checked every {self.options.check_step} rad)")
         self.events.append(TrackEvent(t, "cross-sector", k, f"{self.sector}->{k}: {why}, {len(waypoints)} waypoints"))
         clock = t
-        for a, b in zip(waypoints[:-1], waypoints[1:]):
+        for a, b in itertools.pairwise(waypoints):
             clock += float(np.max(np.abs(b - a))) / self.options.joint_speed
             last = b is waypoints[-1]
             self._record(clock, b, target if last else None, k if last else 0)
@@ -258,7 +259,7 @@ def make_default_planner(robot: WearerArm, *, timeout: float = 2.0, seed: int | 
 
     def plan(start: np.ndarray, goal: np.ndarray, i: int, j: int) -> np.ndarray:
         w = straight_motion(start, goal, i, j) if i != j else np.array([start, goal], dtype=float)
-        if all(robot.are_valid(motion_states(a, b, step)).all() for a, b in zip(w[:-1], w[1:])):
+        if all(robot.are_valid(motion_states(a, b, step)).all() for a, b in itertools.pairwise(w)):
             return w
         ss = make_simple_setup(robot, start, goal)
         ss.setPlanner(og.RRTConnect(ss.getSpaceInformation()))
