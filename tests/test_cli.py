@@ -96,3 +96,10 @@ def test_view_without_meshcat_says_what_to_install(capsys):
         assert "pip install" in capsys.readouterr().err
     else:
         pytest.skip("meshcat is installed: the viewer would block")
+
+
+def test_bench_help_shows_an_example(capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["bench", "--help"])
+    assert exc.value.code == 0
+    assert "example:" in capsys.readouterr().out

@@ -222,6 +222,25 @@ def cmd_view(args: argparse.Namespace) -> int:
         time.sleep(1.0)
 
 
+def _register_bench(sub: argparse._SubParsersAction, fmt: type) -> None:
+    from .benchmark import build_parser
+
+    template = build_parser("tpee-ompl bench")
+    p = sub.add_parser("bench", help="head-to-head benchmark campaign (OMPL Benchmark, SQLite, Table 4)",
+                       formatter_class=fmt, description=(template.description or "") +
+                       "\n\nexample:\n  tpee-ompl bench --max-queries 24 --samples 500 2500 --anytime 0.1 0.5 --workers 2",
+                       parents=[template], add_help=False, conflict_handler="resolve")
+    p.set_defaults(func=cmd_bench)
+
+
+def cmd_bench(args: argparse.Namespace) -> int:
+    """Run a benchmark campaign (delegates to :mod:`tpee_ompl.benchmark`)."""
+    from . import benchmark
+
+    argv = args._argv
+    return int(benchmark.main(argv[argv.index("bench") + 1 :]) or 0)
+
+
 def _register_pictures(sub: argparse._SubParsersAction, fmt: type) -> None:
     p = sub.add_parser("show", help="draw a scene into a PNG", formatter_class=fmt,
                        description="Draw the wearer, the arm and the line of sight.\n\nexample:\n"
@@ -300,13 +319,14 @@ def get_argument_parser() -> argparse.ArgumentParser:
     return parser
 
 
-_EXTRA_COMMANDS: list[Callable[[argparse._SubParsersAction, type], None]] = [_register_pictures]
+_EXTRA_COMMANDS: list[Callable[[argparse._SubParsersAction, type], None]] = [_register_pictures, _register_bench]
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``tpee-ompl``; returns the exit code."""
     parser = get_argument_parser()
     args = parser.parse_args(argv)
+    args._argv = list(sys.argv[1:] if argv is None else argv)
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
     try:
         return int(args.func(args) or 0)
