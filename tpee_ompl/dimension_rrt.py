@@ -573,16 +573,17 @@ class DimensionRRT(ob.Planner):
 
     def _endpoints(self) -> tuple[ob.State | None, ob.State | None, ob.PlannerStatus | None]:
         si, pdef = self.getSpaceInformation(), self.getProblemDefinition()
-        start = self.getPlannerInputStates().nextStart()
-        if start is None and pdef.getStartStateCount() > 0:
-            start = pdef.getStartState(0)
+        # never pdef.getStartState(i): its Python wrapper frees a state pdef owns (crash at exit)
+        pis = self.getPlannerInputStates()
+        start = pis.nextStart()
+        if start is None and pis.getSeenStartStatesCount() > 0:  # solve() again without clear()
+            pis.restart()
+            start = pis.nextStart()
         if start is None or not (si.satisfiesBounds(start) and si.isValid(start)):
             return None, None, _status(ob.PlannerStatus.INVALID_START)
         goal = pdef.getGoal()
         if isinstance(goal, ob.GoalState):
             gstate = goal.getState()
-        elif isinstance(goal, ob.GoalStates) and goal.getStateCount() == 1:
-            gstate = goal.getState(0)
         else:
             log.error("DimensionRRT needs a goal that is a single state, got %s", type(goal).__name__)
             return None, None, _status(ob.PlannerStatus.UNRECOGNIZED_GOAL_TYPE)

@@ -1,0 +1,84 @@
+"""The fake-time grouped view: validation, group path-space points, paths, metric."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from ompl import base as ob
+
+from tpee_ompl.grouped_space import GroupedSpace, RealVectorLayout, default_groups, interpolate_waypoints
+from tpee_ompl.sectors import cross_sector_trajectory
+
+
+def _space(n: int = 4) -> ob.RealVectorStateSpace:
+    space = ob.RealVectorStateSpace(n)
+    space.setBounds(-2.0, 2.0)
+    return space
+
+
+def test_default_groups_are_pairs() -> None:
+    assert default_groups(4) == [[0, 1], [2, 3]]
+    assert default_groups(5) == [[0, 1], [2, 3], [4]]
+
+
+@pytest.mark.parametrize(
+    ("groups", "h", "match"),
+    [([[0, 1], [1, 2, 3]], 7, "more than one group"), ([[0, 1], [3]], 7, "in no group"), ([[0, 1], [2, 4]], 7, "out of range"), ([[0, 1, 2, 3]], 2, "h")],
+)
+def test_bad_groups_and_h_raise(groups, h, match) -> None:
+    with pytest.raises(ValueError, match=match):
+        GroupedSpace(_space(), groups, h)
+
+
+def test_group_point_round_trip_and_initial_path() -> None:
+    T = cross_sector_trajectory(1, 4)
+    gs = GroupedSpace(_space(), [[0, 1], [2, 3]], 7, {0: T})
+    start, goal = np.r_[T[0], 0.5, -0.5], np.r_[T[-1], -1.0, 1.0]
+    W = gs.initial_waypoints(start, goal)
+    assert W.shape == (7, 4) and gs.planned == [1]
+    np.testing.assert_allclose(W[:, :2], T)
+    np.testing.assert_allclose(W[:, 2:], interpolate_waypoints(start[2:], goal[2:], 7))
+    x = gs.group_point(W, 1)
+    assert x.shape == (10,)  # (h - 2) * k = 5 * 2, the paper's 10-D path space
+    W2 = gs.with_group_point(W, 1, x + 0.1)
+    np.testing.assert_allclose(W2[1:-1, 2:], W[1:-1, 2:] + 0.1)
+    np.testing.assert_array_equal(W2[[0, -1]], W[[0, -1]])
+    assert gs.endpoint_mismatch(start, goal) is None
+    assert gs.endpoint_mismatch(np.r_[0.0, 0.0, 0.5, -0.5], goal) == "start"
+
+
+def test_path_round_trip_and_metric_match_ompl() -> None:
+    space = _space()
+    si = ob.SpaceInformation(space)
+    si.setStateValidityChecker(lambda s: True)
+    si.setup()
+    gs = GroupedSpace(si)
+    W = np.random.default_rng(0).uniform(-2, 2, (7, 4))
+    path = gs.to_path(si, W)
+    np.testing.assert_allclose(gs.from_path(path), W)
+    assert gs.path_length(W) == pytest.approx(path.length())
+
+
+def test_compound_layout_reads_writes_and_measures_like_ompl() -> None:
+    cs = ob.CompoundStateSpace()
+    a, b = ob.RealVectorStateSpace(2), ob.RealVectorStateSpace(1)
+    a.setBounds(-1.0, 1.0)
+    b.setBounds(0.0, 3.0)
+    cs.addSubspace(a, 1.0)
+    cs.addSubspace(b, 0.5)
+    si = ob.SpaceInformation(cs)
+    si.setStateValidityChecker(lambda s: True)
+    si.setup()
+    lay = RealVectorLayout(cs)
+    assert lay.n == 3
+    np.testing.assert_array_equal(lay.lower, [-1, -1, 0])
+    x, y = si.allocState(), si.allocState()
+    lay.write(x, [0.1, -0.2, 2.0])
+    lay.write(y, [0.5, 0.3, 1.0])
+    np.testing.assert_allclose(lay.read(x), [0.1, -0.2, 2.0])
+    assert float(lay.distance(lay.read(x), lay.read(y))) == pytest.approx(si.distance(x, y))
+
+
+def test_non_real_vector_space_is_rejected() -> None:
+    with pytest.raises(ValueError, match="RealVector"):
+        RealVectorLayout(ob.SO2StateSpace())

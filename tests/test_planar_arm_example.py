@@ -1,0 +1,52 @@
+"""DimensionRRT in a plain OMPL SimpleSetup: a planar 4-link arm among circles, no prescribed group."""
+
+from __future__ import annotations
+
+import numpy as np
+from ompl import base as ob
+
+from tpee_ompl.dimension_rrt import DimensionRRT
+from tpee_ompl.examples.planar_arm import make_planar_arm_setup
+
+
+def test_finds_valid_paths_in_a_plain_ompl_setup() -> None:
+    ss = make_planar_arm_setup()
+    si = ss.getSpaceInformation()
+    for seed in range(3):
+        ss.clear()
+        planner = DimensionRRT(si, seed=seed, max_samples=600)
+        assert planner.groups == [[0, 1], [2, 3]] and not planner.prescribed
+        ss.setPlanner(planner)
+        assert ss.solve(10.0) == ob.PlannerStatus.EXACT_SOLUTION
+        path = ss.getSolutionPath()
+        states = path.getStates()
+        assert all(si.checkMotion(s, t) for s, t in zip(states[:-1], states[1:]))
+        assert path.getStateCount() == 7
+        stats = planner.last_run_stats()
+        assert stats["collision_checks"] > 0 and stats["best_cost"] == path.length()
+
+
+def test_straight_motion_is_blocked_so_planning_is_needed() -> None:
+    ss = make_planar_arm_setup()
+    checker = ss._planar_arm
+    Q = np.linspace([0.3, 0, 0, 0], [2.6, 0, 0, 0], 200)
+    assert not checker.are_valid(Q).all()
+
+
+def test_per_state_fallback_gives_the_same_path() -> None:
+    paths = []
+    for batch in (True, False):
+        ss = make_planar_arm_setup()
+        planner = DimensionRRT(ss.getSpaceInformation(), seed=4, max_samples=300, batch=batch)
+        ss.setPlanner(planner)
+        assert ss.solve(10.0) == ob.PlannerStatus.EXACT_SOLUTION
+        paths.append(np.array([[s[i] for i in range(4)] for s in ss.getSolutionPath().getStates()]))
+    np.testing.assert_array_equal(paths[0], paths[1])
+
+
+def test_second_solve_without_clear_still_finds_the_start() -> None:
+    ss = make_planar_arm_setup()
+    planner = DimensionRRT(ss.getSpaceInformation(), seed=1, max_samples=200)
+    ss.setPlanner(planner)
+    assert ss.solve(10.0) == ob.PlannerStatus.EXACT_SOLUTION
+    assert ob.Planner.solve(planner, 10.0) == ob.PlannerStatus.EXACT_SOLUTION

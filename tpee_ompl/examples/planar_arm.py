@@ -1,0 +1,85 @@
+"""A non-TPEE problem in plain OMPL + numpy: a planar 4-link arm among circular obstacles.
+
+It shows DimensionRRT in an ordinary ``og.SimpleSetup`` (C++ default motion validator, a Python
+validity checker with an optional batched ``are_valid``), grouped ``[[0, 1], [2, 3]]``, no
+prescribed group.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from ompl import base as ob
+from ompl import geometric as og
+
+__all__ = ["PlanarArm", "make_planar_arm_setup"]
+
+
+class PlanarArm(ob.StateValidityChecker):
+    """Validity of a planar arm of equal links (base at the origin) against circles.
+
+    Parameters
+    ----------
+    si : ob.SpaceInformation
+    link_length : float
+        Length of each of the 4 links (m).
+    obstacles : array (m, 3)
+        Circles as (x, y, radius), metres.
+    samples_per_link : int
+        Points checked along each link.
+    """
+
+    def __init__(self, si: ob.SpaceInformation, link_length: float, obstacles: np.ndarray, samples_per_link: int = 6) -> None:
+        super().__init__(si)
+        self.link_length = float(link_length)
+        self.obstacles = np.asarray(obstacles, dtype=float).reshape(-1, 3)
+        self._s = np.linspace(0.0, 1.0, samples_per_link)
+        self.collision_checks = 0
+
+    def points(self, Q: np.ndarray) -> np.ndarray:
+        """Points along the links for configurations Q (N, 4), radians -> (N, 4 * samples, 2)."""
+        Q = np.atleast_2d(Q)
+        ang = np.cumsum(Q, axis=1)
+        d = self.link_length * np.stack([np.cos(ang), np.sin(ang)], axis=-1)  # (N, 4, 2)
+        joints = np.concatenate([np.zeros((len(Q), 1, 2)), np.cumsum(d, axis=1)], axis=1)  # (N, 5, 2)
+        pts = joints[:, :-1, None, :] + self._s[None, None, :, None] * d[:, :, None, :]
+        return pts.reshape(len(Q), -1, 2)
+
+    def are_valid(self, Q: np.ndarray) -> np.ndarray:
+        """Batched validity, bool (N,)."""
+        P = self.points(Q)
+        self.collision_checks += len(P)
+        diff = P[:, :, None, :] - self.obstacles[None, None, :, :2]
+        return np.all(np.einsum("npoc,npoc->npo", diff, diff) > self.obstacles[:, 2] ** 2, axis=(1, 2))
+
+    def isValid(self, state: ob.State) -> bool:  # noqa: N802 (OMPL override)
+        """True if no link point is inside an obstacle."""
+        return bool(self.are_valid(np.array([[state[i] for i in range(4)]]))[0])
+
+
+def make_planar_arm_setup(
+    start: np.ndarray = (0.3, 0.0, 0.0, 0.0),
+    goal: np.ndarray = (2.6, 0.0, 0.0, 0.0),
+    obstacles: np.ndarray = ((0.0, 1.55, 0.35), (1.2, 1.2, 0.25), (-1.0, 1.0, 0.3)),
+    link_length: float = 0.5,
+    resolution: float = 0.005,
+) -> og.SimpleSetup:
+    """SimpleSetup over ``RealVectorStateSpace(4)`` in [-pi, pi]^4 with path-length objective.
+
+    The default query sweeps the stretched arm from 0.3 rad to 2.6 rad past an obstacle above the
+    base, so the arm must fold to pass.
+    """
+    space = ob.RealVectorStateSpace(4)
+    space.setBounds(-np.pi, np.pi)
+    ss = og.SimpleSetup(space)
+    si = ss.getSpaceInformation()
+    checker = PlanarArm(si, link_length, np.asarray(obstacles))
+    ss.setStateValidityChecker(checker)
+    si.setStateValidityCheckingResolution(resolution)
+    ss.setOptimizationObjective(ob.PathLengthOptimizationObjective(si))
+    s0, s1 = si.allocState(), si.allocState()
+    s0[0:4] = [float(v) for v in start]
+    s1[0:4] = [float(v) for v in goal]
+    ss.setStartAndGoalStates(s0, s1, 1e-9)
+    ss._planar_arm = checker  # type: ignore[attr-defined]  # keep the Python checker alive
+    si.setup()
+    return ss
