@@ -5,22 +5,22 @@ handled in order; a prescribed group (Table 3 for DOF1/DOF2) is taken as given. 
 each iteration draws ONE ``k_i``-dimensional sample ``c`` and tries it at every intermediate step
 ``t``: the candidate waypoint is ``W[t]`` with the group's values replaced by ``c``.
 
-Acceptance (all steps of one sample are evaluated together, accepted in turn ``t = 1 .. h-2``,
-never two neighbouring steps from the same sample because the edge between them was not checked):
+Improvement (the paper's rule, on a valid path): ``W[t]`` is replaced by the candidate iff the
+path gets shorter, the candidate is valid and both motions to ``W[t-1]`` and ``W[t+1]`` are valid.
+The cost test (``|W[t-1]-c| + |c-W[t+1]| < |W[t-1]-W[t]| + |W[t]-W[t+1]|`` in the space's metric)
+runs first and costs no collision check.  Steps are tried in turn ``t = 1 .. h-2``; two neighbouring
+steps are never both replaced by one sample (the motion between them was not checked).
 
-* *clean step* (``W[t]`` valid and both its motions valid): accept iff the path gets shorter,
-  the candidate is valid and both motions to ``W[t-1]`` and ``W[t+1]`` are valid.  The cost test
-  (``|W[t-1]-c| + |c-W[t+1]| < |W[t-1]-W[t]| + |W[t]-W[t+1]|``) runs first and costs no collision
-  check.  This is the paper's rule.
-* *feasibility phase* (``W[t]`` or one of its motions invalid, possible only before the first valid
-  path): the badness of step t is ``b_t = [W[t] invalid] + [motion t-1 -> t invalid] +
-  [motion t -> t+1 invalid]`` (a motion with an invalid end counts as invalid), i.e. exactly the
-  part of the path's total count of invalid waypoints and motions that ``W[t]`` controls.  Accept
-  iff ``b(c) < b_t`` (the path's invalidity strictly drops), or ``b(c) == b_t`` with ``c`` valid
-  (a plateau move).  A valid candidate reaching one valid neighbour has ``b = 1`` when the other
-  neighbour is in collision, so two neighbouring waypoints that both start in collision no longer
-  deadlock (the literal rule needs both motions valid, which is impossible there); plateau moves let
-  a waypoint that sees only one neighbour wander until the other becomes visible.
+Feasibility phase (before the first valid path; the paper leaves it open): a forward tree from the
+start and a backward tree from the goal whose depth-t nodes are waypoints of step t (only the
+current group varies).  They are seeded with the valid prefix and suffix of the initial path
+(prescribed groups as given, the others linear).  The sample is tried at every step t: connected to
+the nearest forward node of step t-1 it joins the forward tree, to the nearest backward node of
+step t+1 the backward tree, to both and the path is complete.  Every node is valid and reached by
+a valid motion, so two neighbouring waypoints that both start in collision cannot deadlock it (the
+literal rule needs both motions valid, impossible when both neighbours collide).  Half of its
+samples are Gaussian around a random tree node (sigma log-uniform in 1-10 % of the bound widths) so
+the trees grow out of narrow pockets; the other half are uniform.
 
 Narrowing: once a valid path exists and the group has drawn ``narrow_after`` samples, 90 % of the
 samples come from the bounding box of the current path's group values (all ``h`` steps), padded
