@@ -29,7 +29,7 @@ def get_argument_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--reps", type=int, default=2, help="queries per pair type (12 pair types)")
     p.add_argument("--samples", type=int, nargs="+", default=[500, 2500])
-    p.add_argument("--margin", type=float, default=0.015, help="security margin (m); 0.02 makes 3<->4 infeasible")
+    p.add_argument("--margin", type=float, default=0.02, help="security margin (m)")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--rrtstar", action="store_true", help="also time og.RRTstar at equal iterations")
     p.add_argument("--out", default=None, help="JSON file for the rows")

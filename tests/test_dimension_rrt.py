@@ -13,18 +13,12 @@ from ompl import base as ob
 from ompl import tools as ot
 
 from tpee_ompl.dimension_rrt import DimensionRRT, tpee_dimension_rrt
+from tpee_ompl.examples.planar_arm import make_planar_arm_setup
 from tpee_ompl.examples.tpee_queries import PAIR_TYPES, cross_sector_query
 from tpee_ompl.ompl_problem import make_simple_setup, path_to_array, set_state
 from tpee_ompl.robot import WearerArm
 
 SAMPLES = 300
-
-
-@pytest.fixture(scope="module")
-def robot_15mm() -> WearerArm:
-    """The model with a 1.5 cm margin: with the default 2 cm, Table 3 rows 3->4 and 4->3 pass link2
-    1.6-1.9 cm from the helmet at step 3 (0, 40 deg), so no pan/tilt makes them valid."""
-    return WearerArm(security_margin=0.015)
 
 
 def _solve(robot: WearerArm, i: int, j: int, q0: np.ndarray, q1: np.ndarray, **kw):
@@ -35,11 +29,11 @@ def _solve(robot: WearerArm, i: int, j: int, q0: np.ndarray, q1: np.ndarray, **k
     return ss, planner, status
 
 
-def test_valid_paths_on_all_12_pair_types(robot_15mm: WearerArm) -> None:
+def test_valid_paths_on_all_12_pair_types(robot: WearerArm) -> None:
     rng = np.random.default_rng(7)
     for i, j in PAIR_TYPES:
-        q0, q1 = cross_sector_query(robot_15mm, i, j, rng)
-        ss, planner, status = _solve(robot_15mm, i, j, q0, q1, max_samples=SAMPLES, seed=3)
+        q0, q1 = cross_sector_query(robot, i, j, rng)
+        ss, planner, status = _solve(robot, i, j, q0, q1, max_samples=SAMPLES, seed=3)
         assert status == ob.PlannerStatus.EXACT_SOLUTION, (i, j)
         path = ss.getSolutionPath()
         si = ss.getSpaceInformation()
@@ -59,9 +53,9 @@ def test_valid_paths_on_all_12_pair_types(robot_15mm: WearerArm) -> None:
         assert times == sorted(times)
 
 
-def test_cost_never_increases_and_improves(robot_15mm: WearerArm) -> None:
-    q0, q1 = cross_sector_query(robot_15mm, 1, 4, np.random.default_rng(1))
-    _, planner, _ = _solve(robot_15mm, 1, 4, q0, q1, max_samples=800, seed=0)
+def test_cost_never_increases_and_improves(robot: WearerArm) -> None:
+    q0, q1 = cross_sector_query(robot, 1, 4, np.random.default_rng(1))
+    _, planner, _ = _solve(robot, 1, 4, q0, q1, max_samples=800, seed=0)
     prog = planner.last_run_stats()["progress"]
     costs = np.array([c for _, c, _ in prog])
     finite = costs[np.isfinite(costs)]
@@ -69,22 +63,22 @@ def test_cost_never_increases_and_improves(robot_15mm: WearerArm) -> None:
     assert prog[-1][2] == 800
 
 
-def test_same_seed_and_sample_cap_give_identical_path(robot_15mm: WearerArm) -> None:
-    q0, q1 = cross_sector_query(robot_15mm, 4, 1, np.random.default_rng(2))
-    paths = [path_to_array(_solve(robot_15mm, 4, 1, q0, q1, max_samples=200, seed=11)[0].getSolutionPath(), 4) for _ in range(2)]
+def test_same_seed_and_sample_cap_give_identical_path(robot: WearerArm) -> None:
+    q0, q1 = cross_sector_query(robot, 4, 1, np.random.default_rng(2))
+    paths = [path_to_array(_solve(robot, 4, 1, q0, q1, max_samples=200, seed=11)[0].getSolutionPath(), 4) for _ in range(2)]
     np.testing.assert_array_equal(paths[0], paths[1])
 
 
-def test_batched_and_per_state_checks_agree(robot_15mm: WearerArm) -> None:
-    q0, q1 = cross_sector_query(robot_15mm, 2, 3, np.random.default_rng(3))
-    a = _solve(robot_15mm, 2, 3, q0, q1, max_samples=150, seed=5)[0].getSolutionPath()
-    b = _solve(robot_15mm, 2, 3, q0, q1, max_samples=150, seed=5, batch=False)[0].getSolutionPath()
+def test_batched_and_per_state_checks_agree(robot: WearerArm) -> None:
+    q0, q1 = cross_sector_query(robot, 2, 3, np.random.default_rng(3))
+    a = _solve(robot, 2, 3, q0, q1, max_samples=150, seed=5)[0].getSolutionPath()
+    b = _solve(robot, 2, 3, q0, q1, max_samples=150, seed=5, batch=False)[0].getSolutionPath()
     np.testing.assert_array_equal(path_to_array(a, 4), path_to_array(b, 4))
 
 
-def test_runs_inside_ompl_benchmark(robot_15mm: WearerArm, tmp_path) -> None:
-    q0, q1 = cross_sector_query(robot_15mm, 3, 2, np.random.default_rng(4))
-    ss = make_simple_setup(robot_15mm, q0, q1)
+def test_runs_inside_ompl_benchmark(robot: WearerArm, tmp_path) -> None:
+    q0, q1 = cross_sector_query(robot, 3, 2, np.random.default_rng(4))
+    ss = make_simple_setup(robot, q0, q1)
     planner = tpee_dimension_rrt(ss.getSpaceInformation(), 3, 2, max_samples=150, seed=1)
     bench = ot.Benchmark(ss, "dimension_rrt")
     bench.addPlanner(planner)
@@ -118,8 +112,8 @@ def test_runs_inside_ompl_benchmark(robot_15mm: WearerArm, tmp_path) -> None:
         ({"prescribed": {4: np.zeros((7, 2))}}, "not a group index"),
     ],
 )
-def test_bad_parameters_raise(robot_15mm: WearerArm, kwargs: dict, match: str) -> None:
-    ss = make_simple_setup(robot_15mm)
+def test_bad_parameters_raise(robot: WearerArm, kwargs: dict, match: str) -> None:
+    ss = make_simple_setup(robot)
     with pytest.raises(ValueError, match=match):
         DimensionRRT(ss.getSpaceInformation(), **kwargs)
 
@@ -129,27 +123,27 @@ def _status_of(ss, planner) -> ob.PlannerStatus:
     return ss.solve(5.0)
 
 
-def test_invalid_start_and_goal_statuses(robot_15mm: WearerArm) -> None:
-    q0, q1 = cross_sector_query(robot_15mm, 1, 2, np.random.default_rng(5))
+def test_invalid_start_and_goal_statuses(robot: WearerArm) -> None:
+    q0, q1 = cross_sector_query(robot, 1, 2, np.random.default_rng(5))
     bad = np.array([0.0, 0.0, 0.0, 0.0])  # arm folded into the wearer
-    assert not robot_15mm.is_valid(bad)
+    assert not robot.is_valid(bad)
     for start, goal, want in ((bad, q1, ob.PlannerStatus.INVALID_START), (q0, bad, ob.PlannerStatus.INVALID_GOAL)):
-        ss = make_simple_setup(robot_15mm, start, goal, check_endpoints=False)
+        ss = make_simple_setup(robot, start, goal, check_endpoints=False)
         planner = DimensionRRT(ss.getSpaceInformation(), max_samples=10)
         assert _status_of(ss, planner) == want
         assert not ss.haveSolutionPath()
 
 
-def test_start_off_the_prescribed_trajectory_is_invalid_start(robot_15mm: WearerArm) -> None:
-    q0, q1 = cross_sector_query(robot_15mm, 1, 2, np.random.default_rng(6))
-    ss = make_simple_setup(robot_15mm, q0, q1)
+def test_start_off_the_prescribed_trajectory_is_invalid_start(robot: WearerArm) -> None:
+    q0, q1 = cross_sector_query(robot, 1, 2, np.random.default_rng(6))
+    ss = make_simple_setup(robot, q0, q1)
     planner = tpee_dimension_rrt(ss.getSpaceInformation(), 3, 2, max_samples=10)  # wrong Table 3 row
     assert _status_of(ss, planner) == ob.PlannerStatus.INVALID_START
 
 
-def test_goal_region_is_unrecognized_goal_type(robot_15mm: WearerArm) -> None:
-    q0, q1 = cross_sector_query(robot_15mm, 1, 2, np.random.default_rng(6))
-    ss = make_simple_setup(robot_15mm)
+def test_goal_region_is_unrecognized_goal_type(robot: WearerArm) -> None:
+    q0, q1 = cross_sector_query(robot, 1, 2, np.random.default_rng(6))
+    ss = make_simple_setup(robot)
     si = ss.getSpaceInformation()
     s0 = set_state(si.allocState(), q0)
     goals = ob.GoalStates(si)
@@ -160,18 +154,21 @@ def test_goal_region_is_unrecognized_goal_type(robot_15mm: WearerArm) -> None:
     assert _status_of(ss, DimensionRRT(si, max_samples=10)) == ob.PlannerStatus.UNRECOGNIZED_GOAL_TYPE
 
 
-def test_no_solution_times_out_without_a_path(robot: WearerArm) -> None:
-    # default 2 cm margin: Table 3 row 3->4 is in collision at step 3 for every pan/tilt
-    q0, q1 = cross_sector_query(robot, 3, 4, np.random.default_rng(8), need_planning=False)
-    ss, planner, status = _solve(robot, 3, 4, q0, q1, max_samples=100, seed=0)
-    assert status == ob.PlannerStatus.TIMEOUT
+def test_no_solution_times_out_without_a_path() -> None:
+    # planar arm whose prescribed joint-0 trajectory puts link 1 through an obstacle at step 3
+    ss = make_planar_arm_setup(start=(-1.0, 0, 0, 0), goal=(1.0, 0, 0, 0), obstacles=((0.25, 0.0, 0.05),))
+    prescribed = {0: np.c_[np.linspace(-1.0, 1.0, 7), np.zeros(7)]}
+    planner = DimensionRRT(ss.getSpaceInformation(), prescribed=prescribed, max_samples=100, seed=0)
+    ss.setPlanner(planner)
+    assert ss.solve(10.0) == ob.PlannerStatus.TIMEOUT
     assert not ss.haveSolutionPath()
     stats = planner.last_run_stats()
     assert stats["best_cost"] == math.inf and stats["first_solution_time"] is None
+    assert stats["samples"] == 100
 
 
-def test_settings_and_stats_shape(robot_15mm: WearerArm) -> None:
-    ss = make_simple_setup(robot_15mm)
+def test_settings_and_stats_shape(robot: WearerArm) -> None:
+    ss = make_simple_setup(robot)
     planner = tpee_dimension_rrt(ss.getSpaceInformation(), 1, 2, max_samples=500, seed=2)
     settings = planner.settings()
     assert settings["h"] == "7" and settings["max_samples"] == "500" and settings["groups"] == "[[0, 1], [2, 3]]"
