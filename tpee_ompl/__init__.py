@@ -13,11 +13,45 @@ from .ompl_problem import (
     motion_states,
     path_to_array,
 )
+from .dmp import DMP, DMPOptions, generate, generate_blended, learn_dmp
+from .path_library import LibraryFileError, PathLibrary, QueryResult
+from .pointing import AimingError, BlindAreaError, UnreachableTargetError, aim, aim_batch, aim_checked
+from .queries import Query, load_queries
 from .robot import WearerArm, default_robot
-from .sectors import CROSS_SECTOR_TRAJECTORIES, POSTURE_PRESETS, cross_sector_trajectory, posture_preset
+from .sectors import (
+    CROSS_SECTOR_TRAJECTORIES,
+    POSTURE_PRESETS,
+    cross_sector_trajectory,
+    in_pointing_sector,
+    posture_preset,
+    posture_sector,
+    select_sector,
+)
+from .tracker import Tracker, make_default_planner
 
 __all__ = [
+    "AimingError",
     "BatchedMotionValidator",
+    "BlindAreaError",
+    "DMP",
+    "DMPOptions",
+    "LibraryFileError",
+    "PathLibrary",
+    "Query",
+    "QueryResult",
+    "Tracker",
+    "UnreachableTargetError",
+    "aim",
+    "aim_batch",
+    "aim_checked",
+    "generate",
+    "generate_blended",
+    "in_pointing_sector",
+    "learn_dmp",
+    "load_queries",
+    "make_default_planner",
+    "posture_sector",
+    "select_sector",
     "CROSS_SECTOR_TRAJECTORIES",
     "POSTURE_PRESETS",
     "WearerArm",

@@ -158,6 +158,113 @@ def cmd_plan(args: argparse.Namespace) -> int:
     return 0 if exact else 1
 
 
+# ---------------------------------------------------------------------------------------- aim / track
+def cmd_aim(args: argparse.Namespace) -> int:
+    """Closed-form aiming IK for one target (eqs. 1-11) with the collision and line-of-sight verdict."""
+    from .pointing import aim, aim_errors, check_target
+    from .sectors import select_sector
+
+    robot = _load_robot(args)
+    target = check_target(np.array(args.target), robot)
+    sector = args.sector if args.sector is not None else select_sector(target)
+    q = aim(target, sector, pan_reference=args.pan_reference)
+    perp, _, ang = aim_errors(robot, q, target)
+    result = {"target": target.tolist(), "sector": sector, "q_rad": q.round(9).tolist(),
+              "q_deg": np.degrees(q).round(4).tolist(), "collision_free": robot.is_valid(q),
+              "line_of_sight_clear": robot.line_of_sight_clear(q, target), "aim_error_m": perp, "aim_error_rad": ang}
+    if args.json:
+        print(json.dumps(result))
+    else:
+        print(f"sector {sector}: DOF1..DOF4 = {' '.join(f'{v:+.6f}' for v in q)} rad "
+              f"({' '.join(f'{v:+.2f}' for v in np.degrees(q))} deg)")
+        print(f"collision-free: {result['collision_free']}, line of sight clear: {result['line_of_sight_clear']}, "
+              f"aim error {perp:.1e} m")
+    return 0 if result["collision_free"] and result["line_of_sight_clear"] else 1
+
+
+def _scripted_targets(name: str, duration: float, rate: float) -> list[tuple]:
+    """Target streams for `track`: a circle around the wearer, boundary jitter, sector jumps."""
+    t = np.arange(0.0, duration, 1.0 / rate)
+    if name == "circle":
+        az = 2 * np.pi * t / duration
+        pts = np.c_[5 * np.cos(az), 5 * np.sin(az), 1.5 + 1.0 * np.sin(3 * az)]
+        return [(ti, p) for ti, p in zip(t, pts)]
+    if name == "jitter":
+        rng = np.random.default_rng(0)
+        az = np.radians(90.0 + rng.uniform(-4.0, 4.0, size=t.size))  # the 2/3 posture boundary, to the left
+        pts = np.c_[6 * np.cos(az) - 0.3, 6 * np.sin(az), np.full(t.size, 2.0)]
+        return [(ti, p) for ti, p in zip(t, pts)]
+    if name == "jump":
+        spots = [np.array(v) for v in ((6.0, 3.0, 2.0), (-2.0, -6.0, 1.0), (-5.0, 4.0, 2.5), (6.0, -3.0, 1.5))]
+        return [(ti, spots[int(k * len(spots) / t.size)], k > 0 and int(k * len(spots) / t.size) != int((k - 1) * len(spots) / t.size))
+                for k, ti in enumerate(t)]
+    raise CliError(f"unknown script {name!r}")
+
+
+def cmd_track(args: argparse.Namespace) -> int:
+    """Run the Fig. 10 tracking strategy on a scripted target stream and report its events."""
+    from .tracker import Tracker, make_default_planner
+
+    robot = _load_robot(args)
+    if args.planner == "dimension-rrt":
+        from .dimension_rrt import make_path_planner
+
+        planner = make_path_planner(robot, max_samples=args.samples, seed=args.seed)
+    elif args.planner == "library":
+        from .path_library import PathLibrary
+
+        lib = PathLibrary.load(args.library, robot)
+        planner = lib.as_planner()
+    else:
+        planner = make_default_planner(robot, seed=args.seed)
+    stream = _scripted_targets(args.script, args.duration, args.rate)
+    result = Tracker(robot, planner).run(stream)
+    kinds = ("aim", "cross-sector", "blind-area", "unreachable")
+    summary = {k: result.count(k) for k in kinds}
+    if args.output:
+        header = "t,dof1,dof2,dof3,dof4,sector"
+        np.savetxt(args.output, np.c_[result.times, result.configurations, result.sectors], delimiter=",",
+                   header=header, comments="")
+    if args.json:
+        print(json.dumps({"script": args.script, "samples": len(stream), "trajectory_points": len(result.times),
+                          "events": summary}))
+    else:
+        print(f"{args.script}: {len(stream)} target samples -> {len(result.times)} trajectory points; "
+              + ", ".join(f"{k} {v}" for k, v in summary.items()))
+        if args.output:
+            print(f"wrote {args.output}")
+    return 0
+
+
+def _register_aim_track(sub: argparse._SubParsersAction, fmt: type) -> None:
+    p = sub.add_parser("aim", help="aiming IK for a target", formatter_class=fmt,
+                       description="Closed-form aiming IK (paper eqs. 1-11).\n\nexample:\n"
+                                   "  tpee-ompl aim --target 5 2 1.5\n  tpee-ompl aim --target -4 -3 1 --sector 1 --json")
+    p.add_argument("--target", type=_finite, nargs=3, required=True, metavar=("X", "Y", "Z"), help="metres, world frame")
+    p.add_argument("--sector", type=_sector, default=None, help="posture sector (default: chosen from the target)")
+    p.add_argument("--pan-reference", type=_finite, default=0.0, help="pan angle the smaller rotation is measured from")
+    p.add_argument("--json", action="store_true")
+    _add_model_args(p)
+    p.set_defaults(func=cmd_aim)
+
+    p = sub.add_parser("track", help="run the tracking strategy (Fig. 10) on a scripted target", formatter_class=fmt,
+                       description="Track a scripted target: re-aim inside a pointing sector, plan cross-sector motions "
+                                   "when it leaves.\n\nexample:\n  tpee-ompl track --script circle\n"
+                                   "  tpee-ompl track --script jump --planner dimension-rrt -o traj.csv")
+    p.add_argument("--script", choices=("circle", "jitter", "jump"), default="circle")
+    p.add_argument("--planner", choices=("default", "dimension-rrt", "library"), default="default",
+                   help="cross-sector planner: default (Table 3 straight motion, else RRTConnect), dimension-rrt, library")
+    p.add_argument("--library", default="experiments/library/default.npz", help="path library file (with --planner library)")
+    p.add_argument("--samples", type=_positive_int, default=2500, help="dimension-RRT sample cap")
+    p.add_argument("--duration", type=_positive_float, default=20.0, help="seconds of target motion")
+    p.add_argument("--rate", type=_positive_float, default=10.0, help="target samples per second")
+    p.add_argument("--seed", type=int, default=1, help="OMPL / planner seed (>= 1)")
+    p.add_argument("--json", action="store_true")
+    p.add_argument("-o", "--output", help="write the trajectory as CSV")
+    _add_model_args(p)
+    p.set_defaults(func=cmd_track)
+
+
 # ---------------------------------------------------------------------------------------- pictures
 DEFAULT_SCENE_Q = (50.0, 20.0, 17.0, -37.0)  # degrees: sector 4 preset aiming forward-left-up
 DEFAULT_SCENE_TARGET = (4.0, 1.5, 1.9)
@@ -319,7 +426,7 @@ def get_argument_parser() -> argparse.ArgumentParser:
     return parser
 
 
-_EXTRA_COMMANDS: list[Callable[[argparse._SubParsersAction, type], None]] = [_register_pictures, _register_bench]
+_EXTRA_COMMANDS: list[Callable[[argparse._SubParsersAction, type], None]] = [_register_aim_track, _register_pictures, _register_bench]
 
 
 def main(argv: Sequence[str] | None = None) -> int:

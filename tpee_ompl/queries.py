@@ -41,6 +41,7 @@ __all__ = [
     "NECESSITY_REGIONS",
     "QUERY_DIR",
     "Query",
+    "BarrelRegion",
     "TargetRegion",
     "generate_queries",
     "load_queries",
@@ -135,17 +136,49 @@ class TargetRegion:
         return origin + d * rng.uniform(*self.distance, n)[:, None]
 
 
+@dataclass(frozen=True)
+class BarrelRegion:
+    """Targets on the barrel's ray from posture k at a uniformly random pan/tilt within the joint limits.
+
+    Uniform over the arm's own pointing directions rather than over the sphere: it reaches the
+    directions that point past the wearer's gear (across the body, down past the hip), which
+    uniform target directions almost never produce.
+
+    Attributes
+    ----------
+    distance : (lo, hi), metres beyond the muzzle
+    """
+
+    distance: tuple[float, float] = (2.0, 10.0)
+
+    def sample_for(self, robot: WearerArm, k: int, rng: np.random.Generator, n: int) -> np.ndarray:
+        """n target points (n, 3) in the world frame."""
+        import pinocchio as pin
+
+        from .sectors import posture_preset
+
+        q = np.c_[np.tile(posture_preset(k), (n, 1)), rng.uniform(robot.lower[2:], robot.upper[2:], (n, 2))]
+        fid = robot.muzzle_frame_id
+        out = np.empty((n, 3))
+        for m in range(n):
+            pin.forwardKinematics(robot.model, robot.data, q[m])
+            M = pin.updateFramePlacement(robot.model, robot.data, fid)
+            out[m] = M.translation + rng.uniform(*self.distance) * M.rotation[:, 0]
+        return out
+
+
 _WIDE = (-60.0, 60.0)
 NECESSITY_REGIONS: dict[int, tuple[TargetRegion, ...]] = {
     # stowed postures: ground targets ahead on their own side (the barrel swings across the
     # front, past the rifle and the arms), plus their whole pointing sector
     1: (TargetRegion((-25.0, -5.0), (-45.0, -5.0)), TargetRegion((-30.0, 0.0), (-15.0, 20.0)),
-        TargetRegion((-200.0, -5.0), _WIDE)),
+        TargetRegion((-200.0, -5.0), _WIDE), BarrelRegion()),
     2: (TargetRegion((10.0, 35.0), (-45.0, -5.0)), TargetRegion((10.0, 40.0), (-15.0, 20.0)),
-        TargetRegion((10.0, 200.0), _WIDE)),
-    # shoulder postures: no region stands out (docs/pointing.md); their whole pointing sector
-    3: (TargetRegion((-5.0, 230.0), _WIDE),),
-    4: (TargetRegion((-230.0, 5.0), _WIDE),),
+        TargetRegion((10.0, 200.0), _WIDE), BarrelRegion()),
+    # shoulder postures: no direction region stands out (docs/pointing.md); targets along the
+    # barrel at random pan/tilt reach the across-the-body directions
+    3: (TargetRegion((-5.0, 230.0), _WIDE), BarrelRegion(), BarrelRegion()),
+    4: (TargetRegion((-230.0, 5.0), _WIDE), BarrelRegion(), BarrelRegion()),
 }
 """Per-sector target regions of the ``planning_necessary`` set (measured in docs/pointing.md)."""
 
@@ -189,14 +222,22 @@ def _sample_aimable(
     max_rounds: int = 200,
 ):
     """Yield (target (3,), configuration (4,)) in sector k's regions, above the floor, aimable from posture k."""
-    for _ in range(max_rounds):
+    empty_rounds = 0
+    while empty_rounds < max_rounds:  # an endless stream; give up only when nothing is aimable
+        empty_rounds += 1
         which = rng.integers(len(regions), size=batch)
-        pts = np.concatenate([regions[r].sample(rng, int((which == r).sum()), origin) for r in range(len(regions))])
+        pts = np.concatenate([
+            regions[r].sample_for(robot, k, rng, int((which == r).sum())) if isinstance(regions[r], BarrelRegion)
+            else regions[r].sample(rng, int((which == r).sum()), origin)
+            for r in range(len(regions))
+        ])
         pts = pts[rng.permutation(len(pts))]
         pts = pts[(pts[:, 2] >= 0.0) & in_pointing_sector(pts, k, origin)]
         if len(pts) == 0:
             continue
         q, ok = aim_checked(robot, pts, k, geometry=geometry)
+        if ok.any():
+            empty_rounds = 0
         yield from zip(pts[ok], q[ok])
     raise RuntimeError(f"could not find aimable targets for sector {k} in {regions}")
 
