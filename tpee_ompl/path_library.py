@@ -12,6 +12,11 @@ any particular planner::
     sample_query(rng, from_sector, to_sector) -> (start (4,), goal (4,))
     plan(start, goal, from_sector, to_sector) -> waypoints (7, 4) at the fake-time steps, or None
 
+Default builders: :func:`query_sampler` (the planning-necessary query generator's sampling,
+:mod:`tpee_ompl.queries`) and :func:`dimension_rrt_planner` (dimension-RRT, 2500 samples);
+:meth:`PathLibrary.build_default` uses both.  :meth:`PathLibrary.as_planner` plugs a library
+into :class:`tpee_ompl.tracker.Tracker`.
+
 Resampling: each straight segment between consecutive fake-time steps gets ``per_step`` samples
 with a quintic time scaling (zero velocity and acceleration at every step), applied to all four
 DOFs alike, so the resampled demo is *geometrically identical* to the planned (checked) path and
@@ -24,16 +29,15 @@ import json
 import logging
 import time
 import zipfile
+import zlib
 from collections import Counter
 from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field
-from itertools import pairwise
 from pathlib import Path
 
 import numpy as np
 
 from .dmp import DMP, DMPOptions, generate_blended, learn_dmp
-from .ompl_problem import motion_states
 from .robot import WearerArm
 from .sectors import check_sector, cross_sector_trajectory
 
@@ -44,7 +48,12 @@ __all__ = [
     "LibraryFileError",
     "PathLibrary",
     "QueryResult",
+    "benchmark_queries",
+    "dimension_rrt_planner",
+    "motion_check_states",
     "motion_is_valid",
+    "path_length",
+    "query_sampler",
     "resample_waypoints",
 ]
 
@@ -81,16 +90,119 @@ def resample_waypoints(waypoints: np.ndarray, per_step: int = 100) -> np.ndarray
     return np.vstack([seg.reshape(-1, W.shape[1]), W[-1:]])
 
 
+def motion_check_states(path: np.ndarray, step: float) -> np.ndarray:
+    """All states ``si.checkMotion`` checks along the polyline ``path`` (K, n), plus its first state.
+
+    For each segment a -> b: ``n = max(1, ceil(|b - a| / step))`` states ``a + (k / n)(b - a)``,
+    k = 1..n, exactly those of :func:`tpee_ompl.ompl_problem.motion_states` (OMPL's discrete
+    motion validator), built for all segments at once; shape (1 + sum n, n).
+    """
+    path = np.asarray(path, dtype=float)
+    if path.ndim != 2 or len(path) < 1:
+        raise ValueError(f"path must have shape (K >= 1, n); got {path.shape}")
+    if not step > 0:
+        raise ValueError(f"step must be > 0, got {step!r}")
+    delta = np.diff(path, axis=0)
+    if len(delta) == 0:
+        return path[:1].copy()
+    counts = np.maximum(1, np.ceil(np.linalg.norm(delta, axis=1) / step)).astype(np.int64)
+    seg = np.repeat(np.arange(len(delta)), counts)
+    k = np.arange(1, counts.sum() + 1) - np.repeat(np.cumsum(counts) - counts, counts)
+    states = path[seg] + (k / counts[seg])[:, None] * delta[seg]
+    return np.vstack([path[:1], states])
+
+
 def motion_is_valid(robot: WearerArm, path: np.ndarray, step: float | None = None) -> bool:
     """True if the first state and every straight segment of ``path`` (K, 4) pass the motion check.
 
-    Checks the states of :func:`tpee_ompl.ompl_problem.motion_states` for each segment, the same
-    states as ``si.checkMotion`` in our setups, in one batched ``robot.are_valid`` call.
+    Checks the states of :func:`motion_check_states` (those ``si.checkMotion`` checks in a
+    :func:`~tpee_ompl.ompl_problem.make_simple_setup` setup at resolution ``step``, default
+    ``robot.max_joint_step()``) in ONE batched ``robot.are_valid`` call.
     """
-    path = np.asarray(path, dtype=float)
     step = robot.max_joint_step() if step is None else float(step)
-    chunks = [path[:1]] + [motion_states(a, b, step) for a, b in pairwise(path)]
-    return bool(robot.are_valid(np.concatenate(chunks)).all())
+    return bool(robot.are_valid(motion_check_states(path, step)).all())
+
+
+def path_length(path: np.ndarray) -> float:
+    """Euclidean joint-space length of a polyline (K, n), radians (the setups' path-length objective)."""
+    return float(np.linalg.norm(np.diff(np.asarray(path, dtype=float), axis=0), axis=1).sum())
+
+
+def query_sampler(
+    robot: WearerArm,
+    regions: dict | None = None,
+    require_planning: bool = True,
+    max_draws: int = 2000,
+) -> SampleQuery:
+    """The default ``sample_query``: random cross-sector motions as the query generator draws them.
+
+    Start and goal aim at random targets of :data:`tpee_ompl.queries.NECESSITY_REGIONS` (or
+    ``regions``) from postures i and j (goal pan nearest the start pan), as in
+    :func:`tpee_ompl.queries.generate_queries`.  With ``require_planning`` a draw is kept only if
+    its straight motion collides (about 2 % of draws: slow, ~1 s per pair); after ``max_draws``
+    the last valid draw is returned.  Deterministic given the generator passed in.
+    """
+    from .pointing import PointingGeometry, aim_checked
+    from .queries import NECESSITY_REGIONS, _sample_aimable, straight_motion_valid
+
+    geometry = PointingGeometry.from_robot(robot)
+    origin = geometry.pivot
+    regions = NECESSITY_REGIONS if regions is None else regions
+
+    def sample(rng: np.random.Generator, i: int, j: int) -> tuple[np.ndarray, np.ndarray]:
+        from_stream = _sample_aimable(robot, geometry, i, tuple(regions[i]), rng, origin)
+        to_stream = _sample_aimable(robot, geometry, j, tuple(regions[j]), rng, origin)
+        last = None
+        for _ in range(max_draws):
+            _, qa = next(from_stream)
+            tb, _ = next(to_stream)
+            qb, ok = aim_checked(robot, tb[None], j, pan_reference=qa[2], geometry=geometry)
+            if not ok[0]:
+                continue
+            last = (np.asarray(qa, dtype=float), np.asarray(qb[0], dtype=float))
+            if not require_planning or not straight_motion_valid(robot, qa, qb[0], i, j):
+                return last
+        if last is None:
+            raise RuntimeError(f"no valid cross-sector motion {i}->{j} in {max_draws} draws")
+        return last
+
+    return sample
+
+
+def dimension_rrt_planner(
+    robot: WearerArm, max_samples: int = 2500, seed: int = 0, timeout: float = 10.0
+) -> Plan:
+    """The default ``plan``: dimension-RRT (sec. 4.1.2) with Table 3's DOF1/DOF2, 7 waypoints or None.
+
+    Each call builds :func:`~tpee_ompl.ompl_problem.make_simple_setup` and runs
+    :func:`~tpee_ompl.dimension_rrt.tpee_dimension_rrt` for ``max_samples`` samples (or
+    ``timeout`` s); the planner's seed is ``seed`` mixed with a CRC of (start, goal), so a query
+    gets the same path whatever was planned before.  Returns the exact solution's (7, 4)
+    waypoints (every segment passed ``si.checkMotion``), else None.
+    """
+    from ompl import util as ou
+
+    from .dimension_rrt import tpee_dimension_rrt
+    from .ompl_problem import make_simple_setup, path_to_array
+
+    ou.setLogLevel(ou.LOG_WARN)
+
+    def plan(start: np.ndarray, goal: np.ndarray, i: int, j: int) -> np.ndarray | None:
+        start, goal = np.asarray(start, dtype=float), np.asarray(goal, dtype=float)
+        call_seed = (int(seed) * 1_000_003 + zlib.crc32(np.r_[start, goal].tobytes())) % (2**31)
+        try:
+            ss = make_simple_setup(robot, start, goal)
+        except ValueError as exc:  # start or goal in collision / out of limits
+            log.warning("dimension-RRT %d->%d not run: %s", i, j, exc)
+            return None
+        ss.setPlanner(tpee_dimension_rrt(ss.getSpaceInformation(), i, j, max_samples=max_samples, seed=call_seed))
+        ss.solve(timeout)
+        if not ss.haveExactSolutionPath():
+            return None
+        W = path_to_array(ss.getSolutionPath(), robot.nq)
+        return W if W.shape == (N_FAKE_TIME_STEPS, robot.nq) else None
+
+    return plan
 
 
 @dataclass(frozen=True)
@@ -140,9 +252,12 @@ def _key(start: np.ndarray, goal: np.ndarray) -> np.ndarray:
 class PathLibrary:
     """Demonstrations and forward/reverse DMPs for the cross-sector motions (sections 4.2.2-4.2.3).
 
-    Build with :meth:`build`, or :meth:`load` a saved one; then :meth:`query`.
-    ``plan`` (same signature as for :meth:`build`) is used for repair/fallback; without it a query
-    whose DMP candidates all collide is "failed".
+    Build with :meth:`build` (or :meth:`build_default`), or :meth:`load` a saved one; then
+    :meth:`query`.  ``plan`` (same signature as for :meth:`build`) is the fallback; without it a
+    query whose DMP candidates all collide is "failed".  ``query_stride``: a query returns every
+    ``query_stride``-th sample of the ``per_step``-dense DMP rollout (plus the last), i.e. a
+    polyline of ``(N_FAKE_TIME_STEPS - 1) per_step / query_stride + 1`` points; that polyline is
+    what is checked and returned, so the stride changes cost, never the guarantee.
     """
 
     def __init__(
@@ -154,6 +269,8 @@ class PathLibrary:
         plan: Plan | None = None,
         n_candidates: int = 3,
         build_stats: dict[str, int] | None = None,
+        query_stride: int = 10,
+        build_params: dict | None = None,
     ) -> None:
         self.robot = robot
         self.pairs = pairs
@@ -162,7 +279,12 @@ class PathLibrary:
         self.plan = plan
         self.n_candidates = int(n_candidates)
         self.build_stats = dict(build_stats or {})
+        self.build_params = dict(build_params or {})
+        if query_stride < 1:
+            raise ValueError(f"query_stride must be >= 1, got {query_stride}")
+        self.query_stride = int(query_stride)
         self._counts: Counter[str] = Counter()
+        self._dof12_cache: dict[tuple[int, int], np.ndarray] = {}
 
     # ------------------------------------------------------------------ building
     @classmethod
@@ -233,29 +355,78 @@ class PathLibrary:
             log.info("pair %d->%d: %d demonstrations", i, j, len(pd.starts))
         return cls(robot, data, per_step, options, plan=plan, build_stats=dict(stats))
 
+    @classmethod
+    def build_default(
+        cls,
+        robot: WearerArm,
+        per_pair: int = 10,
+        seed: int = 0,
+        pairs: Sequence[tuple[int, int]] = ALL_PAIRS,
+        min_difference: float = 0.3,
+        max_samples: int = 2500,
+        timeout: float = 10.0,
+        require_planning: bool = True,
+    ) -> PathLibrary:
+        """:meth:`build` with :func:`query_sampler` and :func:`dimension_rrt_planner`; the
+        parameters are recorded in ``build_params`` (saved in the file's metadata)."""
+        t0 = time.perf_counter()
+        plan = dimension_rrt_planner(robot, max_samples=max_samples, seed=seed, timeout=timeout)
+        lib = cls.build(robot, query_sampler(robot, require_planning=require_planning), plan, pairs=pairs,
+                        per_pair=per_pair, min_difference=min_difference, seed=seed)
+        lib.build_params = {
+            "builder": "PathLibrary.build_default",
+            "per_pair": int(per_pair),
+            "seed": int(seed),
+            "pairs": [list(map(int, p)) for p in pairs],
+            "min_difference": float(min_difference),
+            "sampler": f"query_sampler(NECESSITY_REGIONS, require_planning={bool(require_planning)})",
+            "planner": f"dimension_rrt_planner(max_samples={max_samples}, timeout={timeout:g})",
+            "build_seconds": round(time.perf_counter() - t0, 1),
+        }
+        return lib
+
     # ------------------------------------------------------------------ querying
     def _dof12(self, start: np.ndarray, goal: np.ndarray, i: int, j: int) -> np.ndarray:
         """Table 3 DOF1/DOF2 on the fake-time grid, shifted (linearly in fake time) to the exact endpoints."""
-        T = cross_sector_trajectory(i, j)
-        base = resample_waypoints(T, self.per_step)
+        base = self._dof12_cache.get((i, j))
+        if base is None:
+            base = self._dof12_cache[(i, j)] = resample_waypoints(cross_sector_trajectory(i, j), self.per_step)
+        T0, T1 = base[0], base[-1]
         u = np.linspace(0.0, 1.0, base.shape[0])[:, None]
-        return base + (1.0 - u) * (start[:2] - T[0]) + u * (goal[:2] - T[-1])
+        return base + (1.0 - u) * (start[:2] - T0) + u * (goal[:2] - T1)
 
-    def generate(self, start: np.ndarray, goal: np.ndarray, from_sector: int, to_sector: int, demo_index: int) -> np.ndarray:
-        """The blended DMP path (section 4.2.3) for one demonstration, unchecked; shape (P, 4)."""
+    def generate(
+        self, start: np.ndarray, goal: np.ndarray, from_sector: int, to_sector: int, demo_index: int, stride: int = 1
+    ) -> np.ndarray:
+        """The blended DMP path (section 4.2.3) for one demonstration, unchecked.
+
+        Shape (P, 4) with P = (N_FAKE_TIME_STEPS - 1) per_step + 1; with ``stride`` > 1 only every
+        ``stride``-th sample and the last one are kept.
+        """
         pd = self.pairs[(from_sector, to_sector)]
+        start, goal = np.asarray(start, dtype=float), np.asarray(goal, dtype=float)
         dof34 = generate_blended(pd.forward[demo_index], pd.reverse[demo_index], start[2:], goal[2:])
         path = np.hstack([self._dof12(start, goal, from_sector, to_sector), dof34])
+        if stride > 1:
+            keep = np.arange(0, len(path), int(stride))
+            if keep[-1] != len(path) - 1:
+                keep = np.append(keep, len(path) - 1)
+            path = path[keep]
         path[0], path[-1] = start, goal
         return path
 
-    def query(self, start: np.ndarray, goal: np.ndarray, from_sector: int, to_sector: int) -> QueryResult:
+    def query(
+        self, start: np.ndarray, goal: np.ndarray, from_sector: int, to_sector: int, step: float | None = None
+    ) -> QueryResult:
         """A motion-checked path from ``start`` to ``goal`` (section 4.2.3, validated).
 
         Tries the blended DMP paths of the ``n_candidates`` closest demonstrations (closest in the
         DOF3/DOF4 start/goal 4-vector), then the planner; counts each outcome (:meth:`stats`).
+        Every segment of the returned path passes the check of ``si.checkMotion`` at resolution
+        ``step`` (default ``robot.max_joint_step()``, the setups' resolution).
         """
         t0 = time.perf_counter()
+        step = self.robot.max_joint_step() if step is None else float(step)
         start, goal = self.robot.check_config(start), self.robot.check_config(goal)
         i, j = check_sector(from_sector), check_sector(to_sector)
         if i == j:
@@ -267,17 +438,17 @@ class PathLibrary:
             order = np.argsort(np.linalg.norm(pd.keys - _key(start, goal), axis=1), kind="stable")
             for rank, k in enumerate(order[: self.n_candidates]):
                 tried += 1
-                path = self.generate(start, goal, i, j, int(k))
-                if motion_is_valid(self.robot, path):
+                path = self.generate(start, goal, i, j, int(k), stride=self.query_stride)
+                if motion_is_valid(self.robot, path, step):
                     outcome = "dmp" if rank == 0 else "repaired"
                     return self._result(path, outcome, int(k), tried, t0)
         if self.plan is not None:
             W = self.plan(start, goal, i, j)
             if W is not None:
-                path = resample_waypoints(np.asarray(W, dtype=float), self.per_step)
+                path = np.array(W, dtype=float)
                 if np.allclose(path[0], start, atol=1e-9) and np.allclose(path[-1], goal, atol=1e-9):
                     path[0], path[-1] = start, goal
-                    if motion_is_valid(self.robot, path):
+                    if motion_is_valid(self.robot, path, step):
                         return self._result(path, "fallback", None, tried, t0)
         return self._result(None, "failed", None, tried, t0)
 
@@ -295,6 +466,40 @@ class PathLibrary:
             out[f"build_{k}"] = int(self.build_stats.get(k, 0))
         return out
 
+    def reset_stats(self) -> None:
+        """Zero the query counters (build counters are kept)."""
+        self._counts.clear()
+
+    def as_planner(
+        self, step: float | None = None, same_sector: Callable[[np.ndarray, np.ndarray, int, int], np.ndarray] | None = None
+    ) -> Callable[[np.ndarray, np.ndarray, int, int], np.ndarray]:
+        """The library as a :class:`tpee_ompl.tracker.Tracker` planner: ``(start, goal, i, j) -> (K, 4)``.
+
+        Cross-sector calls go to :meth:`query` at resolution ``step`` (pass the tracker's
+        ``options.check_step`` so its own check sees exactly the states checked here; default
+        ``min(robot.max_joint_step(), 0.01)``, 0.01 being the tracker's default).  Raises
+        RuntimeError when the outcome is "failed".  Same-sector calls (the tracker's re-aim
+        around an obstacle) have no demonstrations: they go to ``same_sector``, by default
+        :func:`tpee_ompl.tracker.make_default_planner`.
+        """
+        step = min(self.robot.max_joint_step(), 0.01) if step is None else float(step)
+        fallback = same_sector
+
+        def plan(start: np.ndarray, goal: np.ndarray, i: int, j: int) -> np.ndarray:
+            nonlocal fallback
+            if i == j:
+                if fallback is None:
+                    from .tracker import make_default_planner
+
+                    fallback = make_default_planner(self.robot)
+                return fallback(start, goal, i, j)
+            res = self.query(start, goal, i, j, step=step)
+            if res.path is None:
+                raise RuntimeError(f"path library: no collision-free path {i}->{j} (outcome 'failed')")
+            return res.path
+
+        return plan
+
     def __len__(self) -> int:
         return sum(len(pd.starts) for pd in self.pairs.values())
 
@@ -310,6 +515,8 @@ class PathLibrary:
             "options": asdict(self.options),
             "pairs": [list(p) for p in sorted(self.pairs)],
             "build_stats": self.build_stats,
+            "build_params": self.build_params,
+            "query_stride": self.query_stride,
         }
         arrays: dict[str, np.ndarray] = {"meta": np.array(json.dumps(meta))}
         n_basis = self.options.basis_count((N_FAKE_TIME_STEPS - 1) * self.per_step + 1)
@@ -364,4 +571,41 @@ class PathLibrary:
         except (KeyError, ValueError) as exc:
             raise LibraryFileError(f"path library {path} is inconsistent: {exc}") from exc
         return cls(robot, data, per_step, options, plan=plan, n_candidates=int(meta["n_candidates"]),
-                   build_stats=meta.get("build_stats"))
+                   build_stats=meta.get("build_stats"), query_stride=int(meta.get("query_stride", 10)),
+                   build_params=meta.get("build_params"))
+
+
+def benchmark_queries(
+    library: PathLibrary,
+    queries: Sequence,
+    reference: Plan | None = None,
+) -> list[dict]:
+    """One row per query (objects with start, goal, from_sector, to_sector, id), ready for a DataFrame.
+
+    Columns: ``pair``, ``id``, ``outcome``, ``query_s`` (whole :meth:`PathLibrary.query`, with
+    validation, repair and fallback), ``generation_s`` (nearest demo + its DMP path, no check),
+    ``raw_valid`` (that path passed the motion check), ``length`` (rad, joint-space), and with a
+    ``reference`` planner ``ref_length`` and ``length_ratio`` (NaN when either has no path).
+    """
+    rows = []
+    step = library.robot.max_joint_step()
+    for q in queries:
+        i, j = int(q.from_sector), int(q.to_sector)
+        start, goal = np.asarray(q.start, dtype=float), np.asarray(q.goal, dtype=float)
+        pd = library.pairs[(i, j)]
+        t0 = time.perf_counter()
+        k = int(np.argmin(np.linalg.norm(pd.keys - _key(start, goal), axis=1)))
+        raw = library.generate(start, goal, i, j, k, stride=library.query_stride)
+        gen_s = time.perf_counter() - t0
+        raw_valid = motion_is_valid(library.robot, raw, step)
+        res = library.query(start, goal, i, j)
+        length = path_length(res.path) if res.path is not None else float("nan")
+        row = {"pair": f"{i}->{j}", "id": int(getattr(q, "id", len(rows))), "outcome": res.outcome,
+               "query_s": res.seconds, "generation_s": gen_s, "raw_valid": bool(raw_valid),
+               "candidates_tried": res.candidates_tried, "length": length}
+        if reference is not None:
+            W = reference(start, goal, i, j)
+            ref = path_length(W) if W is not None else float("nan")
+            row.update(ref_length=ref, length_ratio=length / ref if ref > 0 else float("nan"))
+        rows.append(row)
+    return rows

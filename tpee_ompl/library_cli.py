@@ -1,0 +1,170 @@
+"""``tpee-ompl library build|query|stats``: the cross-sector path library on the command line.
+
+:func:`register` adds the ``library`` subcommand to the main parser; each sub-subcommand sets
+``func`` (``args -> int``).  Errors are raised as ValueError / FileNotFoundError with a one-line
+message for the main CLI to print.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import time
+from pathlib import Path
+
+import numpy as np
+
+from .path_library import ALL_PAIRS, PathLibrary, dimension_rrt_planner, path_length
+
+__all__ = ["DEFAULT_LIBRARY", "build_parser", "register", "run_build", "run_query", "run_stats"]
+
+log = logging.getLogger(__name__)
+
+DEFAULT_LIBRARY = Path("experiments/library/default.npz")
+"""Default library file (relative to the working directory; ``make library`` writes it)."""
+
+_BUILD_EXAMPLE = """example:
+  tpee-ompl library build --per-pair 20 --seed 0 --library experiments/library/default.npz
+  tpee-ompl library build --pairs 1-2 3-4 --per-pair 3 --max-samples 500 --library /tmp/small.npz
+"""
+_QUERY_EXAMPLE = """example:
+  tpee-ompl library query --query-set planning_necessary --index 0
+  tpee-ompl library query --from 1 --to 3 --start -2.2 1.1 0.3 0.2 --goal 0.4 1.3 -0.5 0.1 --json
+"""
+_STATS_EXAMPLE = """example:
+  tpee-ompl library stats --library experiments/library/default.npz
+"""
+
+
+def _pair(text: str) -> tuple[int, int]:
+    try:
+        i, j = (int(v) for v in text.replace(",", "-").split("-"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"a sector pair is written I-J (e.g. 1-3), got {text!r}") from None
+    if not (1 <= i <= 4 and 1 <= j <= 4 and i != j):
+        raise argparse.ArgumentTypeError(f"sectors must be two different numbers in 1..4, got {text!r}")
+    return i, j
+
+
+def _load(path: Path, fallback: bool = True, max_samples: int = 2500) -> PathLibrary:
+    from .robot import default_robot
+
+    if not path.exists():
+        raise FileNotFoundError(f"path library {path} not found: build it with 'make library' or 'tpee-ompl library build'")
+    robot = default_robot()
+    plan = dimension_rrt_planner(robot, max_samples=max_samples) if fallback else None
+    return PathLibrary.load(path, robot, plan=plan)
+
+
+def run_build(args: argparse.Namespace) -> int:
+    """Build a library with the default sampler and dimension-RRT and save it."""
+    from .robot import default_robot
+
+    if args.per_pair < 1:
+        raise ValueError(f"--per-pair must be >= 1, got {args.per_pair}")
+    if args.max_samples < 1:
+        raise ValueError(f"--max-samples must be >= 1, got {args.max_samples}")
+    out = Path(args.library)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    t0 = time.perf_counter()
+    lib = PathLibrary.build_default(default_robot(), per_pair=args.per_pair, seed=args.seed,
+                                    pairs=tuple(args.pairs or ALL_PAIRS), min_difference=args.min_difference,
+                                    max_samples=args.max_samples, timeout=args.timeout)
+    lib.save(out)
+    s = lib.stats()
+    print(f"wrote {out}: {len(lib)} demonstrations in {len(lib.pairs)} pairs "
+          f"({s['build_sampled']} drawn, {s['build_rejected_similar']} too similar, "
+          f"{s['build_plan_failed']} not planned) in {time.perf_counter() - t0:.0f} s, "
+          f"{out.stat().st_size / 1e6:.2f} MB")
+    return 0
+
+
+def run_query(args: argparse.Namespace) -> int:
+    """Answer one query from the library and print the outcome (and the path with --json)."""
+    if args.query_set is not None:
+        from .queries import load_queries
+
+        queries = load_queries(args.query_set)
+        if not 0 <= args.index < len(queries):
+            raise ValueError(f"--index must be in 0..{len(queries) - 1} for query set {args.query_set!r}, got {args.index}")
+        q = queries[args.index]
+        start, goal, i, j = q.start, q.goal, q.from_sector, q.to_sector
+    else:
+        missing = [n for n, v in (("--from", args.from_sector), ("--to", args.to_sector), ("--start", args.start),
+                                  ("--goal", args.goal)) if v is None]
+        if missing:
+            raise ValueError(f"give --query-set NAME --index K, or all of --from --to --start --goal (missing {' '.join(missing)})")
+        start, goal, i, j = np.array(args.start), np.array(args.goal), args.from_sector, args.to_sector
+    lib = _load(Path(args.library), fallback=not args.no_fallback)
+    res = lib.query(start, goal, i, j)
+    if args.json:
+        print(json.dumps({"from": i, "to": j, "outcome": res.outcome, "demo_index": res.demo_index,
+                          "candidates_tried": res.candidates_tried, "seconds": res.seconds,
+                          "path": None if res.path is None else np.round(res.path, 6).tolist()}))
+    else:
+        extra = "" if res.path is None else f", {len(res.path)} waypoints, length {path_length(res.path):.3f} rad"
+        print(f"{i}->{j}: {res.outcome} (demo {res.demo_index}, {res.candidates_tried} DMP candidates) "
+              f"in {res.seconds * 1e3:.1f} ms{extra}")
+    return 0 if res.path is not None else 1
+
+
+def run_stats(args: argparse.Namespace) -> int:
+    """Print what a library file holds: demonstrations per pair, build parameters and counters."""
+    path = Path(args.library)
+    lib = _load(path, fallback=False)
+    print(f"{path}: {len(lib)} demonstrations, {path.stat().st_size / 1e6:.2f} MB, model {lib.robot.model_hash}")
+    print("per pair: " + ", ".join(f"{i}->{j}: {len(pd.starts)}" for (i, j), pd in sorted(lib.pairs.items())))
+    print(f"per_step {lib.per_step}, query_stride {lib.query_stride}, n_candidates {lib.n_candidates}")
+    print("build parameters: " + json.dumps(lib.build_params))
+    s = lib.stats()
+    print("build counters: " + json.dumps({k: v for k, v in s.items() if k.startswith("build_")}))
+    return 0
+
+
+def register(subparsers: argparse._SubParsersAction, formatter_class: type = argparse.RawDescriptionHelpFormatter) -> argparse.ArgumentParser:
+    """Add ``library build|query|stats`` to the main CLI's subparsers; returns the ``library`` parser."""
+    lib = subparsers.add_parser("library", help="build, query or inspect the DMP path library",
+                                description="The cross-sector DMP path library (paper sec. 4.2).",
+                                epilog=_BUILD_EXAMPLE + _QUERY_EXAMPLE + _STATS_EXAMPLE, formatter_class=formatter_class)
+    sub = lib.add_subparsers(dest="library_command", metavar="{build,query,stats}", required=True)
+
+    def common(p: argparse.ArgumentParser) -> None:
+        p.add_argument("--library", type=Path, default=DEFAULT_LIBRARY, metavar="FILE",
+                       help=f"library file (.npz), default {DEFAULT_LIBRARY}")
+
+    b = sub.add_parser("build", help="build a library (dimension-RRT demonstrations)", epilog=_BUILD_EXAMPLE,
+                       formatter_class=formatter_class)
+    common(b)
+    b.add_argument("--per-pair", type=int, default=20, help="demonstrations per ordered sector pair (default 20)")
+    b.add_argument("--seed", type=int, default=0, help="seed of the sampler and the planner (default 0)")
+    b.add_argument("--pairs", type=_pair, nargs="+", metavar="I-J", help="sector pairs (default all 12)")
+    b.add_argument("--min-difference", type=float, default=0.3,
+                   help="new demo kept only if its DOF3/DOF4 (start, goal) differs by this many rad (default 0.3)")
+    b.add_argument("--max-samples", type=int, default=2500, help="dimension-RRT samples per demo (default 2500)")
+    b.add_argument("--timeout", type=float, default=10.0, help="dimension-RRT time limit per demo, s (default 10)")
+    b.set_defaults(func=run_build)
+
+    q = sub.add_parser("query", help="answer one query", epilog=_QUERY_EXAMPLE, formatter_class=formatter_class)
+    common(q)
+    q.add_argument("--query-set", metavar="NAME", help="take the query from a named set (e.g. planning_necessary)")
+    q.add_argument("--index", type=int, default=0, help="index in --query-set (default 0)")
+    q.add_argument("--from", dest="from_sector", type=int, choices=range(1, 5), help="start sector")
+    q.add_argument("--to", dest="to_sector", type=int, choices=range(1, 5), help="goal sector")
+    q.add_argument("--start", type=float, nargs=4, metavar="Q", help="start configuration, 4 angles in rad")
+    q.add_argument("--goal", type=float, nargs=4, metavar="Q", help="goal configuration, 4 angles in rad")
+    q.add_argument("--no-fallback", action="store_true", help="do not fall back to dimension-RRT")
+    q.add_argument("--json", action="store_true", help="print the result (with the path) as JSON")
+    q.set_defaults(func=run_query)
+
+    s = sub.add_parser("stats", help="describe a library file", epilog=_STATS_EXAMPLE, formatter_class=formatter_class)
+    common(s)
+    s.set_defaults(func=run_stats)
+    return lib
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """A stand-alone parser with only the ``library`` subcommand (for scripts and tests)."""
+    parser = argparse.ArgumentParser(prog="tpee-ompl", formatter_class=argparse.RawDescriptionHelpFormatter)
+    register(parser.add_subparsers(dest="command", required=True), argparse.RawDescriptionHelpFormatter)
+    return parser
