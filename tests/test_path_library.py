@@ -195,3 +195,136 @@ def test_library_from_another_model_or_version_is_refused(robot: WearerArm, libr
     monkeypatch.setattr(pl, "FORMAT_VERSION", pl.FORMAT_VERSION + 1)
     with pytest.raises(LibraryFileError, match="format version"):
         PathLibrary.load(f, robot)
+
+
+# ---------------------------------------------------------------------------------------------
+# With the real builders: the query generator's sampling and dimension-RRT (small caps)
+# ---------------------------------------------------------------------------------------------
+RRT_PAIRS = ((1, 2), (3, 4))
+
+
+@pytest.fixture(scope="module")
+def rrt_library(robot: WearerArm) -> PathLibrary:
+    return PathLibrary.build_default(robot, per_pair=2, seed=3, pairs=RRT_PAIRS, max_samples=300, timeout=5.0)
+
+
+def _necessary_queries(pairs, n: int):
+    from tpee_ompl.queries import load_queries
+
+    return [q for q in load_queries("planning_necessary") if (q.from_sector, q.to_sector) in pairs][:n]
+
+
+def test_motion_check_states_are_the_ompl_motion_states_of_every_segment(robot: WearerArm, rng) -> None:
+    from tpee_ompl.ompl_problem import motion_states
+    from tpee_ompl.path_library import motion_check_states
+
+    path = np.cumsum(rng.uniform(-0.05, 0.05, (30, 4)), axis=0)
+    path[10] = path[9]  # a zero-length segment still checks its end state once
+    step = robot.max_joint_step()
+    expected = np.vstack([path[:1]] + [motion_states(a, b, step) for a, b in zip(path[:-1], path[1:])])
+    np.testing.assert_allclose(motion_check_states(path, step), expected, atol=1e-15)
+
+
+def test_default_sampler_draws_planning_necessary_motions_from_the_presets(robot: WearerArm) -> None:
+    from tpee_ompl.path_library import query_sampler
+    from tpee_ompl.queries import straight_motion_valid
+
+    sample = query_sampler(robot)
+    rng = np.random.default_rng(5)
+    for i, j in RRT_PAIRS:
+        start, goal = sample(rng, i, j)
+        np.testing.assert_allclose(start[:2], posture_preset(i))
+        np.testing.assert_allclose(goal[:2], posture_preset(j))
+        assert robot.is_valid(start) and robot.is_valid(goal)
+        assert not straight_motion_valid(robot, start, goal, i, j)
+
+
+def test_dimension_rrt_builder_stores_planned_demos_that_pass_the_motion_check(robot: WearerArm, rrt_library: PathLibrary) -> None:
+    assert set(rrt_library.pairs) == set(RRT_PAIRS) and len(rrt_library) == 2 * len(RRT_PAIRS)
+    for (i, j), pd in rrt_library.pairs.items():
+        for start, goal, W in zip(pd.starts, pd.goals, pd.waypoints):
+            np.testing.assert_allclose(W[:, :2], cross_sector_trajectory(i, j), atol=1e-12)
+            assert np.array_equal(W[0], start) and np.array_equal(W[-1], goal)
+            assert motion_is_valid(robot, W)
+    assert rrt_library.build_params["per_pair"] == 2 and rrt_library.build_params["seed"] == 3
+
+
+def test_every_returned_path_passes_si_check_motion_segment_by_segment(robot: WearerArm, rrt_library: PathLibrary) -> None:
+    from tpee_ompl.ompl_problem import set_state
+    from tpee_ompl.path_library import dimension_rrt_planner
+
+    rrt_library.plan = dimension_rrt_planner(robot, max_samples=300, timeout=5.0)
+    for q in _necessary_queries(RRT_PAIRS, 40)[::5]:
+        res = rrt_library.query(q.start, q.goal, q.from_sector, q.to_sector)
+        assert res.outcome != "failed"
+        assert np.array_equal(res.path[0], q.start) and np.array_equal(res.path[-1], q.goal)
+        ss = make_simple_setup(robot, q.start, q.goal)
+        si = ss.getSpaceInformation()
+        a, b = si.allocState(), si.allocState()
+        for u, v in zip(res.path[:-1], res.path[1:]):
+            set_state(a, u)
+            set_state(b, v)
+            assert si.checkMotion(a, b)
+
+
+def test_seeded_default_build_is_deterministic(robot: WearerArm, rrt_library: PathLibrary) -> None:
+    again = PathLibrary.build_default(robot, per_pair=2, seed=3, pairs=RRT_PAIRS[:1], max_samples=300, timeout=5.0)
+    a, b = rrt_library.pairs[RRT_PAIRS[0]], again.pairs[RRT_PAIRS[0]]
+    assert np.array_equal(a.starts, b.starts) and np.array_equal(a.goals, b.goals)
+    assert np.array_equal(a.waypoints, b.waypoints)
+
+
+def test_build_parameters_survive_the_round_trip(robot: WearerArm, rrt_library: PathLibrary, tmp_path) -> None:
+    loaded = PathLibrary.load(rrt_library.save(tmp_path / "lib.npz"), robot)
+    assert loaded.build_params == rrt_library.build_params and loaded.query_stride == rrt_library.query_stride
+    q = _necessary_queries(RRT_PAIRS, 1)[0]
+    for k in range(2):
+        assert np.array_equal(loaded.generate(q.start, q.goal, q.from_sector, q.to_sector, k, stride=10),
+                              rrt_library.generate(q.start, q.goal, q.from_sector, q.to_sector, k, stride=10))
+
+
+def test_strided_query_path_is_a_subsequence_of_the_dense_rollout(rrt_library: PathLibrary) -> None:
+    q = _necessary_queries(RRT_PAIRS, 1)[0]
+    dense = rrt_library.generate(q.start, q.goal, q.from_sector, q.to_sector, 0)
+    coarse = rrt_library.generate(q.start, q.goal, q.from_sector, q.to_sector, 0, stride=7)
+    assert np.array_equal(coarse[:-1], dense[:-1:7]) and np.array_equal(coarse[-1], dense[-1])
+
+
+def test_planner_adapter_raises_when_nothing_valid_is_found(rrt_library: PathLibrary, monkeypatch) -> None:
+    import tpee_ompl.path_library as pl
+
+    monkeypatch.setattr(pl, "motion_is_valid", lambda *a, **k: False)
+    monkeypatch.setattr(rrt_library, "plan", None)
+    q = _necessary_queries(RRT_PAIRS, 1)[0]
+    with pytest.raises(RuntimeError, match="failed"):
+        rrt_library.as_planner()(q.start, q.goal, q.from_sector, q.to_sector)
+
+
+def test_library_plugs_into_the_tracker_as_its_cross_sector_planner(robot: WearerArm, rrt_library: PathLibrary) -> None:
+    from tpee_ompl.ompl_problem import motion_states
+    from tpee_ompl.sectors import sector_origin
+    from tpee_ompl.tracker import Tracker
+
+    q = _necessary_queries(((3, 4),), 1)[0]
+    tracker = Tracker(robot, rrt_library.as_planner(step=0.01), initial=q.start, initial_sector=3)
+    before = rrt_library.stats()["queries"]
+    # a target straight out to the front-right: outside pointing sector 3, aimed from posture 4
+    a = np.deg2rad(-80.0)
+    result = tracker.run([(0.0, sector_origin() + np.r_[5.0 * np.cos(a), 5.0 * np.sin(a), 0.0])])
+    assert [e.kind for e in result.events] == ["cross-sector"] and tracker.sector == 4
+    assert rrt_library.stats()["queries"] == before + 1
+    Q = np.vstack([q.start, result.configurations])
+    for u, v in zip(Q[:-1], Q[1:]):
+        assert robot.are_valid(motion_states(u, v, 0.01)).all()
+
+
+def test_benchmark_rows_report_outcome_time_and_length(robot: WearerArm, rrt_library: PathLibrary) -> None:
+    from tpee_ompl.path_library import benchmark_queries, path_length
+
+    qs = _necessary_queries(RRT_PAIRS, 3)
+    rows = benchmark_queries(rrt_library, qs, reference=lambda s, g, i, j: np.array([s, g]))
+    assert [r["id"] for r in rows] == [q.id for q in qs]
+    for r, q in zip(rows, qs):
+        assert r["outcome"] in ("dmp", "repaired", "fallback") and r["query_s"] > 0 and r["generation_s"] > 0
+        assert r["ref_length"] == pytest.approx(path_length(np.array([q.start, q.goal])))
+        assert r["length"] >= r["ref_length"] - 1e-12  # nothing is shorter than the straight line

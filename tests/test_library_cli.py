@@ -1,0 +1,76 @@
+"""``tpee-ompl library build|query|stats`` (parser from :func:`tpee_ompl.library_cli.build_parser`)."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from tpee_ompl.library_cli import DEFAULT_LIBRARY, build_parser
+from tpee_ompl.path_library import PathLibrary
+
+
+def _run(argv: list[str]) -> int:
+    args = build_parser().parse_args(argv)
+    return args.func(args)
+
+
+@pytest.fixture(scope="module")
+def small_file(tmp_path_factory) -> str:
+    path = tmp_path_factory.mktemp("lib") / "small.npz"
+    assert _run(["library", "build", "--pairs", "1-2", "--per-pair", "1", "--max-samples", "200",
+                 "--seed", "2", "--library", str(path)]) == 0
+    return str(path)
+
+
+def test_build_writes_a_loadable_library_with_its_parameters(robot, small_file: str) -> None:
+    lib = PathLibrary.load(small_file, robot)
+    assert list(lib.pairs) == [(1, 2)] and len(lib) == 1
+    assert lib.build_params["per_pair"] == 1 and lib.build_params["seed"] == 2
+    assert "max_samples=200" in lib.build_params["planner"]
+
+
+def test_stats_describes_the_file(small_file: str, capsys) -> None:
+    assert _run(["library", "stats", "--library", small_file]) == 0
+    out = capsys.readouterr().out
+    assert "1 demonstrations" in out and "1->2: 1" in out and '"per_pair": 1' in out
+
+
+def test_query_from_a_named_set_prints_a_checked_path_as_json(robot, small_file: str, capsys) -> None:
+    from tpee_ompl.path_library import motion_is_valid
+    from tpee_ompl.queries import load_queries
+
+    q = load_queries("planning_necessary")[0]
+    assert (q.from_sector, q.to_sector) == (1, 2)
+    code = _run(["library", "query", "--library", small_file, "--query-set", "planning_necessary", "--index", "0", "--json"])
+    res = json.loads(capsys.readouterr().out)
+    assert code == 0 and res["outcome"] in ("dmp", "repaired", "fallback")
+    path = np.array(res["path"])
+    np.testing.assert_allclose(path[0], q.start, atol=1e-6)
+    np.testing.assert_allclose(path[-1], q.goal, atol=1e-6)
+    assert motion_is_valid(robot, path)
+
+
+def test_missing_library_file_names_the_fix(tmp_path) -> None:
+    with pytest.raises(FileNotFoundError, match="make library"):
+        _run(["library", "stats", "--library", str(tmp_path / "none.npz")])
+
+
+def test_query_without_a_query_names_the_missing_options(small_file: str) -> None:
+    with pytest.raises(ValueError, match="missing --start --goal"):
+        _run(["library", "query", "--library", small_file, "--from", "1", "--to", "2"])
+
+
+def test_bad_sector_pair_is_a_usage_error(capsys) -> None:
+    with pytest.raises(SystemExit):
+        build_parser().parse_args(["library", "build", "--pairs", "2-2"])
+    assert "two different numbers" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("sub", ["build", "query", "stats"])
+def test_every_subcommand_help_shows_an_example_and_the_default_file(sub: str, capsys) -> None:
+    with pytest.raises(SystemExit):
+        build_parser().parse_args(["library", sub, "--help"])
+    out = capsys.readouterr().out
+    assert "example:" in out and f"tpee-ompl library {sub}" in out and str(DEFAULT_LIBRARY) in out
