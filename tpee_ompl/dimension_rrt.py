@@ -85,10 +85,12 @@ class _Checker:
         self.step: float | None = None
         self.euclid = True
         if batch and callable(are_valid):
+            factor = max(1, int(si.getStateSpace().getValidSegmentCountFactor()))
             if isinstance(getattr(mv, "step", None), float) and callable(getattr(mv, "check_motions", None)):
-                self.step = float(mv.step)  # BatchedMotionValidator: Euclidean, ceil(|b-a| / step) segments
+                # BatchedMotionValidator: Euclidean, ceil(|b-a| / step) segments (step / factor)
+                self.step = float(mv.effective_step()) if callable(getattr(mv, "effective_step", None)) else mv.step
             elif type(mv) is ob.MotionValidator:  # the C++ default, DiscreteMotionValidator
-                self.step = float(si.getStateSpace().getLongestValidSegmentLength())
+                self.step = float(si.getStateSpace().getLongestValidSegmentLength()) / factor
                 self.euclid = layout.is_plain
         self.batched = self.step is not None
         self._are_valid = are_valid if self.batched else None
@@ -488,26 +490,41 @@ class DimensionRRT(ob.Planner):
         *,
         batch: bool = True,
     ) -> None:
-        super().__init__(si, name)
-        self.grouped = GroupedSpace(si, groups, h, prescribed)
+        # Validate everything BEFORE super().__init__: an exception raised after it leaves a
+        # half-constructed nanobind trampoline whose collection crashed the interpreter.
+        if not isinstance(name, str) or not name:
+            raise ValueError(f"name must be a non-empty string, got {name!r}")
+        if not isinstance(si, ob.SpaceInformation):
+            raise ValueError(f"si must be an ompl.base.SpaceInformation, got {type(si).__name__}")
+        grouped = GroupedSpace(si, groups, h, prescribed)
         if max_samples is not None and (
             isinstance(max_samples, bool) or not isinstance(max_samples, (int, np.integer)) or max_samples < 1
         ):
             raise ValueError(f"max_samples must be None or an integer >= 1 (zero samples cannot plan), got {max_samples!r}")
         if isinstance(narrow_after, bool) or not isinstance(narrow_after, (int, np.integer)) or narrow_after < 0:
             raise ValueError(f"narrow_after must be an integer >= 0, got {narrow_after!r}")
-        if not (isinstance(narrowing, (int, float)) and 0.0 < float(narrowing) <= 1.0):
+        if (
+            isinstance(narrowing, bool)
+            or not isinstance(narrowing, (int, float, np.integer, np.floating))
+            or not 0.0 < float(narrowing) <= 1.0
+        ):
             raise ValueError(f"narrowing must be a number in (0, 1], got {narrowing!r}")
         if seed is not None and (isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0):
             raise ValueError(f"seed must be None or an integer >= 0, got {seed!r}")
-        layout = self.grouped.layout
+        layout = grouped.layout
         span = layout.upper - layout.lower
         if range_ is None:
             rng_full = 0.02 * span
         else:
-            rng_full = np.broadcast_to(np.asarray(range_, dtype=float), (layout.n,)).copy() if np.ndim(range_) <= 1 else None
+            try:
+                arr = np.asarray(range_, dtype=float)
+                rng_full = np.broadcast_to(arr, (layout.n,)).copy() if arr.ndim <= 1 else None
+            except (TypeError, ValueError):
+                rng_full = None
             if rng_full is None or not np.all(np.isfinite(rng_full)) or np.any(rng_full <= 0):
                 raise ValueError(f"range_ must be a positive number or array of {layout.n}, got {range_!r}")
+        super().__init__(si, name)
+        self.grouped = grouped
         self.h = self.grouped.h
         self.groups = self.grouped.groups
         self.prescribed = self.grouped.prescribed

@@ -35,7 +35,11 @@ __all__ = [
     "validate_groups",
     "validate_prescribed",
     "interpolate_waypoints",
+    "MAX_H",
 ]
+
+MAX_H = 10_000
+"""Largest number of fake-time steps accepted (the paper uses 7); bounds memory per path."""
 
 
 def default_groups(n: int) -> list[list[int]]:
@@ -91,13 +95,17 @@ def validate_prescribed(
         if isinstance(key, bool) or not isinstance(key, (int, np.integer)) or not 0 <= int(key) < len(groups):
             raise ValueError(f"prescribed key {key!r} is not a group index (0..{len(groups) - 1})")
         k = len(groups[int(key)])
-        arr = np.array(value, dtype=float)
+        try:
+            arr = np.array(value, dtype=float)
+        except (TypeError, ValueError) as exc:
+            raise ValueError(f"prescribed trajectory of group {int(key)} is not an array of numbers: {exc}") from exc
         if arr.ndim == 1 and k == 1:
             arr = arr[:, None]
         if arr.shape != (h, k):
             raise ValueError(f"prescribed trajectory of group {int(key)} must have shape ({h}, {k}), got {arr.shape}")
         if not np.all(np.isfinite(arr)):
-            raise ValueError(f"prescribed trajectory of group {int(key)} contains NaN or inf")
+            bad = arr[~np.isfinite(arr)][0]
+            raise ValueError(f"prescribed trajectory of group {int(key)} contains {bad} (NaN or inf)")
         arr.setflags(write=False)
         out[int(key)] = arr
     return out
@@ -233,8 +241,8 @@ class GroupedSpace:
             space = space.getStateSpace()
         self.layout = RealVectorLayout(space)
         n = self.layout.n
-        if isinstance(h, bool) or not isinstance(h, (int, np.integer)) or h < 3:
-            raise ValueError(f"h (fake-time steps incl. start and goal) must be an integer >= 3, got {h!r}")
+        if isinstance(h, bool) or not isinstance(h, (int, np.integer)) or not 3 <= h <= MAX_H:
+            raise ValueError(f"h (fake-time steps incl. start and goal) must be an integer in [3, {MAX_H}], got {h!r}")
         self.h = int(h)
         self.groups = validate_groups(default_groups(n) if groups is None else groups, n)
         self.prescribed = validate_prescribed(prescribed, self.groups, self.h)

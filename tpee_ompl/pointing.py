@@ -43,7 +43,7 @@ import coal
 import numpy as np
 import pinocchio as pin
 
-from .robot import MUZZLE_FRAME, WearerArm, default_robot
+from .robot import MAX_TARGET_DISTANCE, MUZZLE_FRAME, WearerArm, _as_float_array, default_robot
 from .sectors import posture_preset
 
 __all__ = [
@@ -202,7 +202,7 @@ def _as_dof12(posture: int | np.ndarray, n: int) -> np.ndarray:
         return np.broadcast_to(posture_preset(int(posture)), (n, 2))
     if isinstance(posture, bool):
         raise ValueError(f"unknown sector {posture!r}: sectors are 1, 2, 3, 4")  # noqa: TRY004 (bad input value)
-    d = np.asarray(posture, dtype=float)
+    d = _as_float_array(posture, "posture")
     if d.shape == (2,):
         d = np.broadcast_to(d, (n, 2))
     if d.shape != (n, 2) or not np.all(np.isfinite(d)):
@@ -211,7 +211,7 @@ def _as_dof12(posture: int | np.ndarray, n: int) -> np.ndarray:
 
 
 def _as_targets(targets: np.ndarray) -> np.ndarray:
-    t = np.asarray(targets, dtype=float)
+    t = _as_float_array(targets, "targets")
     if t.ndim == 1:
         t = t[None, :]
     if t.ndim != 2 or t.shape[1] != 3:
@@ -258,28 +258,45 @@ def aim_batch(
     t = _as_targets(targets)
     n = len(t)
     dof12 = _as_dof12(posture, n)
-    ref = np.broadcast_to(np.asarray(pan_reference, dtype=float), (n,))
+    try:
+        ref = np.broadcast_to(_as_float_array(pan_reference, "pan_reference"), (n,))
+    except ValueError as exc:
+        raise ValueError(f"pan_reference must be a number or an array of {n}, got {pan_reference!r}") from exc
     out = np.full((n, 4), np.nan)
     out[:, :2] = dof12
     finite = np.all(np.isfinite(t), axis=1) & np.isfinite(ref)
     if strict and not finite.all():
         k = int(np.flatnonzero(~finite)[0])
-        raise UnreachableTargetError(f"target {k} {t[k]} or its pan reference is not finite")
-    if strict and np.any((dof12 < g.dof12_lower) | (dof12 > g.dof12_upper)):
-        raise ValueError("DOF1/DOF2 outside the joint limits")
+        raise UnreachableTargetError(f"target {k} {t[k]} or its pan reference {ref[k]} is not finite")
+    far = finite & (np.max(np.abs(np.where(np.isfinite(t), t, 0.0)), axis=1) > MAX_TARGET_DISTANCE)
+    if strict and far.any():
+        k = int(np.flatnonzero(far)[0])
+        raise UnreachableTargetError(f"target {k} {t[k]} is farther than MAX_TARGET_DISTANCE = {MAX_TARGET_DISTANCE:g} m")
+    finite &= ~far
+    outside = np.any((dof12 < g.dof12_lower) | (dof12 > g.dof12_upper), axis=1)
+    if strict and outside.any():
+        k = int(np.flatnonzero(outside)[0])
+        raise ValueError(
+            f"posture DOF1/DOF2 {dof12[k]} (row {k}) is outside the joint limits "
+            f"[{g.dof12_lower}, {g.dof12_upper}]"
+        )
+    finite &= ~outside
+    # the pan closest to any reference beyond a limit is the one closest to that limit
+    ref = np.clip(np.where(np.isfinite(ref), ref, 0.0), *g.pan_limits)
     s = np.zeros_like(t)
     s[finite] = pointing_frame(t[finite], dof12[finite], g)
     sx, sy, sz = s.T
-    r2 = sx * sx + sy * sy
-    blind = finite & (r2 <= (g.offset + BLIND_TOLERANCE) ** 2)
+    r = np.hypot(sx, sy)  # distance from the pan axis
+    blind = finite & (r <= g.offset + BLIND_TOLERANCE)
     if strict and blind.any():
         k = int(np.flatnonzero(blind)[0])
         raise BlindAreaError(
-            f"target {k} {t[k]} is {np.sqrt(r2[k]):.4f} m from the pan axis, inside the blind cylinder "
+            f"target {k} {t[k]} is {r[k]:.4f} m from the pan axis, inside the blind cylinder "
             f"of radius L3 = {g.offset:.4f} m (Fig. 2a): change posture"
         )
     ok = finite & ~blind
-    l_ab = np.sqrt(np.where(ok, r2 - g.offset**2, 1.0))  # eq. 11 (corrected)
+    # eq. 11 (corrected): l_AB = sqrt(r^2 - l_OB^2), factored so it cannot overflow
+    l_ab = np.where(ok, np.sqrt(np.abs(r - g.offset)) * np.sqrt(r + g.offset), 1.0)
     reach = np.hypot(l_ab, sz)  # distance from the tilt axis to the target along the barrel line
     behind = ok & (reach <= g.barrel)
     if strict and behind.any():
@@ -321,7 +338,7 @@ def aim(
     pan_reference: float = 0.0,
 ) -> np.ndarray:
     """Configuration (4,), radians, that aims the barrel at one world target (3,), metres; see :func:`aim_batch`."""
-    t = np.asarray(target, dtype=float)
+    t = _as_float_array(target, "target")
     if t.shape != (3,):
         raise ValueError(f"target must have shape (3,); got {t.shape}")
     return aim_batch(t[None], posture, geometry=geometry, pan_reference=pan_reference)[0]
@@ -347,16 +364,21 @@ def aim_errors(robot: WearerArm, q: np.ndarray, target: np.ndarray) -> tuple[flo
 
 
 def check_target(target: np.ndarray, robot: WearerArm | None = None) -> np.ndarray:
-    """Return target as a finite (3,) array, or raise UnreachableTargetError.
+    """Return target as a finite (3,) array within MAX_TARGET_DISTANCE, or raise UnreachableTargetError.
 
     With a robot, also refuse targets inside (or touching) the wearer or the arm's base link, where no
     line of sight can reach them.
     """
-    t = np.asarray(target, dtype=float)
+    try:
+        t = _as_float_array(target, "target")
+    except ValueError as exc:
+        raise UnreachableTargetError(str(exc)) from exc
     if t.shape != (3,):
         raise UnreachableTargetError(f"target must have shape (3,); got {t.shape}")
     if not np.all(np.isfinite(t)):
         raise UnreachableTargetError(f"target {t} is not finite")
+    if np.max(np.abs(t)) > MAX_TARGET_DISTANCE:
+        raise UnreachableTargetError(f"target {t} is farther than MAX_TARGET_DISTANCE = {MAX_TARGET_DISTANCE:g} m")
     if robot is not None:
         point = coal.Sphere(1e-6)
         tf = coal.Transform3s(np.eye(3), t)

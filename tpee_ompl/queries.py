@@ -41,6 +41,7 @@ __all__ = [
     "NECESSITY_REGIONS",
     "QUERY_DIR",
     "Query",
+    "QuerySetError",
     "BarrelRegion",
     "TargetRegion",
     "generate_queries",
@@ -88,7 +89,10 @@ class Query:
         if self.from_sector == self.to_sector:
             raise ValueError(f"query {self.id}: from_sector == to_sector == {self.from_sector}")
         for name, n in (("target_a", 3), ("target_b", 3), ("start", 4), ("goal", 4)):
-            a = np.array(getattr(self, name), dtype=float)
+            try:
+                a = np.array(getattr(self, name), dtype=float)
+            except (TypeError, ValueError) as exc:
+                raise ValueError(f"query {self.id}: {name} must be {n} finite numbers, got {getattr(self, name)!r}") from exc
             if a.shape != (n,) or not np.all(np.isfinite(a)):
                 raise ValueError(f"query {self.id}: {name} must be {n} finite numbers, got {a!r}")
             a.setflags(write=False)
@@ -356,21 +360,58 @@ def save_queries(
     return path
 
 
-def load_query_set(name_or_path: str | os.PathLike) -> tuple[list[Query], dict]:
+class QuerySetError(ValueError):
+    """A query set file that cannot be used: not JSON, wrong format_version, bad entries, other model."""
+
+
+def load_query_set(name_or_path: str | os.PathLike, robot: WearerArm | None = None) -> tuple[list[Query], dict]:
     """Queries and the file's header (everything but ``queries``); see :func:`load_queries`."""
+    if isinstance(name_or_path, bool) or not isinstance(name_or_path, (str, os.PathLike)):
+        raise ValueError(f"query set must be a name or a path, got {name_or_path!r}")
     p = Path(name_or_path)
     if not p.suffix and not p.exists():
         p = QUERY_DIR / f"{name_or_path}.json"
     if not p.is_file():
-        raise FileNotFoundError(f"query set {name_or_path!r} not found (looked at {p})")
-    doc = json.loads(p.read_text())
-    if doc.get("format_version") != FORMAT_VERSION:
-        raise ValueError(f"{p}: unsupported format_version {doc.get('format_version')!r} (expected {FORMAT_VERSION})")
-    queries = [Query.from_dict(d) for d in doc["queries"]]
+        raise FileNotFoundError(f"query set {str(name_or_path)!r} not found (looked at {p})")
+    try:
+        doc = json.loads(p.read_text(encoding="utf-8"))
+    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise QuerySetError(f"{p}: not a JSON query set (truncated or corrupt?): {exc}") from exc
+    if not isinstance(doc, dict):
+        raise QuerySetError(f"{p}: expected a JSON object at the top level, got {type(doc).__name__}")
+    version = doc.get("format_version")
+    if isinstance(version, bool) or version != FORMAT_VERSION:
+        raise QuerySetError(f"{p}: unsupported format_version {version!r} (expected {FORMAT_VERSION})")
+    entries = doc.get("queries")
+    if not isinstance(entries, list):
+        raise QuerySetError(f"{p}: 'queries' must be a list, got {type(entries).__name__}")
+    queries = []
+    for k, d in enumerate(entries):
+        try:
+            if not isinstance(d, dict):
+                raise ValueError(f"expected an object, got {type(d).__name__}")
+            queries.append(Query.from_dict(d))
+        except (KeyError, TypeError, ValueError) as exc:
+            raise QuerySetError(f"{p}: query {k} is malformed: {exc!r}") from exc
     header = {k: v for k, v in doc.items() if k != "queries"}
+    if robot is not None and header.get("model_hash") != robot.model_hash:
+        raise QuerySetError(
+            f"{p}: made for model_hash {header.get('model_hash')!r}, but the robot's is {robot.model_hash!r} "
+            "(regenerate the set for this model)"
+        )
     return queries, header
 
 
-def load_queries(name_or_path: str | os.PathLike) -> list[Query]:
-    """Load a query set by name (``"planning_necessary"``, ``"paper_random"``) or JSON path."""
-    return load_query_set(name_or_path)[0]
+def load_queries(name_or_path: str | os.PathLike, robot: WearerArm | None = None) -> list[Query]:
+    """Load a query set by name (``"planning_necessary"``, ``"paper_random"``) or JSON path.
+
+    With ``robot``, refuse a set made for another model (its ``model_hash`` differs).
+
+    Raises
+    ------
+    FileNotFoundError
+        No such set or file.
+    QuerySetError (a ValueError)
+        Not JSON (e.g. truncated), wrong ``format_version``, malformed queries, or another model.
+    """
+    return load_query_set(name_or_path, robot)[0]

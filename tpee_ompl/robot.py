@@ -22,6 +22,8 @@ import pinocchio as pin
 __all__ = [
     "ARM_JOINTS",
     "DEFAULT_SECURITY_MARGIN",
+    "MAX_SECURITY_MARGIN",
+    "MAX_TARGET_DISTANCE",
     "DEFAULT_SRDF",
     "DEFAULT_URDF",
     "WearerArm",
@@ -38,6 +40,11 @@ BOOM_LINKS = ("link1", "link2")
 MUZZLE_FRAME = "muzzle"
 DEFAULT_SECURITY_MARGIN = 0.02
 """Metres. A configuration is valid only if every checked pair is at least this far apart."""
+MAX_SECURITY_MARGIN = 1.0
+"""Metres. Largest accepted security margin (with more, every configuration touches the wearer)."""
+MAX_TARGET_DISTANCE = 1.0e6
+"""Metres. Targets with a coordinate beyond +-this are refused (no physical target is that far; beyond
+it the line-of-sight and aiming arithmetic would lose its precision or overflow)."""
 
 
 def find_model_file(name: str) -> Path:
@@ -53,15 +60,58 @@ DEFAULT_URDF = "wearer_arm.urdf"
 DEFAULT_SRDF = "wearer_arm.srdf"
 
 
+def _as_float_array(x: object, what: str) -> np.ndarray:
+    """``np.asarray(x, dtype=float)``, raising ValueError (naming ``what``) for non-numeric input."""
+    try:
+        return np.asarray(x, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{what} must be numbers, got {x!r} ({exc})") from exc
+
+
 def _as_config_batch(Q: np.ndarray, nq: int) -> np.ndarray:
-    Q = np.asarray(Q, dtype=float)
+    Q = _as_float_array(Q, "configurations")
     if Q.ndim == 1:
         Q = Q[None, :]
     if Q.ndim != 2 or Q.shape[1] != nq:
         raise ValueError(f"configurations must have shape (N, {nq}); got {Q.shape}")
-    if not np.all(np.isfinite(Q)):
-        raise ValueError("configurations contain NaN or inf")
+    bad = ~np.all(np.isfinite(Q), axis=1)
+    if bad.any():
+        k = int(np.flatnonzero(bad)[0])
+        raise ValueError(f"configurations contain NaN or inf: row {k} is {Q[k]}")
     return Q
+
+
+def _check_finite_target(target: object) -> np.ndarray:
+    """Return target as a (3,) float array within MAX_TARGET_DISTANCE, or raise ValueError naming it."""
+    t = _as_float_array(target, "target")
+    if t.shape != (3,) or not np.all(np.isfinite(t)):
+        raise ValueError(f"target must be 3 finite numbers, got {target!r}")
+    if np.max(np.abs(t)) > MAX_TARGET_DISTANCE:
+        raise ValueError(f"target {t} is farther than MAX_TARGET_DISTANCE = {MAX_TARGET_DISTANCE:g} m")
+    return t
+
+
+def _read_text(path: Path, kind: str) -> str:
+    try:
+        return path.read_text(encoding="utf-8")
+    except UnicodeDecodeError as exc:
+        raise ValueError(f"malformed {kind} {path}: not UTF-8 text ({exc})") from exc
+
+
+def _check_shape_sizes(geom: coal.CollisionGeometry, name: str, urdf: Path) -> None:
+    """Refuse zero, negative or non-finite primitive sizes (Coal would silently give wrong answers)."""
+    sizes: list[float] = []
+    if isinstance(geom, coal.Capsule) or isinstance(geom, coal.Cylinder):
+        sizes = [geom.radius]
+        if not (np.isfinite(geom.halfLength) and geom.halfLength >= 0):
+            raise ValueError(f"URDF {urdf}: geometry {name!r} has length {2 * geom.halfLength}")
+    elif isinstance(geom, coal.Sphere):
+        sizes = [geom.radius]
+    elif isinstance(geom, coal.Box):
+        sizes = list(2 * np.asarray(geom.halfSide))
+    for v in sizes:
+        if not (np.isfinite(v) and v > 0):
+            raise ValueError(f"URDF {urdf}: geometry {name!r} has a size of {v} (must be finite and > 0)")
 
 
 def _bounding_radius(geom: coal.CollisionGeometry) -> float:
@@ -103,8 +153,23 @@ class WearerArm:
         security_margin: float = DEFAULT_SECURITY_MARGIN,
         n_threads: int | None = None,
     ) -> None:
-        if not np.isfinite(security_margin) or security_margin < 0:
-            raise ValueError(f"security_margin must be a finite number >= 0, got {security_margin!r}")
+        if (
+            isinstance(security_margin, bool)
+            or not isinstance(security_margin, (int, float, np.integer, np.floating))
+            or not 0 <= float(security_margin) <= MAX_SECURITY_MARGIN
+        ):
+            raise ValueError(
+                f"security_margin must be a number in [0, {MAX_SECURITY_MARGIN}] metres, got {security_margin!r}"
+            )
+        if n_threads is not None and (
+            isinstance(n_threads, bool) or not isinstance(n_threads, (int, np.integer)) or not 1 <= n_threads <= 1024
+        ):
+            raise ValueError(f"n_threads must be None or an integer in [1, 1024], got {n_threads!r}")
+        for what, value in (("urdf_path", urdf_path), ("srdf_path", srdf_path)):
+            if value is not None and value is not False and not isinstance(value, (str, os.PathLike)):
+                raise ValueError(f"{what} must be a path, None or (srdf_path only) False, got {value!r}")
+        if urdf_path is False:
+            raise ValueError("urdf_path must be a path or None, got False")
         urdf = Path(urdf_path) if urdf_path is not None else find_model_file(DEFAULT_URDF)
         if srdf_path is None:
             srdf = find_model_file(DEFAULT_SRDF) if urdf_path is None else None
@@ -114,9 +179,7 @@ class WearerArm:
             srdf = Path(srdf_path)
         self.files = _LoadedFiles(urdf, srdf)
         self.security_margin = float(security_margin)
-        self.n_threads = int(n_threads or min(2, os.cpu_count() or 1))
-        if self.n_threads < 1:
-            raise ValueError("n_threads must be >= 1")
+        self.n_threads = int(n_threads) if n_threads is not None else min(2, os.cpu_count() or 1)
         self.collision_checks = 0
         """Configurations checked for collision so far (single and batched)."""
         self._load()
@@ -126,7 +189,7 @@ class WearerArm:
         urdf, srdf = self.files.urdf, self.files.srdf
         if not urdf.is_file():
             raise FileNotFoundError(f"URDF file not found: {urdf}")
-        text = urdf.read_text()
+        text = _read_text(urdf, "URDF")
         try:
             root = ET.fromstring(text)
         except ET.ParseError as exc:
@@ -160,7 +223,12 @@ class WearerArm:
                 f"URDF {urdf}: {self._n_collision_elements} <collision> elements but only "
                 f"{self.gmodel.ngeoms} geometries were loaded (unsupported shape?)"
             )
+        lo, hi = self.model.lowerPositionLimit, self.model.upperPositionLimit
+        for k, name in enumerate(ARM_JOINTS):
+            if not (np.isfinite(lo[k]) and np.isfinite(hi[k]) and lo[k] < hi[k]):
+                raise ValueError(f"URDF {urdf}: joint {name!r} has limits [{lo[k]}, {hi[k]}] (need finite lower < upper)")
         for go in self.gmodel.geometryObjects:  # every URDF cylinder is a capsule (urdf/README.md)
+            _check_shape_sizes(go.geometry, go.name, urdf)
             if isinstance(go.geometry, coal.Cylinder):
                 go.geometry = coal.Capsule(go.geometry.radius, 2.0 * go.geometry.halfLength)
 
@@ -180,9 +248,11 @@ class WearerArm:
         if not srdf.is_file():
             raise FileNotFoundError(f"SRDF file not found: {srdf}")
         try:
-            root = ET.fromstring(srdf.read_text())
+            root = ET.fromstring(_read_text(srdf, "SRDF"))
         except ET.ParseError as exc:
             raise ValueError(f"malformed SRDF {srdf}: {exc}") from exc
+        if root.tag != "robot":
+            raise ValueError(f"malformed SRDF {srdf}: root element is <{root.tag}>, expected <robot>")
         links = {f.name for f in self.model.frames}
         for dc in root.iter("disable_collisions"):
             for key in ("link1", "link2"):
@@ -289,7 +359,7 @@ class WearerArm:
     # ------------------------------------------------------------------ kinematics
     def check_config(self, q: np.ndarray) -> np.ndarray:
         """Return q as a float array of shape (nq,), or raise ValueError naming the problem."""
-        q = np.asarray(q, dtype=float)
+        q = _as_float_array(q, "configuration")
         if q.shape != (self.nq,):
             raise ValueError(f"configuration must have shape ({self.nq},); got {q.shape}")
         if not np.all(np.isfinite(q)):
@@ -357,9 +427,7 @@ class WearerArm:
 
     def line_of_sight_clear(self, q: np.ndarray, target: np.ndarray) -> bool:
         """True if the segment muzzle -> target touches neither the wearer nor the arm's boom."""
-        target = np.asarray(target, dtype=float)
-        if target.shape != (3,) or not np.all(np.isfinite(target)):
-            raise ValueError(f"target must be 3 finite numbers, got {target!r}")
+        target = _check_finite_target(target)
         p, _ = self.muzzle(q)
         d = target - p
         length = float(np.linalg.norm(d))

@@ -60,6 +60,13 @@ for _arr in (*POSTURE_PRESETS.values(), *CROSS_SECTOR_TRAJECTORIES.values()):
     _arr.setflags(write=False)
 
 
+def _as_float_array(x: object, what: str) -> np.ndarray:
+    try:
+        return np.asarray(x, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{what} must be numbers, got {x!r} ({exc})") from exc
+
+
 def check_sector(k: object) -> int:
     """Return k as a sector number 1-4, or raise ValueError."""
     if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or int(k) not in SECTORS:
@@ -143,20 +150,34 @@ def target_direction(targets: np.ndarray, origin: np.ndarray | None = None) -> t
 
     Raises ValueError for non-finite targets or a target at the origin (no direction).
     """
-    t = np.asarray(targets, dtype=float)
+    t = _as_float_array(targets, "targets")
     single = t.ndim == 1
     t = np.atleast_2d(t)
     if t.ndim != 2 or t.shape[1] != 3:
         raise ValueError(f"targets must have shape (3,) or (N, 3); got {np.shape(targets)}")
-    if not np.all(np.isfinite(t)):
-        raise ValueError("targets contain NaN or inf")
-    d = t - (sector_origin() if origin is None else np.asarray(origin, dtype=float))
-    dist = np.linalg.norm(d, axis=1)
-    if np.any(dist < 1e-9):
-        raise ValueError("a target at the sector origin (the DOF1/DOF2 pivot) has no direction")
-    az = np.arctan2(d[:, 1], d[:, 0])
+    bad = ~np.all(np.isfinite(t), axis=1)
+    if bad.any():
+        k = int(np.flatnonzero(bad)[0])
+        raise ValueError(f"targets contain NaN or inf: target {k} is {t[k]}")
+    if origin is None:
+        o = sector_origin()
+    else:
+        o = _as_float_array(origin, "origin")
+        if o.shape != (3,) or not np.all(np.isfinite(o)):
+            raise ValueError(f"origin must be 3 finite numbers, got {origin!r}")
+    with np.errstate(over="ignore", invalid="ignore"):
+        d = t - o
+    if not np.all(np.isfinite(d)):
+        raise ValueError("targets minus origin overflow: coordinates too large")
+    # scale each row by its largest coordinate so the norm cannot overflow (targets at 1e300 m)
+    scale = np.max(np.abs(d), axis=1)
+    if np.any(scale < 1e-9):
+        k = int(np.flatnonzero(scale < 1e-9)[0])
+        raise ValueError(f"target {k} {t[k]} is at the sector origin (the DOF1/DOF2 pivot) and has no direction")
+    u = d / scale[:, None]
+    az = np.arctan2(u[:, 1], u[:, 0])
     az = np.where(az <= -np.pi, np.pi, az)
-    el = np.arcsin(np.clip(d[:, 2] / dist, -1.0, 1.0))
+    el = np.arcsin(np.clip(u[:, 2] / np.linalg.norm(u, axis=1), -1.0, 1.0))
     return (az[0], el[0]) if single else (az, el)
 
 

@@ -22,9 +22,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .ompl_problem import motion_states
+from .ompl_problem import MIN_JOINT_STEP, motion_states
 from .pointing import AimingError, PointingGeometry, aim_batch, check_target
-from .robot import WearerArm
+from .robot import WearerArm, _as_float_array
 from .sectors import SECTORS, check_sector, in_pointing_sector, posture_preset, posture_sector
 
 __all__ = [
@@ -56,6 +56,16 @@ class TrackerOptions:
 
     joint_speed: float = 1.0
     check_step: float = 0.01
+
+    def __post_init__(self) -> None:
+        for name in ("joint_speed", "check_step"):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)) or not (
+                math.isfinite(v) and v > 0
+            ):
+                raise ValueError(f"{name} must be a finite number > 0, got {v!r}")
+        if self.check_step < MIN_JOINT_STEP:
+            raise ValueError(f"check_step must be >= {MIN_JOINT_STEP} rad, got {self.check_step!r}")
 
 
 @dataclass(frozen=True)
@@ -126,6 +136,8 @@ class Tracker:
         self.geometry = PointingGeometry.from_robot(robot)
         self.sector = check_sector(initial_sector)
         q0 = np.r_[posture_preset(self.sector), 0.0, 0.0] if initial is None else robot.check_config(initial)
+        if not robot.within_limits(q0):
+            raise ValueError(f"initial configuration {np.round(q0, 4).tolist()} is outside the joint limits")
         if not robot.is_valid(q0):
             raise ValueError(f"initial configuration {np.round(q0, 4).tolist()} is in collision")
         self.q = q0.copy()
@@ -184,7 +196,21 @@ class Tracker:
 
     # ------------------------------------------------------------------ API
     def step(self, t: float, target: np.ndarray, new_target: bool = False) -> None:
-        """Process one target sample at time t (seconds); ``new_target`` marks a 'lock a new target' event."""
+        """Process one target sample at time t (seconds); ``new_target`` marks a 'lock a new target' event.
+
+        A time before the last one is clamped to it.  A target that is not finite, too far
+        (``MAX_TARGET_DISTANCE``) or inside the wearer is recorded as an ``"unreachable"`` event.
+
+        Raises
+        ------
+        ValueError
+            If t is not a finite number or target is not 3 numbers.
+        """
+        if isinstance(t, bool) or not isinstance(t, (int, float, np.integer, np.floating)) or not math.isfinite(t):
+            raise ValueError(f"time t must be a finite number (seconds), got {t!r}")
+        raw = _as_float_array(target, "target")
+        if raw.shape != (3,):
+            raise ValueError(f"target must have shape (3,); got {raw.shape}")
         t = max(float(t), self.time)
         try:
             target = check_target(target, self.robot)
