@@ -36,12 +36,12 @@ import io
 import json
 import logging
 import math
-import multiprocessing as mp
 import os
 import platform
 import signal
 import socket
 import sys
+import tempfile
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -65,7 +65,9 @@ __all__ = [
     "make_results_dir",
     "package_versions",
     "run_campaign",
+    "resume_campaign",
     "run_query_task",
+    "write_new_file",
     "stratified_subset",
 ]
 
@@ -142,6 +144,8 @@ class CampaignResult:
     database: Path | None
     interrupted: bool
     report: dict = field(default_factory=dict)
+    skipped_logs: list[Path] = field(default_factory=list)
+    """Corrupt logs left out of the database (reported by name)."""
     plots: list[Path] = field(default_factory=list)
 
 
@@ -240,12 +244,20 @@ def _make_wrapper_class():
 
         def setup(self) -> None:  # noqa: D102 (OMPL override)
             super().setup()
-            self.inner.setProblemDefinition(self.getProblemDefinition())
-            self.inner.setup()
+            self._setup_error = None
+            try:  # an exception escaping to C++ would abort the whole benchmark
+                self.inner.setProblemDefinition(self.getProblemDefinition())
+                self.inner.setup()
+            except Exception as exc:  # noqa: BLE001
+                log.exception("planner %s: setup failed", self.inner.getName())
+                self._setup_error = repr(exc)
 
         def clear(self) -> None:  # noqa: D102 (OMPL override)
             super().clear()
-            self.inner.clear()
+            try:
+                self.inner.clear()
+            except Exception:  # noqa: BLE001
+                log.exception("planner %s: clear failed", self.inner.getName())
 
         def solve(self, ptc):  # noqa: D102 (OMPL override)
             from ompl import base as ob
@@ -264,8 +276,10 @@ def _make_wrapper_class():
                     state["next"] = now + self.progress_period
                 return cap is not None and it >= cap
 
-            error = None
+            error = getattr(self, "_setup_error", None)
             try:
+                if error is not None:
+                    raise RuntimeError(f"setup failed: {error}")
                 if self._native_stats:
                     cond = ob.plannerOrTerminationCondition(ptc, ob.PlannerTerminationCondition(stop))
                     status = inner.solve(cond)
@@ -425,6 +439,8 @@ def _seed_process(seed: int) -> None:
     if not _SEEDED:  # a second setSeed in one process only prints an error
         ou.RNG.setSeed(int(seed))
         _SEEDED.append(int(seed))
+    elif _SEEDED[0] != int(seed):
+        log.warning("OMPL was seeded with %d in this process, not %d: runs are not reproducible", _SEEDED[0], seed)
 
 
 def _sub_seed(*parts: int) -> int:
@@ -451,32 +467,92 @@ def _log_name(query: dict, qpos: int, spec: dict) -> str:
     return f"q{qpos:03d}_{spec['comparison']}_{spec['checker']}_{tag}.log"
 
 
-def run_query_task(task: dict) -> list[str]:
-    """Run every experiment of one query and write one ``.log`` per experiment; return their paths.
+def write_new_file(target: Path, text: str) -> bool:
+    """Write ``text`` to ``target`` atomically and never over an existing file.
+
+    The text goes to a unique ``.part`` file first, then is hard-linked to ``target`` (which fails
+    if ``target`` exists, even when two processes race).  Returns False when ``target`` existed.
+    """
+    target = Path(target)
+    tmp = target.with_name(f"{target.name}.{os.getpid()}.{time.monotonic_ns()}.part")
+    with open(tmp, "w") as f:
+        f.write(text)
+        f.flush()
+        os.fsync(f.fileno())
+    try:
+        os.link(tmp, target)
+        return True
+    except FileExistsError:
+        return False
+    finally:
+        tmp.unlink()
+
+
+def run_query_task(task: dict) -> dict:
+    """Run the experiments of one query; return their OMPL logs as text plus per-run extras.
 
     ``task`` holds only plain data (OMPL objects cannot be pickled): ``config`` (dict of
     :class:`CampaignConfig`), ``query`` (dict), ``qpos`` (position in the set), ``query_set``,
-    ``seed``, ``log_dir``, ``n_threads``.  Logs are written to a temporary name and renamed when
-    complete, so an interrupted campaign never leaves a partial log.
+    ``seed``, ``n_threads``, optionally ``specs`` (the experiments to run; default all) and
+    ``log_dir``.  With ``log_dir`` each log is also written there as soon as its experiment ends
+    (atomically, never over an existing file), so an interrupted campaign keeps it.
+
+    Returns (JSON-able): ``qpos``, ``query_id``, ``logs`` ({file name: log text}), ``extras``
+    ({file name: {planner: [per-run properties]}}), ``errors``, ``pid``, ``host``, ``elapsed``.
     """
     from ompl import util as ou
 
     from .robot import WearerArm
 
+    t0 = time.perf_counter()
     cfg, query, qpos = task["config"], task["query"], int(task["qpos"])
     _seed_process(task["seed"])
     ou.setLogLevel(ou.LOG_WARN)
     robot = WearerArm(n_threads=task.get("n_threads"))
-    log_dir = Path(task["log_dir"])
-    written = []
-    for spec in _experiment_specs(cfg, qpos):
-        target = log_dir / _log_name(query, qpos, spec)
-        _run_experiment(robot, cfg, task, spec, target)
-        written.append(str(target))
-    return written
+    log_dir = Path(task["log_dir"]) if task.get("log_dir") else None
+    specs = task.get("specs") or _experiment_specs(cfg, qpos)
+    out: dict = {"qpos": qpos, "query_id": query["id"], "logs": {}, "extras": {}, "errors": {},
+                 "pid": os.getpid(), "host": socket.gethostname()}
+    for spec in specs:
+        fname = _log_name(query, qpos, spec)
+        text, extras, error = _run_experiment(robot, cfg, task, spec)
+        out["logs"][fname], out["extras"][fname] = text, extras
+        if error:
+            out["errors"][fname] = error
+        if log_dir is not None:
+            write_new_file(log_dir / fname, text)
+    out["elapsed"] = time.perf_counter() - t0
+    return out
 
 
-def _run_experiment(robot, cfg: dict, task: dict, spec: dict, target: Path) -> None:
+def _restore_ompl_output(before) -> None:
+    """Undo what an aborted ``Benchmark.benchmark`` leaves: OMPL's output handler switched off.
+
+    ``restorePreviousOutputHandler`` *swaps* the current and previous handlers, so it is called
+    only when the handler is actually off (calling it after a normal run would silence OMPL).
+    """
+    from ompl import util as ou
+
+    if before is not None and ou.getOutputHandler() is None:
+        ou.restorePreviousOutputHandler()
+        if ou.getOutputHandler() is None:
+            ou.useOutputHandler(before)
+
+
+def _failed_props(error: str) -> dict:
+    return {"planner_error INTEGER": 1, "path_valid_dense INTEGER": 0, "reaches_goal INTEGER": 0,
+            "error_message TEXT": error[:200].replace("\n", " ")}
+
+
+def _run_experiment(robot, cfg: dict, task: dict, spec: dict) -> tuple[str, dict, str | None]:
+    """One OMPL experiment; returns (log text, {planner: [run properties]}, benchmark error or None).
+
+    Exceptions from Python callbacks never escape: planner exceptions are caught in
+    :class:`RecordingPlanner`, event-callback exceptions in the events, and anything else that
+    aborts ``benchmark()`` (e.g. a Python validity checker raising while OMPL checks the path)
+    restores OMPL's logging and records every run that did not finish as a failed run
+    (status *crash*, ``planner_error`` = 1).
+    """
     from ompl import tools as ot
     from ompl import util as ou
 
@@ -525,7 +601,7 @@ def _run_experiment(robot, cfg: dict, task: dict, spec: dict, target: Path) -> N
     def pre_run(planner) -> None:
         counter["before"] = robot.collision_checks
 
-    def post_run(planner, run) -> None:
+    def post_run_props(planner) -> dict:
         checks = robot.collision_checks - counter["before"]
         w = wrappers[planner.getName()]
         rec = dict(w.last)
@@ -551,11 +627,19 @@ def _run_experiment(robot, cfg: dict, task: dict, spec: dict, target: Path) -> N
             if best is None or not math.isfinite(float(best)):
                 best = l4
             ends = bool(np.allclose(W[0], start, atol=1e-6) and np.allclose(W[-1], goal, atol=1e-6))
-            props.update({"reaches_goal INTEGER": int(ends), "best_cost REAL": best, "length_dof12 REAL": l12, "length_dof34 REAL": l34,
-                          "raw_length REAL": l4, "path_valid_dense INTEGER": int(ok)})
-        records[planner.getName()].append({"props": props, "progress": rec["progress"]})
+            props.update({"reaches_goal INTEGER": int(ends), "best_cost REAL": best, "length_dof12 REAL": l12,
+                          "length_dof34 REAL": l34, "raw_length REAL": l4, "path_valid_dense INTEGER": int(ok)})
+        return {"props": props, "progress": rec["progress"]}
 
-    bench.setPreRunEvent(pre_run)
+    def post_run(planner, run) -> None:
+        try:
+            rec = post_run_props(planner)
+        except Exception as exc:  # noqa: BLE001 (would abort benchmark())
+            log.exception("post-run event failed for %s", planner.getName())
+            rec = {"props": _failed_props(repr(exc)), "progress": []}
+        records.setdefault(planner.getName(), []).append(rec)
+
+    bench.setPreRunEvent(lambda p: _guarded(pre_run, p))
     bench.setPostRunEvent(post_run)
     req = ot.Request(
         maxTime=float(cfg["max_time"] if cap is not None else budget),
@@ -566,15 +650,50 @@ def _run_experiment(robot, cfg: dict, task: dict, spec: dict, target: Path) -> N
         saveConsoleOutput=False,
         simplify=bool(cfg["simplify"]),
     )
+    handler = ou.getOutputHandler()
+    error = None
     try:
         bench.benchmark(req)
+    except Exception as exc:  # noqa: BLE001 (a Python callback raised inside OMPL)
+        error = repr(exc)
+        _restore_ompl_output(handler)
+        log.error("benchmark %s aborted by %s; unfinished runs are recorded as failed", name, error)
     finally:
-        ou.restorePreviousOutputHandler()
+        _restore_ompl_output(handler)
         ou.setLogLevel(ou.LOG_WARN)
+    if error is not None:
+        _pad_aborted_runs(bench, records, int(cfg["runs"]), error)
     _patch_recorded_data(bench, wrappers, records, cap)
-    tmp = target.with_suffix(".log.part")
-    bench.saveResultsToFile(str(tmp))
-    os.replace(tmp, target)
+    with tempfile.TemporaryDirectory(prefix="tpee_log_") as tmp:
+        path = Path(tmp) / "experiment.log"
+        bench.saveResultsToFile(str(path))
+        text = path.read_text()
+    extras = {n: [{k.rsplit(" ", 1)[0]: v for k, v in r["props"].items()} for r in recs] for n, recs in records.items()}
+    return text, extras, error
+
+
+def _guarded(fn: Callable, *args) -> None:
+    try:
+        fn(*args)
+    except Exception:  # noqa: BLE001 (an exception would abort benchmark())
+        log.exception("benchmark event %s failed", getattr(fn, "__name__", fn))
+
+
+def _pad_aborted_runs(bench, records: dict, run_count: int, error: str) -> None:
+    """After an aborted ``benchmark()``: add a failed run for every run that never finished."""
+    from ompl import base as ob
+
+    crash = str(int(ob.PlannerStatus.CRASH))
+    for pl in bench.getRecordedExperimentData().planners:
+        name = pl.name.split("_", 1)[1] if "_" in pl.name else pl.name
+        recs = records.setdefault(name, [])
+        runs = list(pl.runs)
+        del recs[len(runs):]  # a record whose run was not stored (the abort came after the post-run event)
+        while len(runs) < run_count:
+            runs.append({"status ENUM": crash, "solved BOOLEAN": "0", "approximate solution BOOLEAN": "0",
+                         "correct solution BOOLEAN": "0", "time REAL": "0", "memory REAL": "0"})
+            recs.append({"props": _failed_props(error), "progress": []})
+        pl.runs = runs
 
 
 def _state(si, values):
@@ -644,26 +763,64 @@ def make_results_dir(out: str | os.PathLike, name: str) -> Path:
     raise RuntimeError(f"could not create a new results folder under {out}")
 
 
-def build_database(logs: Sequence[os.PathLike], db_path: os.PathLike) -> Path:
-    """Build a Planner Arena SQLite database from OMPL ``.log`` files (ompl_benchmark_statistics)."""
+def build_database(logs: Sequence[os.PathLike], db_path: os.PathLike) -> tuple[Path | None, list[Path]]:
+    """Build a Planner Arena SQLite database from OMPL ``.log`` files (ompl_benchmark_statistics).
+
+    Each log is first parsed on its own (into an in-memory database); a log that fails is reported
+    by name and skipped.  The database is written to ``<db>.part`` and renamed over ``db_path``
+    only when complete, so an interruption never leaves a half-written database.  Returns the
+    database (None when no log was readable) and the skipped logs.
+    """
     from ompl import tools as ot
 
     db_path = Path(db_path)
-    if db_path.exists():
-        db_path.unlink()
+    good, bad = [], []
     buf = io.StringIO()
     with contextlib.redirect_stdout(buf):  # readBenchmarkLog prints one line per file and planner
-        ot.readBenchmarkLog(str(db_path), [str(p) for p in logs], False)
-        ot.computeViews(str(db_path), False)
-    return db_path
+        for p in logs:
+            try:
+                ot.readBenchmarkLog(":memory:", [str(p)], False)
+                good.append(Path(p))
+            except Exception as exc:  # noqa: BLE001 (any parse error: the file is corrupt)
+                log.error("skipping corrupt log %s: %r", Path(p).name, exc)
+                bad.append(Path(p))
+    if not good:
+        return None, bad
+    tmp = db_path.with_name(db_path.name + ".part")
+    tmp.unlink(missing_ok=True)
+    try:
+        with contextlib.redirect_stdout(buf):
+            ot.readBenchmarkLog(str(tmp), [str(p) for p in good], False)
+            ot.computeViews(str(tmp), False)
+        os.replace(tmp, db_path)
+    finally:
+        tmp.unlink(missing_ok=True)
+    return db_path, bad
 
 
-def _ignore_sigint() -> None:
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
+def _write_json(path: Path, data: dict) -> None:
+    tmp = path.with_name(path.name + ".part")
+    tmp.write_text(json.dumps(data, indent=2))
+    os.replace(tmp, path)
 
 
-def _pool_run(task: dict) -> list[str]:
-    return run_query_task(task)
+@contextlib.contextmanager
+def _sigterm_as_keyboard_interrupt():
+    """Within the block, SIGTERM interrupts like Ctrl-C (main thread only)."""
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def handler(signum, frame):
+        raise KeyboardInterrupt(f"signal {signum}")
+
+    previous = signal.signal(signal.SIGTERM, handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
 
 
 def run_campaign(
@@ -672,88 +829,148 @@ def run_campaign(
     on_task_done: Callable[[list[str]], None] | None = None,
     report: bool = True,
     progress_bar: bool = True,
+    executor=None,
 ) -> CampaignResult:
     """Run a campaign into a new timestamped folder, build the DB, the report and the plots.
 
-    ``on_task_done`` is called in this process with each finished query's log paths.  Ctrl-C (or
-    a KeyboardInterrupt from ``on_task_done``) stops the campaign: finished logs are kept and the
-    database is still built from them.
+    ``executor`` (:mod:`tpee_ompl.executors`) runs the per-query tasks; default: a local spawn
+    pool of ``config.workers`` processes (0 = this process).  ``on_task_done`` is called in this
+    process with each finished query's log paths.  Ctrl-C or SIGTERM (or a KeyboardInterrupt from
+    ``on_task_done``) stops the campaign: finished logs are kept, the database is still built from
+    them, and :func:`resume_campaign` runs the rest later.
     """
-    from tqdm import tqdm
-
     set_name, queries = load_query_set(config.queries)
     queries = stratified_subset(queries, config.max_queries)
     if not queries:
         raise ValueError(f"query set {config.queries!r} has no queries")
     directory = make_results_dir(config.out, config.name)
-    log_dir = directory / "logs"
-    log_dir.mkdir()
+    (directory / "logs").mkdir()
     cfg = dataclasses.asdict(config)
-    n_threads = 1 if config.workers > 1 else None
-    tasks = [
-        {"config": cfg, "query": q, "qpos": k, "query_set": set_name, "seed": config.seed + k,
-         "log_dir": str(log_dir), "n_threads": n_threads}
-        for k, q in enumerate(queries)
-    ]
     meta = {
         "config": cfg,
         "query_set": set_name,
         "queries": [q["id"] for q in queries],
+        "query_data": queries,
         "expected_experiments": sum(len(_experiment_specs(cfg, k)) for k in range(len(queries))),
         "seed": config.seed,
-        "process_seeds": {str(q["id"]): t["seed"] for q, t in zip(queries, tasks)},
+        "process_seeds": {str(q["id"]): config.seed + k for k, q in enumerate(queries)},
         "versions": package_versions(),
         "hostname": socket.gethostname(),
         "cpu_count": os.cpu_count(),
         "command": sys.argv,
         "started_utc": _dt.datetime.now(_dt.timezone.utc).isoformat(),
     }
-    (directory / "campaign.json").write_text(json.dumps(meta, indent=2))
-    log.info("campaign %s: %d queries, %d experiments", directory, len(queries), meta["expected_experiments"])
+    _write_json(directory / "campaign.json", meta)
+    return _execute(directory, meta, executor, on_task_done, report, progress_bar)
 
-    interrupted = False
-    bar = tqdm(total=len(tasks), desc=f"{config.name} queries", unit="query", disable=not progress_bar)
-    pool = None
-    try:
-        if config.workers == 0:
-            for t in tasks:
-                done = run_query_task(t)
-                bar.update(1)
-                if on_task_done:
-                    on_task_done(done)
-        else:
-            ctx = mp.get_context("spawn")
-            pool = ctx.Pool(processes=config.workers, maxtasksperchild=1, initializer=_ignore_sigint)
-            for done in pool.imap_unordered(_pool_run, tasks):
-                bar.update(1)
-                if on_task_done:
-                    on_task_done(done)
-            pool.close()
-            pool.join()
-    except KeyboardInterrupt:
-        interrupted = True
-        log.warning("interrupted: building the database from the finished logs")
-        if pool is not None:
-            pool.terminate()
-            pool.join()
-    finally:
-        bar.close()
-    for part in log_dir.glob("*.part"):
+
+def resume_campaign(
+    directory: str | os.PathLike,
+    *,
+    executor=None,
+    workers: int | None = None,
+    on_task_done: Callable[[list[str]], None] | None = None,
+    report: bool = True,
+    progress_bar: bool = True,
+) -> CampaignResult:
+    """Run only the experiments of an interrupted campaign that have no log yet, into its folder.
+
+    Finished logs are never touched; the database and report are rebuilt from all logs.  The
+    configuration and queries come from the folder's ``campaign.json``; ``workers`` overrides the
+    pool size.  A query resumed part-way runs its missing experiments in a fresh process seeded
+    as before, so they are valid runs but (OMPL's RNG stream being shared by the experiments of a
+    query) not bit-identical to an uninterrupted campaign.
+    """
+    directory = Path(directory)
+    meta = json.loads((directory / "campaign.json").read_text())
+    if "query_data" not in meta:
+        raise ValueError(f"{directory} was written by an older version (no query_data): cannot resume")
+    if workers is not None:
+        meta["config"]["workers"] = int(workers)
+    meta.setdefault("resumed_utc", []).append(_dt.datetime.now(_dt.timezone.utc).isoformat())
+    (directory / "logs").mkdir(exist_ok=True)
+    return _execute(directory, meta, executor, on_task_done, report, progress_bar)
+
+
+def _execute(directory: Path, meta: dict, executor, on_task_done, report: bool, progress_bar: bool) -> CampaignResult:
+    from tqdm import tqdm
+
+    from .executors import make_executor, run_task_in_subprocess
+
+    cfg = meta["config"]
+    log_dir = directory / "logs"
+    for part in log_dir.glob("*.part"):  # left by a process killed while writing
         part.unlink()
-    logs = sorted(log_dir.glob("*.log"))
-    meta.update({"finished_utc": _dt.datetime.now(_dt.timezone.utc).isoformat(), "interrupted": interrupted,
-                 "finished_experiments": len(logs)})
-    (directory / "campaign.json").write_text(json.dumps(meta, indent=2))
-    result = CampaignResult(directory=directory, logs=logs, database=None, interrupted=interrupted)
-    if logs:
-        result.database = build_database(logs, directory / "benchmark.db")
-        if report:
-            from . import plots
-            from . import report as rep
+    done_names = {p.name for p in log_dir.glob("*.log")}
+    executor = executor if executor is not None else make_executor(int(cfg["workers"]))
+    isolated = getattr(executor, "fresh_process_per_task", True)
+    shared_fs = getattr(executor, "shares_filesystem", True)
+    in_process = not isolated
+    n_threads = None if in_process or int(cfg["workers"]) == 1 and shared_fs else 1
+    tasks = []
+    for k, q in enumerate(meta["query_data"]):
+        specs = [s for s in _experiment_specs(cfg, k) if _log_name(q, k, s) not in done_names]
+        if specs:
+            tasks.append({"config": cfg, "query": q, "qpos": k, "query_set": meta["query_set"], "seed": cfg["seed"] + k,
+                          "specs": specs, "log_dir": str(log_dir) if shared_fs else None, "n_threads": n_threads,
+                          "sys_path": [p for p in sys.path if p]})
+    fn = run_query_task if shared_fs else run_task_in_subprocess
+    meta["executor"] = executor.description
+    log.info("campaign %s: %d queries, %d experiments (%d to run) on %s", directory, len(meta["query_data"]),
+             meta["expected_experiments"], sum(len(t["specs"]) for t in tasks), executor.description)
+    interrupted = False
+    t0 = time.perf_counter()
+    bar = tqdm(total=len(tasks), desc=f"{cfg['name']} queries", unit="query", disable=not progress_bar)
+    try:
+        with _sigterm_as_keyboard_interrupt():
+            try:
+                for res in executor.run(fn, tasks):
+                    written = _store_task_result(directory, res)
+                    bar.update(1)
+                    if on_task_done:
+                        on_task_done(written)
+                executor.shutdown()
+            except KeyboardInterrupt:
+                interrupted = True
+                log.warning("interrupted: building the database from the finished logs")
+                executor.shutdown(cancel=True)
+            finally:
+                bar.close()
+            for part in log_dir.glob("*.part"):
+                part.unlink()
+            logs = sorted(log_dir.glob("*.log"))
+            meta.update({"finished_utc": _dt.datetime.now(_dt.timezone.utc).isoformat(), "interrupted": interrupted,
+                         "finished_experiments": len(logs), "wall_time_s": time.perf_counter() - t0})
+            result = CampaignResult(directory=directory, logs=logs, database=None, interrupted=interrupted)
+            if logs:
+                result.database, result.skipped_logs = build_database(logs, directory / "benchmark.db")
+                meta["corrupt_logs"] = [p.name for p in result.skipped_logs]
+            _write_json(directory / "campaign.json", meta)
+            if result.database is not None and report:
+                from . import plots
+                from . import report as rep
 
-            result.report = rep.write_report(result.database, directory, expected=meta)
-            result.plots = plots.make_plots(result.database, directory / "plots")
+                result.report = rep.write_report(result.database, directory, expected=meta)
+                result.plots = plots.make_plots(result.database, directory / "plots")
+    finally:
+        executor.shutdown(cancel=True)
     return result
+
+
+def _store_task_result(directory: Path, res: dict) -> list[str]:
+    """Write a task's logs into the campaign folder (never over a different existing log)."""
+    log_dir = directory / "logs"
+    written = []
+    for fname, text in res["logs"].items():
+        target = log_dir / Path(fname).name
+        if not write_new_file(target, text) and target.read_text() != text:
+            log.warning("%s exists with other content: kept the existing log", target.name)
+        written.append(str(target))
+    line = {k: res.get(k) for k in ("qpos", "query_id", "pid", "host", "elapsed", "errors")}
+    line["logs"] = sorted(res["logs"])
+    with open(directory / "tasks.jsonl", "a") as f:
+        f.write(json.dumps(line) + "\n")
+    return written
 
 
 # --------------------------------------------------------------------------- command line
@@ -784,6 +1001,16 @@ def build_parser(prog: str | None = None) -> argparse.ArgumentParser:
     p.add_argument("--max-time", type=float, default=300.0, help="safety limit per iteration-capped run, s")
     p.add_argument("--out", default="results", help="parent folder of the timestamped results folder")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    g = p.add_argument_group("executor (default: local process pool of --workers)")
+    g.add_argument("--dask", metavar="local|tcp://HOST:PORT", default=None,
+                   help="run the queries as Dask tasks: 'local' starts a LocalCluster here, an address uses that "
+                        "scheduler (needs the dask extra: pip install 'tpee_ompl[dask]')")
+    g.add_argument("--scheduler", metavar="tcp://HOST:PORT", default=None, help="same as --dask tcp://HOST:PORT")
+    g.add_argument("--dask-workers", type=int, default=2, help="workers of --dask local (default: %(default)s)")
+    g.add_argument("--retries", type=int, default=2, help="Dask retries of a task that raises (default: %(default)s)")
+    p.add_argument("--resume", metavar="DIR", default=None,
+                   help="finish an interrupted campaign in DIR: run only its missing experiments (configuration "
+                        "from DIR/campaign.json; the other campaign options are ignored)")
     return p
 
 
@@ -814,12 +1041,26 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run a campaign from the command line; print the ratio table and where the files are."""
     args = build_parser().parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(message)s")
+    from .executors import make_executor
+
     try:
         config = config_from_args(args)
-    except ValueError as exc:
+        if args.resume and not (Path(args.resume) / "campaign.json").is_file():
+            raise ValueError(f"--resume {args.resume}: no campaign.json there")
+        executor = make_executor(config.workers, dask=args.scheduler or args.dask, dask_workers=args.dask_workers,
+                                 retries=args.retries)
+    except (ValueError, ImportError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
-    result = run_campaign(config, progress_bar=not args.no_progress)
+    try:
+        if args.resume:
+            result = resume_campaign(args.resume, executor=executor, workers=config.workers,
+                                     progress_bar=not args.no_progress)
+        else:
+            result = run_campaign(config, executor=executor, progress_bar=not args.no_progress)
+    except KeyboardInterrupt:  # a second Ctrl-C while the database was built
+        print("interrupted; finished logs are kept: rerun with --resume", file=sys.stderr)
+        return 130
     if result.report.get("markdown_text"):
         print(result.report["markdown_text"])
     print(f"results: {result.directory}")
@@ -828,7 +1069,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"report: {result.report.get('markdown')}  {result.report.get('csv')}")
     if result.plots:
         print(f"plots: {result.directory / 'plots'} ({len(result.plots)} PNG)")
+    if result.skipped_logs:
+        print(f"skipped {len(result.skipped_logs)} corrupt log(s): " + ", ".join(p.name for p in result.skipped_logs))
     if result.interrupted:
-        print("campaign was interrupted: the database holds the finished experiments only")
+        print("campaign was interrupted: the database holds the finished experiments only; "
+              f"finish it with --resume {result.directory}")
         return 130
     return 0
