@@ -1,6 +1,8 @@
-"""Tests of the path library (sections 4.2.2-4.2.3) with stand-ins for the sampler and dimension-RRT."""
+"""Tests of the path library (sections 4.2.2-4.2.3): stand-in sampler/planner, then the real builders (dimension-RRT)."""
 
 from __future__ import annotations
+
+import itertools
 
 import numpy as np
 import pytest
@@ -221,7 +223,7 @@ def test_motion_check_states_are_the_ompl_motion_states_of_every_segment(robot: 
     path = np.cumsum(rng.uniform(-0.05, 0.05, (30, 4)), axis=0)
     path[10] = path[9]  # a zero-length segment still checks its end state once
     step = robot.max_joint_step()
-    expected = np.vstack([path[:1]] + [motion_states(a, b, step) for a, b in zip(path[:-1], path[1:])])
+    expected = np.vstack([path[:1]] + [motion_states(a, b, step) for a, b in itertools.pairwise(path)])
     np.testing.assert_allclose(motion_check_states(path, step), expected, atol=1e-15)
 
 
@@ -314,7 +316,7 @@ def test_library_plugs_into_the_tracker_as_its_cross_sector_planner(robot: Weare
     assert [e.kind for e in result.events] == ["cross-sector"] and tracker.sector == 4
     assert rrt_library.stats()["queries"] == before + 1
     Q = np.vstack([q.start, result.configurations])
-    for u, v in zip(Q[:-1], Q[1:]):
+    for u, v in itertools.pairwise(Q):
         assert robot.are_valid(motion_states(u, v, 0.01)).all()
 
 
