@@ -1,0 +1,166 @@
+"""Every exact solution of every planner we ship or wrap is collision-free at 1x and 4x the setup resolution.
+
+This is OMPL's ``correct_solution_strict`` benchmark column made a test: each segment of an exact
+path passes ``si.checkMotion`` at the setup's resolution, again with the space's
+``validSegmentCountFactor`` at 4 (what ``ot.Benchmark`` does), and, independently of OMPL, at a
+quarter of the joint step with ``motion_states`` + ``robot.are_valid``.  Queries come from the
+``planning_necessary`` set (its straight motion collides), spread over the 12 sector pairs.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+import pytest
+from ompl import base as ob
+from ompl import geometric as og
+from ompl import util as ou
+
+from tpee_ompl.dimension_rrt import tpee_dimension_rrt
+from tpee_ompl.ompl_problem import make_simple_setup, motion_states, path_to_array
+from tpee_ompl.queries import Query, load_queries
+from tpee_ompl.robot import WearerArm
+
+PER_PAIR = 10
+"""Queries per ordered sector pair in the stored set (query k * 10 is the first of pair k)."""
+
+
+@pytest.fixture(scope="module")
+def queries(robot: WearerArm) -> list[Query]:
+    """The planning-necessary set, refused if it was made for another model."""
+    qs = load_queries("planning_necessary", robot)
+    assert len(qs) == 12 * PER_PAIR
+    return qs
+
+
+def _strict_failures(robot: WearerArm, ss: og.SimpleSetup, q: Query) -> list[str]:
+    """Reasons the setup's exact solution is not a correct strict solution (empty if it is)."""
+    si = ss.getSpaceInformation()
+    path = ss.getSolutionPath()
+    W = path_to_array(path, robot.nq)
+    problems = []
+    if len(W) < 2 or not (np.allclose(W[0], q.start, atol=1e-9) and np.allclose(W[-1], q.goal, atol=1e-6)):
+        problems.append(f"path of {len(W)} states does not run from start to goal")
+        return problems
+    if not robot.are_valid(W).all():
+        problems.append("a waypoint is invalid")
+    states = path.getStates()
+    segments = list(zip(states[:-1], states[1:]))
+    if not all(si.checkMotion(a, b) for a, b in segments):
+        problems.append("si.checkMotion rejects a segment at the setup resolution")
+    space = si.getStateSpace()
+    factor = space.getValidSegmentCountFactor()
+    space.setValidSegmentCountFactor(4 * factor)  # as ompl::tools::Benchmark for correct_solution_strict
+    try:
+        if not all(si.checkMotion(a, b) for a, b in segments) or not path.check():
+            problems.append("si.checkMotion rejects a segment at 4x the resolution")
+    finally:
+        space.setValidSegmentCountFactor(factor)
+    step = ss._tpee_refs[2].step / 4  # the setup's joint step, quartered
+    dense = np.concatenate([motion_states(a, b, step) for a, b in zip(W[:-1], W[1:])])
+    if not robot.are_valid(dense).all():
+        problems.append("a state at a quarter of the joint step collides")
+    return problems
+
+
+def _run(robot: WearerArm, q: Query, make: Callable[[ob.SpaceInformation, Query], ob.Planner], seconds: float):
+    ss = make_simple_setup(robot, q.start, q.goal)
+    planner = make(ss.getSpaceInformation(), q)
+    ss.setPlanner(planner)
+    pdef = ss.getProblemDefinition()
+    ptc = ob.plannerOrTerminationCondition(
+        ob.timedPlannerTerminationCondition(seconds), ob.exactSolnPlannerTerminationCondition(pdef)
+    )
+    ss.solve(ptc)
+    return ss
+
+
+def test_dimension_rrt_exact_paths_pass_strict_check_on_all_12_pairs(robot: WearerArm, queries: list[Query]) -> None:
+    exact = 0
+    for pair in range(12):
+        q = queries[pair * PER_PAIR + pair % PER_PAIR]
+        ss = make_simple_setup(robot, q.start, q.goal)
+        ss.setPlanner(tpee_dimension_rrt(ss.getSpaceInformation(), q.from_sector, q.to_sector, max_samples=120, seed=pair))
+        ss.solve(10.0)
+        if ss.haveExactSolutionPath():
+            exact += 1
+            assert _strict_failures(robot, ss, q) == [], (q.id, q.from_sector, q.to_sector)
+    assert exact >= 10, f"only {exact}/12 exact solutions: the strict check tested too little"
+
+
+NATIVE = {
+    "RRTConnect": (og.RRTConnect, 2.0, 0),
+    "RRTstar": (og.RRTstar, 1.5, 1),
+    "InformedRRTstar": (og.InformedRRTstar, 1.5, 2),
+    "BITstar": (og.BITstar, 1.5, 3),
+}
+
+
+@pytest.mark.parametrize("name", sorted(NATIVE))
+def test_native_planner_exact_paths_pass_strict_check(robot: WearerArm, queries: list[Query], name: str) -> None:
+    cls, seconds, offset = NATIVE[name]
+    ou.RNG.setSeed(17)
+    exact = 0
+    for pair in range(offset, 12, 4):  # three pairs per planner, all 12 pairs over the four planners
+        q = queries[pair * PER_PAIR + offset]
+        ss = _run(robot, q, lambda si, _q: cls(si), seconds)
+        if ss.haveExactSolutionPath():
+            exact += 1
+            assert _strict_failures(robot, ss, q) == [], (name, q.id)
+    if name in ("RRTConnect", "BITstar"):
+        assert exact >= 2, f"{name}: {exact}/3 exact solutions"
+
+
+def test_aorrtc_exact_paths_are_strict_or_rejected(robot: WearerArm, queries: list[Query]) -> None:
+    """AORRTC may report zero-length 'exact' paths (ompl/ompl#1420): the strict check must catch any."""
+    ou.RNG.setSeed(5)
+    for pair in (1, 6, 11):
+        q = queries[pair * PER_PAIR + 3]
+        ss = _run(robot, q, lambda si, _q: og.AORRTC(si), 1.0)
+        if not ss.haveExactSolutionPath():
+            continue
+        W = path_to_array(ss.getSolutionPath(), robot.nq)
+        failures = _strict_failures(robot, ss, q)
+        if len(W) < 2 or np.allclose(W[0], W[-1]):  # the upstream bug: must not pass as valid
+            assert failures, f"zero-length AORRTC path passed the strict check (query {q.id})"
+        else:
+            assert failures == [], (q.id, failures)
+
+
+def test_zero_length_path_to_a_different_goal_fails_the_strict_check(robot: WearerArm, queries: list[Query]) -> None:
+    """What ompl/ompl#1420 returns (a path that stays at the start) is never taken as a valid solution."""
+    q = queries[0]
+    ss = make_simple_setup(robot, q.start, q.goal)
+    si = ss.getSpaceInformation()
+    for n in (1, 2):
+        path = og.PathGeometric(si)
+        for _ in range(n):
+            s = si.allocState()
+            for i, v in enumerate(q.start):
+                s[i] = float(v)
+            path.append(s)
+        ss.getProblemDefinition().clearSolutionPaths()
+        ss.getProblemDefinition().addSolutionPath(path, False, 0.0, "zero_length")
+        assert ss.haveExactSolutionPath()  # OMPL itself takes the planner's word for it
+        assert _strict_failures(robot, ss, q), f"a {n}-state zero-length path passed"
+
+
+def test_strict_check_really_is_denser_than_the_setup_resolution(robot: WearerArm) -> None:
+    """The 4x factor reaches our batched motion validator (it would silently ignore it otherwise)."""
+    ss = make_simple_setup(robot)
+    si = ss.getSpaceInformation()
+    mv = ss._tpee_refs[2]
+    a, b = si.allocState(), si.allocState()
+    for i in range(4):
+        a[i], b[i] = 0.3, 0.3
+    b[2] = 0.3 + 10 * mv.step
+    checks0 = robot.collision_checks
+    si.checkMotion(a, b)
+    coarse = robot.collision_checks - checks0
+    si.getStateSpace().setValidSegmentCountFactor(4)
+    checks0 = robot.collision_checks
+    si.checkMotion(a, b)
+    dense = robot.collision_checks - checks0
+    si.getStateSpace().setValidSegmentCountFactor(1)
+    assert (coarse, dense) == (10, 40)
