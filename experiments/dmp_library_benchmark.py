@@ -85,6 +85,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--reference-samples", type=int, default=2500, help="dimension-RRT samples of the reference")
     ap.add_argument("--no-reference", action="store_true", help="skip the dimension-RRT reference")
     ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--queries-cache", type=Path, help="JSON of the generated queries: read if it exists, else written")
+    ap.add_argument("--query-set", metavar="NAME", help="use a stored query set (e.g. planning_necessary) instead of generating")
+    ap.add_argument("--generate-only", action="store_true", help="stop after generating (and caching) the queries")
     ap.add_argument("--out", type=Path, default=Path("experiments/library/benchmark"), help="output stem")
     args = ap.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s: %(message)s")
@@ -95,9 +98,20 @@ def main(argv: list[str] | None = None) -> int:
     workers = max(1, args.workers)
     shares = [args.per_pair // workers + (w < args.per_pair % workers) for w in range(workers)]
     ctx = get_context("spawn")
-    with ProcessPoolExecutor(workers, mp_context=ctx) as ex:
-        parts = list(ex.map(_gen_queries, [s for s in shares if s], [args.seed + w for w in range(workers) if shares[w]]))
-    queries = [Query.from_dict({**d, "id": k}) for k, d in enumerate(d for part in parts for d in part)]
+    if args.query_set is not None:
+        from tpee_ompl.queries import load_queries
+
+        queries = load_queries(args.query_set)
+    elif args.queries_cache is not None and args.queries_cache.exists():
+        queries = [Query.from_dict(d) for d in json.loads(args.queries_cache.read_text())]
+    else:
+        with ProcessPoolExecutor(workers, mp_context=ctx) as ex:
+            parts = list(ex.map(_gen_queries, [s for s in shares if s], [args.seed + w for w in range(workers) if shares[w]]))
+        queries = [Query.from_dict({**d, "id": k}) for k, d in enumerate(d for part in parts for d in part)]
+        if args.queries_cache is not None:
+            args.queries_cache.write_text(json.dumps([q.to_dict() for q in queries]))
+    if args.generate_only:
+        return 0
     t_gen = time.perf_counter() - t0
     log.info("%d queries in %.0f s", len(queries), t_gen)
 

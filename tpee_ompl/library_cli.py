@@ -25,7 +25,7 @@ DEFAULT_LIBRARY = Path("experiments/library/default.npz")
 """Default library file (relative to the working directory; ``make library`` writes it)."""
 
 _BUILD_EXAMPLE = """example:
-  tpee-ompl library build --per-pair 20 --seed 0 --library experiments/library/default.npz
+  tpee-ompl library build --per-pair 12 --seed 0 --library experiments/library/default.npz
   tpee-ompl library build --pairs 1-2 3-4 --per-pair 3 --max-samples 500 --library /tmp/small.npz
 """
 _QUERY_EXAMPLE = """example:
@@ -70,7 +70,8 @@ def run_build(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     lib = PathLibrary.build_default(default_robot(), per_pair=args.per_pair, seed=args.seed,
                                     pairs=tuple(args.pairs or ALL_PAIRS), min_difference=args.min_difference,
-                                    max_samples=args.max_samples, timeout=args.timeout)
+                                    max_samples=args.max_samples, timeout=args.timeout,
+                                    max_attempts=args.max_attempts)
     lib.save(out)
     s = lib.stats()
     print(f"wrote {out}: {len(lib)} demonstrations in {len(lib.pairs)} pairs "
@@ -136,11 +137,13 @@ def register(subparsers: argparse._SubParsersAction, formatter_class: type = arg
     b = sub.add_parser("build", help="build a library (dimension-RRT demonstrations)", epilog=_BUILD_EXAMPLE,
                        formatter_class=formatter_class)
     common(b)
-    b.add_argument("--per-pair", type=int, default=20, help="demonstrations per ordered sector pair (default 20)")
+    b.add_argument("--per-pair", type=int, default=12, help="demonstrations per ordered sector pair (default 12)")
     b.add_argument("--seed", type=int, default=0, help="seed of the sampler and the planner (default 0)")
     b.add_argument("--pairs", type=_pair, nargs="+", metavar="I-J", help="sector pairs (default all 12)")
-    b.add_argument("--min-difference", type=float, default=0.3,
-                   help="new demo kept only if its DOF3/DOF4 (start, goal) differs by this many rad (default 0.3)")
+    b.add_argument("--min-difference", type=float, default=0.15,
+                   help="new demo kept only if its DOF3/DOF4 (start, goal) differs by this many rad (default 0.15)")
+    b.add_argument("--max-attempts", type=int, default=None,
+                   help="draws per pair before giving up on per-pair (default 3 x per-pair)")
     b.add_argument("--max-samples", type=int, default=2500, help="dimension-RRT samples per demo (default 2500)")
     b.add_argument("--timeout", type=float, default=10.0, help="dimension-RRT time limit per demo, s (default 10)")
     b.set_defaults(func=run_build)

@@ -362,23 +362,30 @@ class PathLibrary:
         per_pair: int = 10,
         seed: int = 0,
         pairs: Sequence[tuple[int, int]] = ALL_PAIRS,
-        min_difference: float = 0.3,
+        min_difference: float = 0.15,
         max_samples: int = 2500,
         timeout: float = 10.0,
         require_planning: bool = True,
+        max_attempts: int | None = None,
     ) -> PathLibrary:
         """:meth:`build` with :func:`query_sampler` and :func:`dimension_rrt_planner`; the
-        parameters are recorded in ``build_params`` (saved in the file's metadata)."""
+        parameters are recorded in ``build_params`` (saved in the file's metadata).
+
+        ``max_attempts`` (draws per pair) defaults to 3 per_pair: planning-necessary draws of
+        the shoulder pairs (3 <-> 4) cost several seconds each and cluster within ~0.3 rad.
+        """
+        max_attempts = 3 * per_pair if max_attempts is None else int(max_attempts)
         t0 = time.perf_counter()
         plan = dimension_rrt_planner(robot, max_samples=max_samples, seed=seed, timeout=timeout)
         lib = cls.build(robot, query_sampler(robot, require_planning=require_planning), plan, pairs=pairs,
-                        per_pair=per_pair, min_difference=min_difference, seed=seed)
+                        per_pair=per_pair, min_difference=min_difference, seed=seed, max_attempts=max_attempts)
         lib.build_params = {
             "builder": "PathLibrary.build_default",
             "per_pair": int(per_pair),
             "seed": int(seed),
             "pairs": [list(map(int, p)) for p in pairs],
             "min_difference": float(min_difference),
+            "max_attempts": int(max_attempts),
             "sampler": f"query_sampler(NECESSITY_REGIONS, require_planning={bool(require_planning)})",
             "planner": f"dimension_rrt_planner(max_samples={max_samples}, timeout={timeout:g})",
             "build_seconds": round(time.perf_counter() - t0, 1),
