@@ -103,3 +103,26 @@ def test_bench_help_shows_an_example(capsys):
         main(["bench", "--help"])
     assert exc.value.code == 0
     assert "example:" in capsys.readouterr().out
+
+
+def test_aim_prints_a_collision_free_aim_with_clear_line_of_sight(capsys):
+    assert main(["aim", "--target", "5", "2", "1.5", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["collision_free"] and out["line_of_sight_clear"] and out["aim_error_m"] < 1e-9
+
+
+def test_aim_at_a_target_inside_the_body_is_one_line(capsys):
+    assert main(["aim", "--target", "0", "0", "1.2"]) == 2
+    assert "inside" in capsys.readouterr().err
+
+
+def test_track_jitter_on_a_boundary_causes_no_cross_sector_motion(capsys):
+    assert main(["track", "--script", "jitter", "--duration", "5", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["events"]["cross-sector"] <= 1 and out["events"]["aim"] > 0
+
+
+def test_library_query_without_a_library_file_is_one_line(capsys, tmp_path):
+    assert main(["library", "stats", "--library", str(tmp_path / "none.npz")]) == 2
+    err = capsys.readouterr().err
+    assert "not found" in err and err.count("\n") == 1

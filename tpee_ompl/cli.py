@@ -207,13 +207,19 @@ def cmd_track(args: argparse.Namespace) -> int:
 
     robot = _load_robot(args)
     if args.planner == "dimension-rrt":
-        from .dimension_rrt import make_path_planner
+        from .path_library import dimension_rrt_planner
 
-        planner = make_path_planner(robot, max_samples=args.samples, seed=args.seed)
+        plan = dimension_rrt_planner(robot, max_samples=args.samples, seed=args.seed)
+
+        def planner(start: np.ndarray, goal: np.ndarray, i: int, j: int) -> np.ndarray:
+            path = plan(start, goal, i, j) if i != j else None
+            if path is None:
+                raise RuntimeError(f"dimension-RRT found no path {i}->{j}")
+            return path
     elif args.planner == "library":
-        from .path_library import PathLibrary
+        from .path_library import PathLibrary, dimension_rrt_planner
 
-        lib = PathLibrary.load(args.library, robot)
+        lib = PathLibrary.load(args.library, robot, plan=dimension_rrt_planner(robot, max_samples=args.samples))
         planner = lib.as_planner()
     else:
         planner = make_default_planner(robot, seed=args.seed)
@@ -329,6 +335,12 @@ def cmd_view(args: argparse.Namespace) -> int:
         time.sleep(1.0)
 
 
+def _register_library(sub: argparse._SubParsersAction, fmt: type) -> None:
+    from .library_cli import register
+
+    register(sub, fmt)
+
+
 def _register_bench(sub: argparse._SubParsersAction, fmt: type) -> None:
     from .benchmark import build_parser
 
@@ -426,7 +438,7 @@ def get_argument_parser() -> argparse.ArgumentParser:
     return parser
 
 
-_EXTRA_COMMANDS: list[Callable[[argparse._SubParsersAction, type], None]] = [_register_aim_track, _register_pictures, _register_bench]
+_EXTRA_COMMANDS: list[Callable[[argparse._SubParsersAction, type], None]] = [_register_aim_track, _register_pictures, _register_bench, _register_library]
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -437,7 +449,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
     try:
         return int(args.func(args) or 0)
-    except (CliError, ValueError, FileNotFoundError, ImportError, KeyError) as exc:
+    except (CliError, ValueError, FileNotFoundError, ImportError, KeyError, RuntimeError) as exc:
         msg = exc.args[0] if isinstance(exc, KeyError) and exc.args else exc
         print(f"tpee-ompl {args.command}: error: {msg}", file=sys.stderr)
         return 2
