@@ -358,6 +358,8 @@ def group_lengths(waypoints: np.ndarray) -> tuple[float, float, float]:
 def _fmt(v) -> str:
     if v is None:
         return ""
+    if isinstance(v, str):
+        return v
     if isinstance(v, (bool, np.bool_)):
         return str(int(v))
     if isinstance(v, (int, np.integer)):
@@ -541,7 +543,7 @@ def _restore_ompl_output(before) -> None:
 
 def _failed_props(error: str) -> dict:
     return {"planner_error INTEGER": 1, "path_valid_dense INTEGER": 0, "reaches_goal INTEGER": 0,
-            "error_message TEXT": error[:200].replace("\n", " ")}
+            "error_message TEXT": error[:200].replace("\n", " ").replace(";", ",")}
 
 
 def _run_experiment(robot, cfg: dict, task: dict, spec: dict) -> tuple[str, dict, str | None]:
@@ -682,16 +684,20 @@ def _guarded(fn: Callable, *args) -> None:
 def _pad_aborted_runs(bench, records: dict, run_count: int, error: str) -> None:
     """After an aborted ``benchmark()``: add a failed run for every run that never finished."""
     from ompl import base as ob
+    from ompl import tools as ot
 
-    crash = str(int(ob.PlannerStatus.CRASH))
+    crash = str(ob.PlannerStatus.CRASH.value)
     for pl in bench.getRecordedExperimentData().planners:
         name = pl.name.split("_", 1)[1] if "_" in pl.name else pl.name
         recs = records.setdefault(name, [])
         runs = list(pl.runs)
         del recs[len(runs):]  # a record whose run was not stored (the abort came after the post-run event)
         while len(runs) < run_count:
-            runs.append({"status ENUM": crash, "solved BOOLEAN": "0", "approximate solution BOOLEAN": "0",
-                         "correct solution BOOLEAN": "0", "time REAL": "0", "memory REAL": "0"})
+            run = ot.RunProperties()
+            for k, v in {"status ENUM": crash, "solved BOOLEAN": "0", "approximate solution BOOLEAN": "0",
+                         "correct solution BOOLEAN": "0", "time REAL": "0", "memory REAL": "0"}.items():
+                run[k] = v
+            runs.append(run)
             recs.append({"props": _failed_props(error), "progress": []})
         pl.runs = runs
 
@@ -776,9 +782,11 @@ def build_database(logs: Sequence[os.PathLike], db_path: os.PathLike) -> tuple[P
     db_path = Path(db_path)
     good, bad = [], []
     buf = io.StringIO()
-    with contextlib.redirect_stdout(buf):  # readBenchmarkLog prints one line per file and planner
+    with contextlib.redirect_stdout(buf), _eof_guard(ot.readBenchmarkLog):  # it prints a line per file and planner
         for p in logs:
             try:
+                if not Path(p).read_text().rstrip().endswith("\n."):  # every planner block ends with "."
+                    raise ValueError("truncated (no final '.')")
                 ot.readBenchmarkLog(":memory:", [str(p)], False)
                 good.append(Path(p))
             except Exception as exc:  # noqa: BLE001 (any parse error: the file is corrupt)
@@ -796,6 +804,48 @@ def build_database(logs: Sequence[os.PathLike], db_path: os.PathLike) -> tuple[P
     finally:
         tmp.unlink(missing_ok=True)
     return db_path, bad
+
+
+class _EofGuardedFile:
+    """A text file whose ``readline`` raises after many reads at end of file.
+
+    OMPL's ``readBenchmarkLog`` loops forever on some truncated logs (it keeps reading ``''``).
+    """
+
+    def __init__(self, f, limit: int = 1000) -> None:
+        self._f, self._limit, self._eof_reads = f, limit, 0
+
+    def readline(self, *args) -> str:
+        line = self._f.readline(*args)
+        if line == "":
+            self._eof_reads += 1
+            if self._eof_reads > self._limit:
+                raise ValueError(f"unexpected end of file in {self._f.name}")
+        return line
+
+    def __getattr__(self, name: str):
+        return getattr(self._f, name)
+
+    def __iter__(self):
+        return iter(self._f)
+
+
+@contextlib.contextmanager
+def _eof_guard(reader: Callable):
+    """Within the block, files opened by ``reader``'s module are :class:`_EofGuardedFile`."""
+    import builtins
+
+    mod = sys.modules[reader.__module__]
+    had = "open" in vars(mod)
+    previous = vars(mod).get("open")
+    mod.open = lambda *a, **k: _EofGuardedFile(builtins.open(*a, **k))
+    try:
+        yield
+    finally:
+        if had:
+            mod.open = previous
+        else:
+            del mod.open
 
 
 def _write_json(path: Path, data: dict) -> None:
