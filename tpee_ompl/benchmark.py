@@ -889,6 +889,11 @@ def run_campaign(
     ``on_task_done``) stops the campaign: finished logs are kept, the database is still built from
     them, and :func:`resume_campaign` runs the rest later.
     """
+    with _sigterm_as_keyboard_interrupt():
+        return _run_campaign(config, on_task_done, report, progress_bar, executor)
+
+
+def _run_campaign(config: CampaignConfig, on_task_done, report: bool, progress_bar: bool, executor) -> CampaignResult:
     set_name, queries = load_query_set(config.queries)
     queries = stratified_subset(queries, config.max_queries)
     if not queries:
@@ -909,6 +914,7 @@ def run_campaign(
         "cpu_count": os.cpu_count(),
         "command": sys.argv,
         "started_utc": _dt.datetime.now(_dt.timezone.utc).isoformat(),
+        "interrupted": True,  # until the campaign ends (a killed campaign stays marked)
     }
     _write_json(directory / "campaign.json", meta)
     return _execute(directory, meta, executor, on_task_done, report, progress_bar)
@@ -943,67 +949,64 @@ def resume_campaign(
 
 
 def _execute(directory: Path, meta: dict, executor, on_task_done, report: bool, progress_bar: bool) -> CampaignResult:
-    from tqdm import tqdm
-
-    from .executors import make_executor, run_task_in_subprocess
-
     cfg = meta["config"]
     log_dir = directory / "logs"
-    for part in log_dir.glob("*.part"):  # left by a process killed while writing
-        part.unlink()
-    done_names = {p.name for p in log_dir.glob("*.log")}
-    executor = executor if executor is not None else make_executor(int(cfg["workers"]))
-    isolated = getattr(executor, "fresh_process_per_task", True)
-    shared_fs = getattr(executor, "shares_filesystem", True)
-    in_process = not isolated
-    n_threads = None if in_process or int(cfg["workers"]) == 1 and shared_fs else 1
-    tasks = []
-    for k, q in enumerate(meta["query_data"]):
-        specs = [s for s in _experiment_specs(cfg, k) if _log_name(q, k, s) not in done_names]
-        if specs:
-            tasks.append({"config": cfg, "query": q, "qpos": k, "query_set": meta["query_set"], "seed": cfg["seed"] + k,
-                          "specs": specs, "log_dir": str(log_dir) if shared_fs else None, "n_threads": n_threads,
-                          "sys_path": [p for p in sys.path if p]})
-    fn = run_query_task if shared_fs else run_task_in_subprocess
-    meta["executor"] = executor.description
-    log.info("campaign %s: %d queries, %d experiments (%d to run) on %s", directory, len(meta["query_data"]),
-             meta["expected_experiments"], sum(len(t["specs"]) for t in tasks), executor.description)
     interrupted = False
     t0 = time.perf_counter()
-    bar = tqdm(total=len(tasks), desc=f"{cfg['name']} queries", unit="query", disable=not progress_bar)
-    try:
-        with _sigterm_as_keyboard_interrupt():
-            try:
+    with _sigterm_as_keyboard_interrupt():
+        try:
+            from tqdm import tqdm
+
+            from .executors import make_executor, run_task_in_subprocess
+
+            for part in log_dir.glob("*.part"):  # left by a process killed while writing
+                part.unlink()
+            done_names = {p.name for p in log_dir.glob("*.log")}
+            executor = executor if executor is not None else make_executor(int(cfg["workers"]))
+            in_process = not getattr(executor, "fresh_process_per_task", True)
+            shared_fs = getattr(executor, "shares_filesystem", True)
+            n_threads = None if in_process or int(cfg["workers"]) == 1 and shared_fs else 1
+            tasks = []
+            for k, q in enumerate(meta["query_data"]):
+                specs = [s for s in _experiment_specs(cfg, k) if _log_name(q, k, s) not in done_names]
+                if specs:
+                    tasks.append({"config": cfg, "query": q, "qpos": k, "query_set": meta["query_set"],
+                                  "seed": cfg["seed"] + k, "specs": specs, "n_threads": n_threads,
+                                  "log_dir": str(log_dir) if shared_fs else None,
+                                  "sys_path": [p for p in sys.path if p]})
+            fn = run_query_task if shared_fs else run_task_in_subprocess
+            meta["executor"] = executor.description
+            log.info("campaign %s: %d queries, %d experiments (%d to run) on %s", directory, len(meta["query_data"]),
+                     meta["expected_experiments"], sum(len(t["specs"]) for t in tasks), executor.description)
+            with tqdm(total=len(tasks), desc=f"{cfg['name']} queries", unit="query", disable=not progress_bar) as bar:
                 for res in executor.run(fn, tasks):
                     written = _store_task_result(directory, res)
                     bar.update(1)
                     if on_task_done:
                         on_task_done(written)
-                executor.shutdown()
-            except KeyboardInterrupt:
-                interrupted = True
-                log.warning("interrupted: building the database from the finished logs")
+            executor.shutdown()
+        except KeyboardInterrupt:
+            interrupted = True
+            log.warning("interrupted: building the database from the finished logs")
+        finally:
+            if executor is not None:
                 executor.shutdown(cancel=True)
-            finally:
-                bar.close()
-            for part in log_dir.glob("*.part"):
-                part.unlink()
-            logs = sorted(log_dir.glob("*.log"))
-            meta.update({"finished_utc": _dt.datetime.now(_dt.timezone.utc).isoformat(), "interrupted": interrupted,
-                         "finished_experiments": len(logs), "wall_time_s": time.perf_counter() - t0})
-            result = CampaignResult(directory=directory, logs=logs, database=None, interrupted=interrupted)
-            if logs:
-                result.database, result.skipped_logs = build_database(logs, directory / "benchmark.db")
-                meta["corrupt_logs"] = [p.name for p in result.skipped_logs]
-            _write_json(directory / "campaign.json", meta)
-            if result.database is not None and report:
-                from . import plots
-                from . import report as rep
+        for part in log_dir.glob("*.part"):
+            part.unlink()
+        logs = sorted(log_dir.glob("*.log"))
+        meta.update({"finished_utc": _dt.datetime.now(_dt.timezone.utc).isoformat(), "interrupted": interrupted,
+                     "finished_experiments": len(logs), "wall_time_s": time.perf_counter() - t0})
+        result = CampaignResult(directory=directory, logs=logs, database=None, interrupted=interrupted)
+        if logs:
+            result.database, result.skipped_logs = build_database(logs, directory / "benchmark.db")
+            meta["corrupt_logs"] = [p.name for p in result.skipped_logs]
+        _write_json(directory / "campaign.json", meta)
+        if result.database is not None and report:
+            from . import plots
+            from . import report as rep
 
-                result.report = rep.write_report(result.database, directory, expected=meta)
-                result.plots = plots.make_plots(result.database, directory / "plots")
-    finally:
-        executor.shutdown(cancel=True)
+            result.report = rep.write_report(result.database, directory, expected=meta)
+            result.plots = plots.make_plots(result.database, directory / "plots")
     return result
 
 
@@ -1109,7 +1112,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         else:
             result = run_campaign(config, executor=executor, progress_bar=not args.no_progress)
     except KeyboardInterrupt:  # a second Ctrl-C while the database was built
-        print("interrupted; finished logs are kept: rerun with --resume", file=sys.stderr)
+        print("interrupted; finished logs are kept: finish the campaign with --resume DIR", file=sys.stderr)
         return 130
     if result.report.get("markdown_text"):
         print(result.report["markdown_text"])
