@@ -108,8 +108,8 @@ def test_native_planner_exact_paths_pass_strict_check(robot: WearerArm, queries:
         if ss.haveExactSolutionPath():
             exact += 1
             assert _strict_failures(robot, ss, q) == [], (name, q.id)
-    if name in ("RRTConnect", "BITstar"):
-        assert exact >= 2, f"{name}: {exact}/3 exact solutions"
+    if name in ("RRTConnect", "BITstar"):  # these find exact paths in well under their budget
+        assert exact >= 1, f"{name}: {exact}/3 exact solutions: the strict check tested nothing"
 
 
 def test_aorrtc_exact_paths_are_strict_or_rejected(robot: WearerArm, queries: list[Query]) -> None:
