@@ -102,7 +102,8 @@ def test_exceptions_in_planner_callbacks_are_failed_runs_and_ompl_logging_stays_
     res = run_campaign(cfg, report=False, progress_bar=False)
     rows = {name: (status, solved, err) for name, status, solved, err in _runs(res.database)}
     assert rows["geometric_SolveRaises"] == (7, 0, 1) and rows["geometric_SetupRaises"] == (7, 0, 1)
-    assert rows["geometric_RRTstar"] == (6, 1, 0)  # the rest of the experiment ran
+    status, _, err = rows["geometric_RRTstar"]
+    assert status in (4, 5, 6) and err == 0  # the rest of the experiment ran (20 iterations may not solve)
     assert len(_runs(res.database)) == 3
     assert ou.getOutputHandler() is not None
 
