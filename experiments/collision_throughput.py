@@ -56,6 +56,9 @@ def main(argv: list[str] | None = None) -> dict[str, float]:
         "WearerArm.are_valid (batched)": _median_us(lambda: robot.are_valid(Q), args.n, args.repeats),
         "raw Pinocchio single (computeCollisions loop)": _median_us(raw_single, n_single, args.repeats),
         "WearerArm.is_valid (single)": _median_us(lambda: [robot.is_valid(q) for q in Q[:n_single]], n_single, args.repeats),
+        "WearerArm.is_valid_values (single, OMPL checker path)": _median_us(
+            lambda: [robot.is_valid_values(q) for q in Q[:n_single].tolist()], n_single, args.repeats
+        ),
         "WearerArm.line_of_sight_clear (single)": _median_us(
             lambda: [robot.line_of_sight_clear(q, t) for q, t in aimed], len(aimed), args.repeats
         ),

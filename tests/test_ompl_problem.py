@@ -115,3 +115,11 @@ def test_bad_joint_step_raises(robot, step):
 def test_motion_states_match_ompl_subdivision():
     s = motion_states(np.zeros(4), np.array([1.0, 0, 0, 0]), 0.3)
     np.testing.assert_allclose(s[:, 0], [0.25, 0.5, 0.75, 1.0])
+
+
+def test_ompl_state_checker_agrees_with_the_model_inside_and_outside_the_limits(robot, rng):
+    si = make_simple_setup(robot).getSpaceInformation()
+    s = si.allocState()
+    for q in rng.uniform(robot.lower - 0.2, robot.upper + 0.2, size=(2000, 4)):
+        assert si.isValid(set_state(s, q)) == robot.is_valid(q)
+    assert not robot.is_valid_values([float("nan"), 0.0, 0.0, 0.0])

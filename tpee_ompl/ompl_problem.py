@@ -98,11 +98,11 @@ class WearerValidityChecker(ob.StateValidityChecker):
     def __init__(self, si: ob.SpaceInformation, robot: WearerArm) -> None:
         super().__init__(si)
         self.robot = robot
-        self._n = robot.nq
+        self._indices = range(robot.nq)
 
     def isValid(self, state: ob.State) -> bool:  # noqa: N802 (OMPL override)
         """True if the state is collision-free with the security margin."""
-        return self.robot.is_valid(np.array([state[i] for i in range(self._n)]))
+        return self.robot.is_valid_values([state[i] for i in self._indices])
 
     def are_valid(self, Q: np.ndarray) -> np.ndarray:
         """Batched validity of configurations Q (N, nq)."""

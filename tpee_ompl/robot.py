@@ -12,6 +12,7 @@ import hashlib
 import logging
 import os
 import xml.etree.ElementTree as ET
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -241,6 +242,8 @@ class WearerArm:
         self.muzzle_frame_id = self.model.getFrameId(MUZZLE_FRAME)
         self.lower = self.model.lowerPositionLimit.copy()
         self.upper = self.model.upperPositionLimit.copy()
+        self._lower_list = self.lower.tolist()
+        self._upper_list = self.upper.tolist()
         self._build_line_of_sight_shapes()
         log.debug("loaded %s: %d geometries, %d pairs", urdf, self.gmodel.ngeoms, len(self.gmodel.collisionPairs))
 
@@ -399,6 +402,18 @@ class WearerArm:
             return False
         self.collision_checks += 1
         return not pin.computeCollisions(self.model, self.data, self.gmodel, self.gdata, q, True)
+
+    def is_valid_values(self, values: Sequence[float]) -> bool:
+        """:meth:`is_valid` for nq plain floats (an OMPL state's values), without the input checks.
+
+        The per-state OMPL checker calls this ~10^5 times per plan.  NaN fails the limit test, so a
+        non-finite value is still reported invalid rather than passed to Pinocchio.
+        """
+        for v, lo, hi in zip(values, self._lower_list, self._upper_list):
+            if not lo <= v <= hi:
+                return False
+        self.collision_checks += 1
+        return not pin.computeCollisions(self.model, self.data, self.gmodel, self.gdata, np.array(values), True)
 
     def are_valid(self, Q: np.ndarray) -> np.ndarray:
         """Batched :meth:`is_valid` for Q of shape (N, nq): one Pinocchio call; returns bool (N,)."""
