@@ -220,10 +220,10 @@ def make_simple_setup(
         if check_endpoints:
             for name, q in (("start", q0), ("goal", q1)):
                 if not robot.within_limits(q):
-                    raise ValueError(f"{name} {np.round(q, 4).tolist()} is outside the joint limits")
+                    raise ValueError(f"{name} [{', '.join(f'{v:.4g}' for v in q)}] is outside the joint limits")
                 if not robot.is_valid(q):
                     a, b, d = robot.closest_pair(q)
-                    raise ValueError(f"{name} {np.round(q, 4).tolist()} is in collision ({a} vs {b}, distance {d:.3f} m)")
+                    raise ValueError(f"{name} [{', '.join(f'{v:.4g}' for v in q)}] is in collision ({a} vs {b}, distance {d:.3f} m)")
         s0, s1 = si.allocState(), si.allocState()
         set_state(s0, q0)
         set_state(s1, q1)
