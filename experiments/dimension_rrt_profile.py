@@ -2,6 +2,7 @@
 the time split (collision checking vs Python overhead) and RRT* at equal samples.
 
     .venv/bin/python experiments/dimension_rrt_profile.py --reps 2 --samples 500 2500 --rrtstar
+    .venv/bin/python experiments/dimension_rrt_profile.py --queries planning_necessary --reps 2 --samples 500 2500
 
 Prints one table row per (samples, batch) and writes ``--out`` (JSON rows) when given.
 """
@@ -33,6 +34,8 @@ def get_argument_parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--rrtstar", action="store_true", help="also time og.RRTstar at equal iterations")
     p.add_argument("--out", default=None, help="JSON file for the rows")
+    p.add_argument("--queries", default=None,
+                   help="stored query set (e.g. planning_necessary): its first --reps queries of each pair type")
     return p
 
 
@@ -63,7 +66,14 @@ def run(args: argparse.Namespace) -> list[dict]:
     ou.setLogLevel(ou.LOG_WARN)
     robot = WearerArm(security_margin=args.margin)
     rng = np.random.default_rng(args.seed)
-    queries = [(i, j, *cross_sector_query(robot, i, j, rng)) for _ in range(args.reps) for i, j in PAIR_TYPES]
+    if args.queries:
+        from tpee_ompl.queries import load_queries
+
+        stored = load_queries(args.queries, robot if args.margin == 0.02 else None)
+        queries = [(q.from_sector, q.to_sector, np.asarray(q.start), np.asarray(q.goal)) for i, j in PAIR_TYPES
+                   for q in [q for q in stored if (q.from_sector, q.to_sector) == (i, j)][: args.reps]]
+    else:
+        queries = [(i, j, *cross_sector_query(robot, i, j, rng)) for _ in range(args.reps) for i, j in PAIR_TYPES]
     rows = []
     for n in args.samples:
         for batch in (True, False):
