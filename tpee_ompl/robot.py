@@ -181,6 +181,7 @@ class WearerArm:
         self.files = _LoadedFiles(urdf, srdf)
         self.security_margin = float(security_margin)
         self.n_threads = int(n_threads) if n_threads is not None else min(2, os.cpu_count() or 1)
+        self._lever_arms: np.ndarray | None = None
         self.collision_checks = 0
         """Configurations checked for collision so far (single and batched)."""
         self._load()
@@ -328,7 +329,13 @@ class WearerArm:
         """Upper bound, per joint, on the distance from that joint's axis to any arm point it moves (metres).
 
         Used to bound how far the arm can move for a given joint step (see :meth:`max_joint_step`).
+        The model is fixed after loading, so this is computed once.
         """
+        if self._lever_arms is None:
+            self._lever_arms = self._compute_lever_arms()
+        return self._lever_arms.copy()
+
+    def _compute_lever_arms(self) -> np.ndarray:
         n = self.nq
         reach = np.zeros(n)
         for j in range(1, n + 1):
