@@ -216,15 +216,15 @@ def _necessary_queries(pairs, n: int):
     return [q for q in load_queries("planning_necessary") if (q.from_sector, q.to_sector) in pairs][:n]
 
 
-def test_motion_check_states_are_the_ompl_motion_states_of_every_segment(robot: WearerArm, rng) -> None:
+def test_polyline_motion_states_are_the_ompl_motion_states_of_every_segment(robot: WearerArm, rng) -> None:
     from tpee_ompl.ompl_problem import motion_states
-    from tpee_ompl.path_library import motion_check_states
+    from tpee_ompl.ompl_problem import polyline_motion_states
 
     path = np.cumsum(rng.uniform(-0.05, 0.05, (30, 4)), axis=0)
     path[10] = path[9]  # a zero-length segment still checks its end state once
     step = robot.max_joint_step()
     expected = np.vstack([path[:1]] + [motion_states(a, b, step) for a, b in itertools.pairwise(path)])
-    np.testing.assert_allclose(motion_check_states(path, step), expected, atol=1e-15)
+    np.testing.assert_allclose(polyline_motion_states(path, step), expected, atol=1e-15)
 
 
 def test_default_sampler_draws_planning_necessary_motions_from_the_presets(robot: WearerArm) -> None:

@@ -33,6 +33,7 @@ __all__ = [
     "path_to_array",
     "array_to_path",
     "motion_states",
+    "polyline_motion_states",
     "MIN_JOINT_STEP",
 ]
 
@@ -87,6 +88,28 @@ def motion_states(a: np.ndarray, b: np.ndarray, step: float, include_start: bool
     n = max(1, math.ceil(float(np.linalg.norm(b - a)) / step))
     t = np.arange(0 if include_start else 1, n + 1) / n
     return a + t[:, None] * (b - a)
+
+
+def polyline_motion_states(path: np.ndarray, step: float) -> np.ndarray:
+    """All states ``si.checkMotion`` checks along the polyline ``path`` (K, n), plus its first state.
+
+    For each segment a -> b: ``n = max(1, ceil(|b - a| / step))`` states ``a + (k / n)(b - a)``,
+    k = 1..n, exactly those of :func:`motion_states` (OMPL's discrete motion validator), built
+    for all segments at once; shape (1 + sum n, n).
+    """
+    path = np.asarray(path, dtype=float)
+    if path.ndim != 2 or len(path) < 1:
+        raise ValueError(f"path must have shape (K >= 1, n); got {path.shape}")
+    if not step > 0:
+        raise ValueError(f"step must be > 0, got {step!r}")
+    delta = np.diff(path, axis=0)
+    if len(delta) == 0:
+        return path[:1].copy()
+    counts = np.maximum(1, np.ceil(np.linalg.norm(delta, axis=1) / step)).astype(np.int64)
+    seg = np.repeat(np.arange(len(delta)), counts)
+    k = np.arange(1, counts.sum() + 1) - np.repeat(np.cumsum(counts) - counts, counts)
+    states = path[seg] + (k / counts[seg])[:, None] * delta[seg]
+    return np.vstack([path[:1], states])
 
 
 class WearerValidityChecker(ob.StateValidityChecker):

@@ -38,6 +38,7 @@ from pathlib import Path
 import numpy as np
 
 from .dmp import DMP, DMPOptions, generate_blended, learn_dmp
+from .ompl_problem import polyline_motion_states
 from .robot import WearerArm
 from .sectors import check_sector, cross_sector_trajectory
 
@@ -50,7 +51,6 @@ __all__ = [
     "QueryResult",
     "benchmark_queries",
     "dimension_rrt_planner",
-    "motion_check_states",
     "motion_is_valid",
     "path_length",
     "query_sampler",
@@ -90,37 +90,15 @@ def resample_waypoints(waypoints: np.ndarray, per_step: int = 100) -> np.ndarray
     return np.vstack([seg.reshape(-1, W.shape[1]), W[-1:]])
 
 
-def motion_check_states(path: np.ndarray, step: float) -> np.ndarray:
-    """All states ``si.checkMotion`` checks along the polyline ``path`` (K, n), plus its first state.
-
-    For each segment a -> b: ``n = max(1, ceil(|b - a| / step))`` states ``a + (k / n)(b - a)``,
-    k = 1..n, exactly those of :func:`tpee_ompl.ompl_problem.motion_states` (OMPL's discrete
-    motion validator), built for all segments at once; shape (1 + sum n, n).
-    """
-    path = np.asarray(path, dtype=float)
-    if path.ndim != 2 or len(path) < 1:
-        raise ValueError(f"path must have shape (K >= 1, n); got {path.shape}")
-    if not step > 0:
-        raise ValueError(f"step must be > 0, got {step!r}")
-    delta = np.diff(path, axis=0)
-    if len(delta) == 0:
-        return path[:1].copy()
-    counts = np.maximum(1, np.ceil(np.linalg.norm(delta, axis=1) / step)).astype(np.int64)
-    seg = np.repeat(np.arange(len(delta)), counts)
-    k = np.arange(1, counts.sum() + 1) - np.repeat(np.cumsum(counts) - counts, counts)
-    states = path[seg] + (k / counts[seg])[:, None] * delta[seg]
-    return np.vstack([path[:1], states])
-
-
 def motion_is_valid(robot: WearerArm, path: np.ndarray, step: float | None = None) -> bool:
     """True if the first state and every straight segment of ``path`` (K, 4) pass the motion check.
 
-    Checks the states of :func:`motion_check_states` (those ``si.checkMotion`` checks in a
+    Checks the states of :func:`~tpee_ompl.ompl_problem.polyline_motion_states` (those ``si.checkMotion`` checks in a
     :func:`~tpee_ompl.ompl_problem.make_simple_setup` setup at resolution ``step``, default
     ``robot.max_joint_step()``) in ONE batched ``robot.are_valid`` call.
     """
     step = robot.max_joint_step() if step is None else float(step)
-    return bool(robot.are_valid(motion_check_states(path, step)).all())
+    return bool(robot.are_valid(polyline_motion_states(path, step)).all())
 
 
 def path_length(path: np.ndarray) -> float:

@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .ompl_problem import motion_states
+from .ompl_problem import polyline_motion_states
 from .pointing import PointingGeometry, aim_checked
 from .robot import WearerArm
 from .sectors import (
@@ -214,7 +214,7 @@ def straight_motion_valid(
 ) -> bool:
     """True if every state along the straight motion (checked every ``step`` rad) is collision-free."""
     w = straight_motion(start, goal, i, j)
-    states = np.concatenate([motion_states(w[k], w[k + 1], step) for k in range(len(w) - 1)])
+    states = polyline_motion_states(w, step)
     return bool(robot.are_valid(states).all())
 
 

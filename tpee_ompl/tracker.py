@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .ompl_problem import MIN_JOINT_STEP, motion_states
+from .ompl_problem import MIN_JOINT_STEP, motion_states, polyline_motion_states
 from .pointing import AimingError, PointingGeometry, aim_batch, check_target
 from .robot import WearerArm, _as_float_array
 from .sectors import SECTORS, check_sector, in_pointing_sector, posture_preset, posture_sector
@@ -182,9 +182,8 @@ class Tracker:
         if not (np.allclose(waypoints[0], self.q, atol=1e-6) and np.allclose(waypoints[-1], goal, atol=1e-6)):
             raise ValueError("planner path does not start at the current configuration and end at the goal")
         waypoints[0], waypoints[-1] = self.q, goal
-        for a, b in itertools.pairwise(waypoints):
-            if not self._motion_free(a, b):
-                raise ValueError(f"planner path {self.sector}->{k} collides (checked every {self.options.check_step} rad)")
+        if not self.robot.are_valid(polyline_motion_states(waypoints, self.options.check_step)).all():
+            raise ValueError(f"planner path {self.sector}->{k} collides (checked every {self.options.check_step} rad)")
         self.events.append(TrackEvent(t, "cross-sector", k, f"{self.sector}->{k}: {why}, {len(waypoints)} waypoints"))
         clock = t
         for a, b in itertools.pairwise(waypoints):
@@ -285,7 +284,7 @@ def make_default_planner(robot: WearerArm, *, timeout: float = 2.0, seed: int | 
 
     def plan(start: np.ndarray, goal: np.ndarray, i: int, j: int) -> np.ndarray:
         w = straight_motion(start, goal, i, j) if i != j else np.array([start, goal], dtype=float)
-        if all(robot.are_valid(motion_states(a, b, step)).all() for a, b in itertools.pairwise(w)):
+        if robot.are_valid(polyline_motion_states(w, step)).all():
             return w
         ss = make_simple_setup(robot, start, goal)
         ss.setPlanner(og.RRTConnect(ss.getSpaceInformation()))
