@@ -69,6 +69,35 @@ def test_same_seed_and_sample_cap_give_identical_path(robot: WearerArm) -> None:
     np.testing.assert_array_equal(paths[0], paths[1])
 
 
+def test_valid_initial_waypoints_are_the_first_solution_and_only_get_shorter(robot: WearerArm) -> None:
+    q0, q1 = cross_sector_query(robot, 1, 3, np.random.default_rng(5))
+    ss, planner, _ = _solve(robot, 1, 3, q0, q1, max_samples=SAMPLES, seed=2)
+    W = path_to_array(ss.getSolutionPath(), 4)
+    ss2, planner2, status = _solve(robot, 1, 3, q0, q1, max_samples=1, seed=9, initial_waypoints=W)
+    assert status == ob.PlannerStatus.EXACT_SOLUTION
+    stats = planner2.last_run_stats()
+    assert stats["first_solution_time"] is not None and stats["progress"][0][1] == pytest.approx(ss.getSolutionPath().length())
+    assert ss2.getSolutionPath().length() <= ss.getSolutionPath().length() + 1e-12
+    assert planner2.settings()["initial_waypoints"] == "set"
+
+
+def test_invalid_initial_waypoints_are_checked_not_trusted(robot: WearerArm) -> None:
+    q0, q1 = cross_sector_query(robot, 4, 2, np.random.default_rng(6))
+    ss = make_simple_setup(robot, q0, q1)
+    planner = tpee_dimension_rrt(ss.getSpaceInformation(), 4, 2, max_samples=SAMPLES, seed=1)
+    W = planner.grouped.initial_waypoints(q0, q1)
+    W[1:-1, 2:] = 0.0  # pan/tilt straight ahead at every intermediate step, through whatever is there
+    planner.set_initial_waypoints(W)
+    ss.setPlanner(planner)
+    assert ss.solve(30.0) == ob.PlannerStatus.EXACT_SOLUTION
+    si = ss.getSpaceInformation()
+    states = ss.getSolutionPath().getStates()
+    assert all(si.checkMotion(a, b) for a, b in zip(states[:-1], states[1:]))
+    np.testing.assert_allclose(path_to_array(ss.getSolutionPath(), 4)[:, :2], planner.prescribed[0])
+    planner.set_initial_waypoints(None)
+    assert planner.settings()["initial_waypoints"] == "none"
+
+
 def test_batched_and_per_state_checks_agree(robot: WearerArm) -> None:
     q0, q1 = cross_sector_query(robot, 2, 3, np.random.default_rng(3))
     a = _solve(robot, 2, 3, q0, q1, max_samples=150, seed=5)[0].getSolutionPath()
@@ -110,6 +139,9 @@ def test_runs_inside_ompl_benchmark(robot: WearerArm, tmp_path) -> None:
         ({"seed": -3}, "seed"),
         ({"prescribed": {0: np.zeros((5, 2))}}, "shape"),
         ({"prescribed": {4: np.zeros((7, 2))}}, "not a group index"),
+        ({"initial_waypoints": np.zeros((5, 4))}, "initial_waypoints must have shape"),
+        ({"initial_waypoints": np.full((7, 4), np.nan)}, "NaN"),
+        ({"initial_waypoints": np.full((7, 4), 100.0)}, "outside the state space bounds"),
     ],
 )
 def test_bad_parameters_raise(robot: WearerArm, kwargs: dict, match: str) -> None:

@@ -207,6 +207,7 @@ class _Search:
         narrow_after: int,
         narrowing: float,
         range_: np.ndarray,
+        initial: np.ndarray | None = None,
     ) -> None:
         self.g = grouped
         self.checker = checker
@@ -216,6 +217,10 @@ class _Search:
         self.range_ = range_
         self.dist = grouped.layout.distance
         W = grouped.initial_waypoints(start, goal)
+        if initial is not None:
+            for gi in grouped.planned:
+                d = grouped.group_dims(gi)
+                W[1:-1, d] = initial[1:-1, d]
         self.W = W
         V = np.ones(len(W), dtype=bool)
         V[1:-1] = checker.states(W[1:-1])
@@ -467,6 +472,10 @@ class DimensionRRT(ob.Planner):
         Planner name (``geometric_<name>`` in a Benchmark database).
     batch : bool
         Use the checker's batched ``are_valid`` when it has one (default True).
+    initial_waypoints : array (h, n), optional
+        A first guess of the path (e.g. a DMP path from :mod:`tpee_ompl.path_library`): the
+        planned groups' intermediate waypoints start there instead of on the straight line
+        (see :meth:`set_initial_waypoints`).
 
     Raises
     ------
@@ -489,6 +498,7 @@ class DimensionRRT(ob.Planner):
         name: str = "DimensionRRT",
         *,
         batch: bool = True,
+        initial_waypoints: np.ndarray | None = None,
     ) -> None:
         # Validate everything BEFORE super().__init__: an exception raised after it leaves a
         # half-constructed nanobind trampoline whose collection crashed the interpreter.
@@ -523,6 +533,7 @@ class DimensionRRT(ob.Planner):
                 rng_full = None
             if rng_full is None or not np.all(np.isfinite(rng_full)) or np.any(rng_full <= 0):
                 raise ValueError(f"range_ must be a positive number or array of {layout.n}, got {range_!r}")
+        initial = self._check_initial(grouped, initial_waypoints)
         super().__init__(si, name)
         self.grouped = grouped
         self.h = self.grouped.h
@@ -537,6 +548,34 @@ class DimensionRRT(ob.Planner):
         self._rng = np.random.default_rng(seed)
         self._stats: dict[str, Any] = self._empty_stats()
         self._ranges = {gi: rng_full[self.grouped.group_dims(gi)] for gi in self.grouped.planned}
+        self._initial = initial
+
+    @staticmethod
+    def _check_initial(grouped: GroupedSpace, W: np.ndarray | None) -> np.ndarray | None:
+        if W is None:
+            return None
+        layout = grouped.layout
+        try:
+            arr = np.array(W, dtype=float)
+        except (TypeError, ValueError):
+            raise ValueError(f"initial_waypoints must be a numeric array of shape ({grouped.h}, {layout.n})") from None
+        if arr.shape != (grouped.h, layout.n):
+            raise ValueError(f"initial_waypoints must have shape ({grouped.h}, {layout.n}), got {arr.shape}")
+        if not np.all(np.isfinite(arr)):
+            raise ValueError("initial_waypoints contains NaN or inf")
+        if np.any(arr < layout.lower - 1e-12) or np.any(arr > layout.upper + 1e-12):
+            raise ValueError("initial_waypoints lie outside the state space bounds")
+        return arr
+
+    def set_initial_waypoints(self, W: np.ndarray | None) -> None:
+        """Start the next solves from the waypoints W (h, n) instead of the straight line; None to unset.
+
+        Only the planned groups' intermediate waypoints are taken from W: start, goal and the
+        prescribed groups always come from the problem.  Nothing in W is trusted: its waypoints and
+        motions are checked like any other, and an invalid W only gives the feasibility phase a head
+        start (its valid prefix and suffix seed the layered trees).  Kept across :meth:`clear`.
+        """
+        self._initial = self._check_initial(self.grouped, W)
 
     # ------------------------------------------------------------------ reporting
     def settings(self) -> dict[str, str]:
@@ -551,6 +590,7 @@ class DimensionRRT(ob.Planner):
             "narrowing": str(self.narrowing),
             "range": str([round(float(v), 6) for v in self.range_]),
             "batch": str(self.batch),
+            "initial_waypoints": "none" if self._initial is None else "set",
         }
 
     @staticmethod
@@ -622,7 +662,8 @@ class DimensionRRT(ob.Planner):
             return _status(ob.PlannerStatus.INVALID_START if mismatch == "start" else ob.PlannerStatus.INVALID_GOAL)
         checker = _Checker(si, layout, self.batch)
         checks0 = checker.counter()
-        search = _Search(self.grouped, checker, self._rng, q0, q1, self.narrow_after, self.narrowing, self._ranges)
+        search = _Search(self.grouped, checker, self._rng, q0, q1, self.narrow_after, self.narrowing, self._ranges,
+                         self._initial)
         stats = self._stats
         progress = stats["progress"]
         best_W, best_cost, first_time = None, math.inf, None
