@@ -114,6 +114,31 @@ def test_security_margin_makes_near_contacts_invalid(robot, rng):
     np.testing.assert_array_equal(robot.are_valid(Q), d >= robot.security_margin)
 
 
+def test_link_margins_raise_the_margin_of_the_named_links_only(robot, rng):
+    Q = rng.uniform(robot.lower, robot.upper, size=(1500, 4))
+    wide = WearerArm(link_margins={"link3": 0.035, "link4": 0.035})
+    pairs = [robot.closest_pair(q) for q in Q]
+    pointing = np.array([a.startswith(("link3", "link4")) or b.startswith(("link3", "link4")) for a, b, _ in pairs])
+    valid, valid_wide = robot.are_valid(Q), wide.are_valid(Q)
+    assert not np.any(valid_wide & ~valid)  # never looser than the base margin
+    d = np.array([p[2] for p in pairs])
+    # where the closest pair is not a pointing-system one and clears 3.5 cm, nothing changes
+    np.testing.assert_array_equal(valid_wide[~pointing & (d >= 0.035)], valid[~pointing & (d >= 0.035)])
+    # a pointing-system pair between 2 and 3.5 cm is valid at 2 cm and invalid with the wider margin
+    near = pointing & (d > 0.021) & (d < 0.034)
+    assert near.any() and valid[near].all() and not valid_wide[near].any()
+
+
+@pytest.mark.parametrize(
+    "link_margins, match",
+    [({"link4": 0.01}, "link_margins"), ({"link4": float("nan")}, "link_margins"), ({"tentacle": 0.03}, "unknown link"),
+     ([("link4", 0.03)], "mapping")],
+)
+def test_bad_link_margins_raise_value_error(link_margins, match):
+    with pytest.raises(ValueError, match=match):
+        WearerArm(link_margins=link_margins)
+
+
 def test_collision_checks_are_counted(robot, rng):
     before = robot.collision_checks
     robot.are_valid(rng.uniform(robot.lower, robot.upper, size=(25, 4)))

@@ -12,7 +12,7 @@ import hashlib
 import logging
 import os
 import xml.etree.ElementTree as ET
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -145,6 +145,10 @@ class WearerArm:
         Pairs closer than this count as colliding (Coal security margin).
     n_threads : int or None
         Threads for batched checks (default: all cores, at most 2).
+    link_margins : mapping {link name: metres}, optional
+        Larger margins for the pairs that involve a geometry of these links (the larger of the two
+        applies), e.g. ``{"link3": 0.03, "link4": 0.03}`` to plan demonstrations that keep more
+        room around the pointing system only.  Never smaller than ``security_margin``.
     """
 
     def __init__(
@@ -153,6 +157,7 @@ class WearerArm:
         srdf_path: str | os.PathLike | None | bool = None,
         security_margin: float = DEFAULT_SECURITY_MARGIN,
         n_threads: int | None = None,
+        link_margins: Mapping[str, float] | None = None,
     ) -> None:
         if (
             isinstance(security_margin, bool)
@@ -180,6 +185,7 @@ class WearerArm:
             srdf = Path(srdf_path)
         self.files = _LoadedFiles(urdf, srdf)
         self.security_margin = float(security_margin)
+        self.link_margins = self._check_link_margins(link_margins, self.security_margin)
         self.n_threads = int(n_threads) if n_threads is not None else min(2, os.cpu_count() or 1)
         self._lever_arms: np.ndarray | None = None
         self.collision_checks = 0
@@ -271,7 +277,7 @@ class WearerArm:
         """
         pin.forwardKinematics(self.model, self.data, pin.neutral(self.model))
         pivot = self.data.oMi[1].translation.copy()
-        reach = self.lever_arms()[0] + self.security_margin
+        reach = self.lever_arms()[0] + max([self.security_margin, *self.link_margins.values()])
         removed = []
         for cp in list(self.gmodel.collisionPairs):
             a, b = self.gmodel.geometryObjects[cp.first], self.gmodel.geometryObjects[cp.second]
@@ -285,10 +291,43 @@ class WearerArm:
             self.gmodel.removeCollisionPair(cp)
         self.pruned_pairs = len(removed)
 
+    @staticmethod
+    def _check_link_margins(link_margins: Mapping[str, float] | None, base: float) -> dict[str, float]:
+        if link_margins is None:
+            return {}
+        if not isinstance(link_margins, Mapping):
+            raise ValueError(f"link_margins must be a mapping {{link name: metres}}, got {link_margins!r}")
+        out = {}
+        for name, m in link_margins.items():
+            if (
+                not isinstance(name, str)
+                or isinstance(m, bool)
+                or not isinstance(m, (int, float, np.integer, np.floating))
+                or not base <= float(m) <= MAX_SECURITY_MARGIN
+            ):
+                raise ValueError(
+                    f"link_margins[{name!r}] must be a number in [security_margin = {base}, {MAX_SECURITY_MARGIN}] "
+                    f"metres, got {m!r}"
+                )
+            out[name] = float(m)
+        return out
+
+    def _margin_matrix(self) -> np.ndarray:
+        """(ng, ng) security margins: the base margin, raised for the pairs touching ``link_margins``."""
+        ng = self.gmodel.ngeoms
+        per_geom = np.full(ng, self.security_margin)
+        frames = {f.name for f in self.model.frames}
+        unknown = sorted(set(self.link_margins) - frames)
+        if unknown:
+            raise ValueError(f"link_margins names unknown link(s) {unknown}")
+        for k, g in enumerate(self.gmodel.geometryObjects):
+            per_geom[k] = max(per_geom[k], self.link_margins.get(self.model.frames[g.parentFrame].name, 0.0))
+        return np.maximum(per_geom[:, None], per_geom[None, :])
+
     def _rebuild_geometry_data(self) -> None:
         self.gdata = pin.GeometryData(self.gmodel)
         ng = self.gmodel.ngeoms
-        self.gdata.setSecurityMargins(self.gmodel, np.full((ng, ng), self.security_margin))
+        self.gdata.setSecurityMargins(self.gmodel, self._margin_matrix())
         for req in self.gdata.collisionRequests:
             req.enable_contact = True  # Coal misses edge/corner contacts otherwise
         self.pool = pin.GeometryPool(self.model, self.gmodel, self.n_threads)
