@@ -71,7 +71,7 @@ def test_same_seed_and_sample_cap_give_identical_path(robot: WearerArm) -> None:
 
 def test_valid_initial_waypoints_are_the_first_solution_and_only_get_shorter(robot: WearerArm) -> None:
     q0, q1 = cross_sector_query(robot, 1, 3, np.random.default_rng(5))
-    ss, planner, _ = _solve(robot, 1, 3, q0, q1, max_samples=SAMPLES, seed=2)
+    ss, _, _ = _solve(robot, 1, 3, q0, q1, max_samples=SAMPLES, seed=2)
     W = path_to_array(ss.getSolutionPath(), 4)
     ss2, planner2, status = _solve(robot, 1, 3, q0, q1, max_samples=1, seed=9, initial_waypoints=W)
     assert status == ob.PlannerStatus.EXACT_SOLUTION

@@ -62,6 +62,12 @@ def test_query_without_a_query_names_the_missing_options(small_file: str) -> Non
         _run(["library", "query", "--library", small_file, "--from", "1", "--to", "2"])
 
 
+@pytest.mark.parametrize("extra, match", [(["--workers", "0"], "--workers"), (["--demo-margins", "nan"], "--demo-margins")])
+def test_bad_build_options_name_the_option(extra: list[str], match: str, tmp_path) -> None:
+    with pytest.raises(ValueError, match=match):
+        _run(["library", "build", "--pairs", "1-2", "--library", str(tmp_path / "x.npz"), *extra])
+
+
 def test_bad_sector_pair_is_a_usage_error(capsys) -> None:
     with pytest.raises(SystemExit):
         build_parser().parse_args(["library", "build", "--pairs", "2-2"])

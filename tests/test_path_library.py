@@ -164,6 +164,29 @@ def test_colliding_dmp_path_is_never_returned(robot: WearerArm, library: PathLib
     assert res.outcome == "failed" and res.path is None
 
 
+def test_fallback_starts_from_the_closest_dmp_path(robot: WearerArm, library: PathLibrary, monkeypatch) -> None:
+    import tpee_ompl.path_library as pl
+
+    seen = {}
+    straight = _straight_plan(robot)
+
+    def plan(start, goal, i, j, initial_waypoints=None):
+        seen["initial"] = initial_waypoints
+        return straight(start, goal, i, j)
+
+    (i, j), pd = next(iter(library.pairs.items()))
+    start, goal = pd.starts[0], pd.goals[0]
+    monkeypatch.setattr(library, "plan", plan)
+    monkeypatch.setattr(pl, "motion_is_valid", lambda robot_, path, step=None: len(path) == N_FAKE_TIME_STEPS
+                        and motion_is_valid(robot_, path, step))  # every DMP candidate "collides"
+    before = library.stats()["fallback_seeded"]
+    res = library.query(start, goal, i, j)
+    assert res.outcome == "fallback" and library.stats()["fallback_seeded"] == before + 1
+    W = seen["initial"]
+    assert W.shape == (N_FAKE_TIME_STEPS, 4) and np.array_equal(W[0], start) and np.array_equal(W[-1], goal)
+    np.testing.assert_allclose(W, library.generate(start, goal, i, j, 0)[:: library.per_step])
+
+
 def test_library_round_trips_through_disk(robot: WearerArm, library: PathLibrary, tmp_path) -> None:
     f = library.save(tmp_path / "lib.npz")
     loaded = PathLibrary.load(f, robot)
@@ -217,8 +240,7 @@ def _necessary_queries(pairs, n: int):
 
 
 def test_polyline_motion_states_are_the_ompl_motion_states_of_every_segment(robot: WearerArm, rng) -> None:
-    from tpee_ompl.ompl_problem import motion_states
-    from tpee_ompl.ompl_problem import polyline_motion_states
+    from tpee_ompl.ompl_problem import motion_states, polyline_motion_states
 
     path = np.cumsum(rng.uniform(-0.05, 0.05, (30, 4)), axis=0)
     path[10] = path[9]  # a zero-length segment still checks its end state once
@@ -269,11 +291,37 @@ def test_every_returned_path_passes_si_check_motion_segment_by_segment(robot: We
             assert si.checkMotion(a, b)
 
 
-def test_seeded_default_build_is_deterministic(robot: WearerArm, rrt_library: PathLibrary) -> None:
-    again = PathLibrary.build_default(robot, per_pair=2, seed=3, pairs=RRT_PAIRS[:1], max_samples=300, timeout=5.0)
-    a, b = rrt_library.pairs[RRT_PAIRS[0]], again.pairs[RRT_PAIRS[0]]
-    assert np.array_equal(a.starts, b.starts) and np.array_equal(a.goals, b.goals)
-    assert np.array_equal(a.waypoints, b.waypoints)
+def test_seeded_default_build_is_deterministic_with_one_or_two_workers(robot: WearerArm, rrt_library: PathLibrary) -> None:
+    again = PathLibrary.build_default(robot, per_pair=2, seed=3, pairs=RRT_PAIRS, max_samples=300, timeout=5.0, workers=2)
+    for pair in RRT_PAIRS:
+        a, b = rrt_library.pairs[pair], again.pairs[pair]
+        assert np.array_equal(a.starts, b.starts) and np.array_equal(a.goals, b.goals)
+        assert np.array_equal(a.waypoints, b.waypoints) and np.array_equal(a.margins, b.margins, equal_nan=True)
+    assert again.build_stats == rrt_library.build_stats
+
+
+def test_demonstrations_keep_the_wider_margin_they_were_planned_with(robot: WearerArm, rrt_library: PathLibrary) -> None:
+    from tpee_ompl.path_library import DEMO_MARGINS, POINTING_LINKS
+
+    margins = np.concatenate([pd.margins for pd in rrt_library.pairs.values()])
+    assert set(margins) <= {*DEMO_MARGINS, robot.security_margin}
+    assert (margins > robot.security_margin).any()
+    for pd in rrt_library.pairs.values():
+        for W, m in zip(pd.waypoints, pd.margins):
+            wide = WearerArm(link_margins={name: float(m) for name in POINTING_LINKS})
+            assert motion_is_valid(wide, W, robot.max_joint_step())
+    stored = sum(v for k, v in rrt_library.build_stats.items() if k.startswith("stored_at_"))
+    assert stored == rrt_library.build_stats["stored"] == len(rrt_library)
+
+
+def test_demo_planner_falls_back_to_the_robots_margin_when_the_wide_one_rejects_the_start(robot: WearerArm) -> None:
+    from tpee_ompl.path_library import POINTING_LINKS, DemoPlanner
+
+    q = next(q for q in _necessary_queries(((1, 2), (2, 1), (3, 4), (4, 3), (4, 2), (2, 4)), 120)
+             if not WearerArm(link_margins={n: 0.03 for n in POINTING_LINKS}).is_valid(q.start))
+    plan = DemoPlanner(robot, margins=(0.03,), max_samples=300, timeout=5.0)
+    W = plan(q.start, q.goal, q.from_sector, q.to_sector)
+    assert W is not None and plan.last_margin == robot.security_margin and plan.counts == {"margin_20mm": 1}
 
 
 def test_build_parameters_survive_the_round_trip(robot: WearerArm, rrt_library: PathLibrary, tmp_path) -> None:

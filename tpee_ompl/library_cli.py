@@ -15,7 +15,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .path_library import ALL_PAIRS, PathLibrary, dimension_rrt_planner, path_length
+from .dmp import DMPOptions
+from .path_library import ALL_PAIRS, DEMO_MARGINS, LIBRARY_DMP_OPTIONS, PathLibrary, dimension_rrt_planner, path_length
 
 __all__ = ["DEFAULT_LIBRARY", "build_parser", "register", "run_build", "run_query", "run_stats"]
 
@@ -25,7 +26,7 @@ DEFAULT_LIBRARY = Path("experiments/library/default.npz")
 """Default library file (relative to the working directory; ``make library`` writes it)."""
 
 _BUILD_EXAMPLE = """example:
-  tpee-ompl library build --per-pair 12 --seed 0 --library experiments/library/default.npz
+  tpee-ompl library build --per-pair 20 --seed 0 --workers 2 --library experiments/library/default.npz
   tpee-ompl library build --pairs 1-2 3-4 --per-pair 3 --max-samples 500 --library /tmp/small.npz
 """
 _QUERY_EXAMPLE = """example:
@@ -65,13 +66,18 @@ def run_build(args: argparse.Namespace) -> int:
         raise ValueError(f"--per-pair must be >= 1, got {args.per_pair}")
     if args.max_samples < 1:
         raise ValueError(f"--max-samples must be >= 1, got {args.max_samples}")
+    if args.workers < 1:
+        raise ValueError(f"--workers must be >= 1, got {args.workers}")
+    if any(not (np.isfinite(m) and 0 <= m <= 1.0) for m in args.demo_margins):
+        raise ValueError(f"--demo-margins must be numbers in [0, 1] metres, got {args.demo_margins}")
     out = Path(args.library)
     out.parent.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
     lib = PathLibrary.build_default(default_robot(), per_pair=args.per_pair, seed=args.seed,
                                     pairs=tuple(args.pairs or ALL_PAIRS), min_difference=args.min_difference,
                                     max_samples=args.max_samples, timeout=args.timeout,
-                                    max_attempts=args.max_attempts)
+                                    max_attempts=args.max_attempts, demo_margins=tuple(args.demo_margins),
+                                    workers=args.workers, options=DMPOptions(scaling=args.dmp_scaling))
     lib.save(out)
     s = lib.stats()
     print(f"wrote {out}: {len(lib)} demonstrations in {len(lib.pairs)} pairs "
@@ -146,6 +152,13 @@ def register(subparsers: argparse._SubParsersAction, formatter_class: type = arg
                    help="draws per pair before giving up on per-pair (default 3 x per-pair)")
     b.add_argument("--max-samples", type=int, default=2500, help="dimension-RRT samples per demo (default 2500)")
     b.add_argument("--timeout", type=float, default=10.0, help="dimension-RRT time limit per demo, s (default 10)")
+    b.add_argument("--demo-margins", type=float, nargs="*", default=list(DEMO_MARGINS), metavar="M",
+                   help="margins (m) around the pointing system tried, widest first, before the robot's own "
+                        f"when planning a demo (default {' '.join(map(str, DEMO_MARGINS))}; none: robot's margin only)")
+    b.add_argument("--workers", type=int, default=1, help="processes building the pairs in parallel (default 1)")
+    b.add_argument("--dmp-scaling", choices=("none", "amplitude"), default=LIBRARY_DMP_OPTIONS.scaling,
+                   help="DMP forcing: 'amplitude' = eq. 13's x(g - y0), 'none' = absolute "
+                        f"(default {LIBRARY_DMP_OPTIONS.scaling}; docs/dmp.md says why)")
     b.set_defaults(func=run_build)
 
     q = sub.add_parser("query", help="answer one query", epilog=_QUERY_EXAMPLE, formatter_class=formatter_class)

@@ -13,8 +13,9 @@ any particular planner::
     plan(start, goal, from_sector, to_sector) -> waypoints (7, 4) at the fake-time steps, or None
 
 Default builders: :func:`query_sampler` (the planning-necessary query generator's sampling,
-:mod:`tpee_ompl.queries`) and :func:`dimension_rrt_planner` (dimension-RRT, 2500 samples);
-:meth:`PathLibrary.build_default` uses both.  :meth:`PathLibrary.as_planner` plugs a library
+:mod:`tpee_ompl.queries`) and :class:`DemoPlanner` (dimension-RRT, 2500 samples, with a wider margin
+around the pointing system first, so demonstrations keep room that their DMP generalisations can
+use); :meth:`PathLibrary.build_default` uses both, in parallel over the pairs with ``workers``.  :meth:`PathLibrary.as_planner` plugs a library
 into :class:`tpee_ompl.tracker.Tracker`.
 
 Resampling: each straight segment between consecutive fake-time steps gets ``per_step`` samples
@@ -25,6 +26,7 @@ smooth in fake time, which the DMP needs to reproduce it within 1e-3 rad (docs/d
 
 from __future__ import annotations
 
+import inspect
 import json
 import logging
 import time
@@ -32,7 +34,9 @@ import zipfile
 import zlib
 from collections import Counter
 from collections.abc import Callable, Sequence
+from concurrent.futures import ProcessPoolExecutor
 from dataclasses import asdict, dataclass, field
+from multiprocessing import get_context
 from pathlib import Path
 
 import numpy as np
@@ -44,8 +48,12 @@ from .sectors import check_sector, cross_sector_trajectory
 
 __all__ = [
     "ALL_PAIRS",
+    "DEMO_MARGINS",
     "FORMAT_VERSION",
+    "LIBRARY_DMP_OPTIONS",
     "N_FAKE_TIME_STEPS",
+    "POINTING_LINKS",
+    "DemoPlanner",
     "LibraryFileError",
     "PathLibrary",
     "QueryResult",
@@ -59,12 +67,22 @@ __all__ = [
 
 log = logging.getLogger(__name__)
 
-FORMAT_VERSION = 1
-"""Version of the ``.npz`` layout written by :meth:`PathLibrary.save`."""
+FORMAT_VERSION = 2
+"""Version of the ``.npz`` layout written by :meth:`PathLibrary.save` (2: per-demo planning margins)."""
 N_FAKE_TIME_STEPS = 7
 """Fake-time steps of every planned path (section 4.1.2)."""
 ALL_PAIRS: tuple[tuple[int, int], ...] = tuple((i, j) for i in range(1, 5) for j in range(1, 5) if i != j)
 """The 12 ordered (from, to) posture-sector pairs."""
+POINTING_LINKS: tuple[str, ...] = ("link3", "link4")
+"""Links moved by DOF3/DOF4, the DOFs the DMPs generate (DOF1/DOF2 follow Table 3 for every query)."""
+DEMO_MARGINS: tuple[float, ...] = (0.035, 0.03, 0.025)
+"""Metres. Margins around :data:`POINTING_LINKS` tried in turn when planning a demonstration, before
+the robot's own margin.  A demonstration planned at 2 cm hugs the wearer; its DMP generalisations
+then cross into the margin (docs/dmp.md has the measurements)."""
+LIBRARY_DMP_OPTIONS = DMPOptions(scaling="none")
+"""DMP options of the library's DOF3/DOF4 primitives: absolute forcing instead of eq. 13's (g - y0)
+scaling, which flips or shrinks a demo's detour whenever the query moves pan or tilt the other way
+or less far than the demo (docs/dmp.md has the measurements)."""
 
 SampleQuery = Callable[[np.random.Generator, int, int], tuple[np.ndarray, np.ndarray]]
 Plan = Callable[[np.ndarray, np.ndarray, int, int], "np.ndarray | None"]
@@ -155,8 +173,10 @@ def dimension_rrt_planner(
     Each call builds :func:`~tpee_ompl.ompl_problem.make_simple_setup` and runs
     :func:`~tpee_ompl.dimension_rrt.tpee_dimension_rrt` for ``max_samples`` samples (or
     ``timeout`` s); the planner's seed is ``seed`` mixed with a CRC of (start, goal), so a query
-    gets the same path whatever was planned before.  Returns the exact solution's (7, 4)
-    waypoints (every segment passed ``si.checkMotion``), else None.
+    gets the same path whatever was planned before.  ``initial_waypoints`` (7, 4), e.g. a DMP path
+    at the fake-time steps, is the planner's first guess (clipped to the joint limits; checked like
+    any other path).  Returns the exact solution's (7, 4) waypoints (every segment passed
+    ``si.checkMotion``), else None.
     """
     from ompl import util as ou
 
@@ -165,7 +185,9 @@ def dimension_rrt_planner(
 
     ou.setLogLevel(ou.LOG_WARN)
 
-    def plan(start: np.ndarray, goal: np.ndarray, i: int, j: int) -> np.ndarray | None:
+    def plan(
+        start: np.ndarray, goal: np.ndarray, i: int, j: int, initial_waypoints: np.ndarray | None = None
+    ) -> np.ndarray | None:
         start, goal = np.asarray(start, dtype=float), np.asarray(goal, dtype=float)
         call_seed = (int(seed) * 1_000_003 + zlib.crc32(np.r_[start, goal].tobytes())) % (2**31)
         try:
@@ -173,7 +195,10 @@ def dimension_rrt_planner(
         except ValueError as exc:  # start or goal in collision / out of limits
             log.warning("dimension-RRT %d->%d not run: %s", i, j, exc)
             return None
-        ss.setPlanner(tpee_dimension_rrt(ss.getSpaceInformation(), i, j, max_samples=max_samples, seed=call_seed))
+        planner = tpee_dimension_rrt(ss.getSpaceInformation(), i, j, max_samples=max_samples, seed=call_seed)
+        if initial_waypoints is not None:
+            planner.set_initial_waypoints(np.clip(np.asarray(initial_waypoints, dtype=float), robot.lower, robot.upper))
+        ss.setPlanner(planner)
         ss.solve(timeout)
         if not ss.haveExactSolutionPath():
             return None
@@ -181,6 +206,62 @@ def dimension_rrt_planner(
         return W if W.shape == (N_FAKE_TIME_STEPS, robot.nq) else None
 
     return plan
+
+
+class DemoPlanner:
+    """The default ``plan`` of :meth:`PathLibrary.build_default`: dimension-RRT, wide margins first.
+
+    For each margin of ``margins`` (largest first, those above the robot's own only) the start and
+    goal are checked, and dimension-RRT is run, with that margin around ``links``; the first
+    exact path is returned, else the plan at the robot's own margin.  A path valid at a wider
+    margin is valid at the robot's.  ``last_margin`` is the margin of the last returned path;
+    ``counts`` counts paths per margin ("margin_30mm", ...) and "failed".
+    """
+
+    def __init__(
+        self,
+        robot: WearerArm,
+        margins: Sequence[float] = DEMO_MARGINS,
+        links: Sequence[str] = POINTING_LINKS,
+        max_samples: int = 2500,
+        seed: int = 0,
+        timeout: float = 10.0,
+    ) -> None:
+        srdf = robot.files.srdf if robot.files.srdf is not None else False
+        rungs: list[tuple[float, WearerArm]] = []
+        for m in sorted({float(m) for m in margins}, reverse=True):
+            if m > robot.security_margin:
+                rungs.append((m, WearerArm(robot.files.urdf, srdf, security_margin=robot.security_margin,
+                                           link_margins={name: m for name in links}, n_threads=robot.n_threads)))
+        rungs.append((robot.security_margin, robot))
+        self.margins = tuple(m for m, _ in rungs)
+        self._rungs = [(m, r, dimension_rrt_planner(r, max_samples=max_samples, seed=seed, timeout=timeout))
+                       for m, r in rungs]
+        self.counts: Counter[str] = Counter()
+        self.last_margin: float | None = None
+
+    def __call__(
+        self, start: np.ndarray, goal: np.ndarray, i: int, j: int, initial_waypoints: np.ndarray | None = None
+    ) -> np.ndarray | None:
+        """Waypoints (7, 4) of the first exact dimension-RRT path down the margin ladder, or None."""
+        self.last_margin = None
+        for m, r, plan in self._rungs:
+            if not (r.is_valid(start) and r.is_valid(goal)):
+                continue
+            W = plan(start, goal, i, j, initial_waypoints=initial_waypoints)
+            if W is not None:
+                self.last_margin = m
+                self.counts[f"margin_{round(m * 1000)}mm"] += 1
+                return W
+        self.counts["failed"] += 1
+        return None
+
+
+def _takes_initial_waypoints(plan: Callable) -> bool:
+    try:
+        return "initial_waypoints" in inspect.signature(plan).parameters
+    except (TypeError, ValueError):
+        return False
 
 
 @dataclass(frozen=True)
@@ -193,7 +274,8 @@ class QueryResult:
         Motion-checked path from the query's start to its goal; None only if outcome is "failed".
     outcome : {"dmp", "repaired", "fallback", "failed"}
         "dmp": the closest demonstration's blended DMP path was valid; "repaired": a later
-        candidate's was; "fallback": the planner's path; "failed": nothing valid was found.
+        candidate's was; "fallback": the planner's path (seeded with the closest DMP path when the
+        planner takes ``initial_waypoints``); "failed": nothing valid was found.
     demo_index : int or None
         Index (within the pair) of the demonstration used, if any.
     candidates_tried : int
@@ -214,6 +296,7 @@ class _PairData:
     starts: np.ndarray  # (M, 4)
     goals: np.ndarray  # (M, 4)
     waypoints: np.ndarray  # (M, 7, 4)
+    margins: np.ndarray | None = None  # (M,) metres each demo was planned with (NaN: unknown)
     forward: list[DMP] = field(default_factory=list)
     reverse: list[DMP] = field(default_factory=list)
 
@@ -225,6 +308,76 @@ class _PairData:
 
 def _key(start: np.ndarray, goal: np.ndarray) -> np.ndarray:
     return np.concatenate([start[2:], goal[2:]])
+
+
+def _check_build_args(
+    pairs: Sequence[tuple[int, int]], per_pair: int, min_difference: float, max_attempts: int | None
+) -> tuple[list[tuple[int, int]], int]:
+    if isinstance(per_pair, bool) or not isinstance(per_pair, (int, np.integer)) or per_pair < 1:
+        raise ValueError(f"per_pair must be an integer >= 1, got {per_pair!r}")
+    if not (np.isfinite(min_difference) and min_difference >= 0):
+        raise ValueError(f"min_difference must be a finite number >= 0, got {min_difference!r}")
+    max_attempts = 20 * per_pair if max_attempts is None else int(max_attempts)
+    if max_attempts < 1:
+        raise ValueError(f"max_attempts must be >= 1, got {max_attempts}")
+    pair_list = [(check_sector(i), check_sector(j)) for i, j in pairs]
+    for i, j in pair_list:
+        if i == j:
+            raise ValueError(f"pair ({i}, {j}) is not a cross-sector motion")
+    return pair_list, max_attempts
+
+
+def _collect_pair(
+    sample_query: SampleQuery,
+    plan: Plan,
+    i: int,
+    j: int,
+    child: np.random.SeedSequence,
+    per_pair: int,
+    min_difference: float,
+    max_attempts: int,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, Counter[str]]:
+    """Draw, filter and plan the demonstrations of one pair: starts, goals, waypoints, margins, counters."""
+    rng = np.random.default_rng(child)
+    stats: Counter[str] = Counter()
+    starts, goals, paths, keys, margins = [], [], [], [], []
+    for _ in range(max_attempts):
+        if len(starts) >= per_pair:
+            break
+        stats["sampled"] += 1
+        start, goal = (np.asarray(q, dtype=float) for q in sample_query(rng, i, j))
+        key = _key(start, goal)
+        if keys and np.min(np.linalg.norm(np.array(keys) - key, axis=1)) < min_difference:
+            stats["rejected_similar"] += 1
+            continue
+        W = plan(start, goal, i, j)
+        if W is None:
+            stats["plan_failed"] += 1
+            continue
+        W = np.asarray(W, dtype=float)
+        if W.shape != (N_FAKE_TIME_STEPS, 4):
+            raise ValueError(f"plan returned shape {W.shape}; expected ({N_FAKE_TIME_STEPS}, 4)")
+        margin = getattr(plan, "last_margin", None)
+        starts.append(start)
+        goals.append(goal)
+        paths.append(W)
+        keys.append(key)
+        margins.append(np.nan if margin is None else float(margin))
+        stats["stored"] += 1
+        if margin is not None:
+            stats[f"stored_at_{round(margin * 1000)}mm"] += 1
+    return (np.array(starts).reshape(-1, 4), np.array(goals).reshape(-1, 4),
+            np.array(paths).reshape(-1, N_FAKE_TIME_STEPS, 4), np.array(margins, dtype=float), stats)
+
+
+def _collect_default_pair(job: tuple, robot: WearerArm | None = None) -> tuple:
+    """:func:`_collect_pair` with the default sampler and :class:`DemoPlanner` (runs in a worker process)."""
+    urdf, srdf, margin, i, j, child, per_pair, min_difference, max_attempts, max_samples, timeout, require, margins, seed = job
+    if robot is None:
+        robot = WearerArm(urdf, srdf if srdf is not None else False, security_margin=margin)
+    plan = DemoPlanner(robot, margins=margins, max_samples=max_samples, seed=seed, timeout=timeout)
+    return _collect_pair(query_sampler(robot, require_planning=require), plan, i, j, child, per_pair,
+                         min_difference, max_attempts)
 
 
 class PathLibrary:
@@ -253,7 +406,7 @@ class PathLibrary:
         self.robot = robot
         self.pairs = pairs
         self.per_step = int(per_step)
-        self.options = options or DMPOptions()
+        self.options = options or LIBRARY_DMP_OPTIONS
         self.plan = plan
         self.n_candidates = int(n_candidates)
         self.build_stats = dict(build_stats or {})
@@ -284,47 +437,34 @@ class PathLibrary:
         For each pair, draw random cross-sector motions with ``sample_query``; keep one only if its
         DOF3/DOF4 (start, goal) 4-vector is at least ``min_difference`` (radians, Euclidean) from
         every stored one; plan it with ``plan``; resample the 7 waypoints (``per_step`` samples per
-        step); learn a forward DMP of DOF3/DOF4 and a reverse DMP of the time-flipped demo.
-        Stops at ``per_pair`` demos or ``max_attempts`` draws (default 20 per_pair) per pair.
-        Deterministic for a given ``seed`` (one child generator per pair) if ``plan`` is.
+        step); learn a forward DMP of DOF3/DOF4 and a reverse DMP of the time-flipped demo
+        (``options``, default :data:`LIBRARY_DMP_OPTIONS`).  Stops at ``per_pair`` demos or
+        ``max_attempts`` draws (default 20 per_pair) per pair.  Deterministic for a given ``seed``
+        (one child generator per pair) if ``plan`` is.  A ``plan`` with a ``last_margin``
+        attribute (:class:`DemoPlanner`) has it stored per demonstration.
         """
-        options = options or DMPOptions()
-        if per_pair < 1:
-            raise ValueError(f"per_pair must be >= 1, got {per_pair}")
-        if not (np.isfinite(min_difference) and min_difference >= 0):
-            raise ValueError(f"min_difference must be a finite number >= 0, got {min_difference!r}")
-        max_attempts = 20 * per_pair if max_attempts is None else int(max_attempts)
+        pair_list, max_attempts = _check_build_args(pairs, per_pair, min_difference, max_attempts)
         stats: Counter[str] = Counter()
-        data: dict[tuple[int, int], _PairData] = {}
-        pair_list = [(check_sector(i), check_sector(j)) for i, j in pairs]
+        collected = {}
         for (i, j), child in zip(pair_list, np.random.SeedSequence(seed).spawn(len(pair_list))):
-            if i == j:
-                raise ValueError(f"pair ({i}, {j}) is not a cross-sector motion")
-            rng = np.random.default_rng(child)
-            starts, goals, paths, keys = [], [], [], []
-            for _ in range(max_attempts):
-                if len(starts) >= per_pair:
-                    break
-                stats["sampled"] += 1
-                start, goal = (np.asarray(q, dtype=float) for q in sample_query(rng, i, j))
-                key = _key(start, goal)
-                if keys and np.min(np.linalg.norm(np.array(keys) - key, axis=1)) < min_difference:
-                    stats["rejected_similar"] += 1
-                    continue
-                W = plan(start, goal, i, j)
-                if W is None:
-                    stats["plan_failed"] += 1
-                    continue
-                W = np.asarray(W, dtype=float)
-                if W.shape != (N_FAKE_TIME_STEPS, 4):
-                    raise ValueError(f"plan returned shape {W.shape}; expected ({N_FAKE_TIME_STEPS}, 4)")
-                starts.append(start)
-                goals.append(goal)
-                paths.append(W)
-                keys.append(key)
-                stats["stored"] += 1
-            pd = _PairData(np.array(starts).reshape(-1, 4), np.array(goals).reshape(-1, 4),
-                           np.array(paths).reshape(-1, N_FAKE_TIME_STEPS, 4))
+            collected[(i, j)] = _collect_pair(sample_query, plan, i, j, child, per_pair, min_difference, max_attempts)
+            stats.update(collected[(i, j)][4])
+        return cls._learn(robot, collected, stats, per_step, options, plan)
+
+    @classmethod
+    def _learn(
+        cls,
+        robot: WearerArm,
+        collected: dict[tuple[int, int], tuple],
+        stats: Counter[str],
+        per_step: int,
+        options: DMPOptions | None,
+        plan: Plan | None,
+    ) -> PathLibrary:
+        options = options or LIBRARY_DMP_OPTIONS
+        data: dict[tuple[int, int], _PairData] = {}
+        for (i, j), (starts, goals, waypoints, margins, _) in collected.items():
+            pd = _PairData(starts, goals, waypoints, margins)
             for W in pd.waypoints:
                 demo = resample_waypoints(W[:, 2:], per_step)
                 pd.forward.append(learn_dmp(demo, options))
@@ -345,29 +485,62 @@ class PathLibrary:
         timeout: float = 10.0,
         require_planning: bool = True,
         max_attempts: int | None = None,
+        demo_margins: Sequence[float] = DEMO_MARGINS,
+        workers: int = 1,
+        options: DMPOptions | None = None,
     ) -> PathLibrary:
-        """:meth:`build` with :func:`query_sampler` and :func:`dimension_rrt_planner`; the
-        parameters are recorded in ``build_params`` (saved in the file's metadata).
+        """:meth:`build` with :func:`query_sampler` and :class:`DemoPlanner`; the parameters are
+        recorded in ``build_params`` (saved in the file's metadata).
 
         ``max_attempts`` (draws per pair) defaults to 3 per_pair: planning-necessary draws of
         the shoulder pairs (3 <-> 4) cost several seconds each and cluster within ~0.3 rad.
+        ``workers`` > 1 builds the pairs in that many processes; the result is the same as with
+        one (each pair has its own seed).  ``options``: the DMPs' (default
+        :data:`LIBRARY_DMP_OPTIONS`).  The fallback of the returned library is
+        :func:`dimension_rrt_planner` at the robot's margin.
         """
-        max_attempts = 3 * per_pair if max_attempts is None else int(max_attempts)
+        pair_list, max_attempts = _check_build_args(pairs, per_pair, 0.0 if min_difference is None else min_difference,
+                                                    max_attempts if max_attempts is not None else 3 * per_pair)
+        if isinstance(workers, bool) or not isinstance(workers, (int, np.integer)) or workers < 1:
+            raise ValueError(f"workers must be an integer >= 1, got {workers!r}")
         t0 = time.perf_counter()
-        plan = dimension_rrt_planner(robot, max_samples=max_samples, seed=seed, timeout=timeout)
-        lib = cls.build(robot, query_sampler(robot, require_planning=require_planning), plan, pairs=pairs,
-                        per_pair=per_pair, min_difference=min_difference, seed=seed, max_attempts=max_attempts)
+        children = np.random.SeedSequence(seed).spawn(len(pair_list))
+        jobs = [(robot.files.urdf, robot.files.srdf, robot.security_margin, i, j, child, per_pair, min_difference,
+                 max_attempts, max_samples, timeout, require_planning, tuple(demo_margins), seed)
+                for (i, j), child in zip(pair_list, children)]
+        if workers > 1 and len(jobs) > 1:
+            with ProcessPoolExecutor(min(workers, len(jobs)), mp_context=get_context("spawn")) as ex:
+                results = list(ex.map(_collect_default_pair, jobs))
+        else:
+            results = [_collect_default_pair(job, robot) for job in jobs]
+        stats: Counter[str] = Counter()
+        for r in results:
+            stats.update(r[4])
+        collected = dict(zip(pair_list, results))
+        lib = cls._learn(robot, collected, stats, 100, options,
+                         dimension_rrt_planner(robot, max_samples=max_samples, seed=seed, timeout=timeout))
         lib.build_params = {
             "builder": "PathLibrary.build_default",
             "per_pair": int(per_pair),
             "seed": int(seed),
-            "pairs": [list(map(int, p)) for p in pairs],
+            "pairs": [list(map(int, p)) for p in pair_list],
             "min_difference": float(min_difference),
             "max_attempts": int(max_attempts),
             "sampler": f"query_sampler(NECESSITY_REGIONS, require_planning={bool(require_planning)})",
-            "planner": f"dimension_rrt_planner(max_samples={max_samples}, timeout={timeout:g})",
+            "planner": f"DemoPlanner(margins={[float(m) for m in demo_margins]}, links={list(POINTING_LINKS)}, "
+                       f"max_samples={max_samples}, timeout={timeout:g})",
+            "dmp_options": asdict(lib.options),
+            "workers": int(workers),
             "build_seconds": round(time.perf_counter() - t0, 1),
         }
+        return lib
+
+    def with_options(self, options: DMPOptions) -> PathLibrary:
+        """The same demonstrations with DMPs learned anew with ``options`` (e.g. to compare scalings)."""
+        collected = {pair: (pd.starts, pd.goals, pd.waypoints, pd.margins, Counter()) for pair, pd in self.pairs.items()}
+        lib = self._learn(self.robot, collected, Counter(self.build_stats), self.per_step, options, self.plan)
+        lib.build_params = {**self.build_params, "dmp_options": asdict(options)}
+        lib.n_candidates, lib.query_stride = self.n_candidates, self.query_stride
         return lib
 
     # ------------------------------------------------------------------ querying
@@ -379,6 +552,12 @@ class PathLibrary:
         T0, T1 = base[0], base[-1]
         u = np.linspace(0.0, 1.0, base.shape[0])[:, None]
         return base + (1.0 - u) * (start[:2] - T0) + u * (goal[:2] - T1)
+
+    def demo_order(self, start: np.ndarray, goal: np.ndarray, from_sector: int, to_sector: int) -> np.ndarray:
+        """Indices of the pair's demonstrations, closest first in the DOF3/DOF4 (start, goal) 4-vector."""
+        pd = self.pairs[(from_sector, to_sector)]
+        key = _key(np.asarray(start, dtype=float), np.asarray(goal, dtype=float))
+        return np.argsort(np.linalg.norm(pd.keys - key, axis=1), kind="stable")
 
     def generate(
         self, start: np.ndarray, goal: np.ndarray, from_sector: int, to_sector: int, demo_index: int, stride: int = 1
@@ -419,16 +598,22 @@ class PathLibrary:
         self._counts["queries"] += 1
         pd = self.pairs.get((i, j))
         tried = 0
+        seed_path = None
         if pd is not None and len(pd.starts):
-            order = np.argsort(np.linalg.norm(pd.keys - _key(start, goal), axis=1), kind="stable")
+            order = self.demo_order(start, goal, i, j)
             for rank, k in enumerate(order[: self.n_candidates]):
                 tried += 1
                 path = self.generate(start, goal, i, j, int(k), stride=self.query_stride)
                 if motion_is_valid(self.robot, path, step):
                     outcome = "dmp" if rank == 0 else "repaired"
                     return self._result(path, outcome, int(k), tried, t0)
+            seed_path = self.generate(start, goal, i, j, int(order[0]), stride=self.per_step)
         if self.plan is not None:
-            W = self.plan(start, goal, i, j)
+            kw = {}
+            if seed_path is not None and seed_path.shape == (N_FAKE_TIME_STEPS, 4) and _takes_initial_waypoints(self.plan):
+                kw["initial_waypoints"] = seed_path
+                self._counts["fallback_seeded"] += 1
+            W = self.plan(start, goal, i, j, **kw)
             if W is not None:
                 path = np.array(W, dtype=float)
                 if np.allclose(path[0], start, atol=1e-9) and np.allclose(path[-1], goal, atol=1e-9):
@@ -444,11 +629,15 @@ class PathLibrary:
 
     def stats(self) -> dict[str, int]:
         """Counters: queries and outcomes ("dmp", "repaired", "fallback", "failed"), candidates
-        tried, plus the build counters ("sampled", "rejected_similar", "plan_failed", "stored")."""
-        keys = ("queries", "dmp", "repaired", "fallback", "failed", "candidates_tried")
+        tried, fallbacks seeded with a DMP path, plus the build counters ("sampled",
+        "rejected_similar", "plan_failed", "stored", "stored_at_<margin>mm")."""
+        keys = ("queries", "dmp", "repaired", "fallback", "failed", "candidates_tried", "fallback_seeded")
         out = {k: int(self._counts[k]) for k in keys}
         for k in ("sampled", "rejected_similar", "plan_failed", "stored"):
             out[f"build_{k}"] = int(self.build_stats.get(k, 0))
+        for k in sorted(self.build_stats):
+            if k.startswith("stored_at_"):
+                out[f"build_{k}"] = int(self.build_stats[k])
         return out
 
     def reset_stats(self) -> None:
@@ -508,6 +697,7 @@ class PathLibrary:
         for (i, j), pd in sorted(self.pairs.items()):
             p = f"p{i}{j}_"
             arrays[p + "starts"], arrays[p + "goals"], arrays[p + "waypoints"] = pd.starts, pd.goals, pd.waypoints
+            arrays[p + "margins"] = pd.margins if pd.margins is not None else np.full(len(pd.starts), np.nan)
             for name, dmps in (("fwd", pd.forward), ("rev", pd.reverse)):
                 arrays[p + name + "_weights"] = np.array([d.weights for d in dmps]).reshape(len(dmps), 2, n_basis)
                 arrays[p + name + "_scaled"] = np.array([d.scaled for d in dmps], dtype=bool).reshape(len(dmps), 2)
@@ -547,7 +737,7 @@ class PathLibrary:
         try:
             for i, j in meta["pairs"]:
                 p = f"p{i}{j}_"
-                pd = _PairData(arrays[p + "starts"], arrays[p + "goals"], arrays[p + "waypoints"])
+                pd = _PairData(arrays[p + "starts"], arrays[p + "goals"], arrays[p + "waypoints"], arrays[p + "margins"])
                 for W, fw, fs, rw, rs in zip(pd.waypoints, arrays[p + "fwd_weights"], arrays[p + "fwd_scaled"],
                                              arrays[p + "rev_weights"], arrays[p + "rev_scaled"], strict=True):
                     pd.forward.append(DMP.from_weights(fw, W[0, 2:], W[-1, 2:], fs, n_steps, options))
@@ -577,9 +767,8 @@ def benchmark_queries(
     for q in queries:
         i, j = int(q.from_sector), int(q.to_sector)
         start, goal = np.asarray(q.start, dtype=float), np.asarray(q.goal, dtype=float)
-        pd = library.pairs[(i, j)]
         t0 = time.perf_counter()
-        k = int(np.argmin(np.linalg.norm(pd.keys - _key(start, goal), axis=1)))
+        k = int(library.demo_order(start, goal, i, j)[0])
         raw = library.generate(start, goal, i, j, k, stride=library.query_stride)
         gen_s = time.perf_counter() - t0
         raw_valid = motion_is_valid(library.robot, raw, step)

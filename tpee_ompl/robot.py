@@ -326,7 +326,6 @@ class WearerArm:
 
     def _rebuild_geometry_data(self) -> None:
         self.gdata = pin.GeometryData(self.gmodel)
-        ng = self.gmodel.ngeoms
         self.gdata.setSecurityMargins(self.gmodel, self._margin_matrix())
         for req in self.gdata.collisionRequests:
             req.enable_contact = True  # Coal misses edge/corner contacts otherwise
