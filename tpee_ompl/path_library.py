@@ -499,7 +499,7 @@ class PathLibrary:
         :data:`LIBRARY_DMP_OPTIONS`).  The fallback of the returned library is
         :func:`dimension_rrt_planner` at the robot's margin.
         """
-        pair_list, max_attempts = _check_build_args(pairs, per_pair, 0.0 if min_difference is None else min_difference,
+        pair_list, max_attempts = _check_build_args(pairs, per_pair, min_difference,
                                                     max_attempts if max_attempts is not None else 3 * per_pair)
         if isinstance(workers, bool) or not isinstance(workers, (int, np.integer)) or workers < 1:
             raise ValueError(f"workers must be an integer >= 1, got {workers!r}")
