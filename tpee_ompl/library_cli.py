@@ -143,7 +143,7 @@ def register(subparsers: argparse._SubParsersAction, formatter_class: type = arg
     b = sub.add_parser("build", help="build a library (dimension-RRT demonstrations)", epilog=_BUILD_EXAMPLE,
                        formatter_class=formatter_class)
     common(b)
-    b.add_argument("--per-pair", type=int, default=12, help="demonstrations per ordered sector pair (default 12)")
+    b.add_argument("--per-pair", type=int, default=20, help="demonstrations per ordered sector pair (default 20)")
     b.add_argument("--seed", type=int, default=0, help="seed of the sampler and the planner (default 0)")
     b.add_argument("--pairs", type=_pair, nargs="+", metavar="I-J", help="sector pairs (default all 12)")
     b.add_argument("--min-difference", type=float, default=0.15,
