@@ -17,6 +17,7 @@ import sys
 import time
 from pathlib import Path
 
+from tpee_ompl.benchmark import new_output_stem
 from tpee_ompl.dmp import DMPOptions
 from tpee_ompl.path_library import DEMO_MARGINS, PathLibrary, motion_is_valid
 from tpee_ompl.queries import load_queries
@@ -63,9 +64,10 @@ def main(argv: list[str] | None = None) -> int:
     for label in SETTINGS:
         a, n = (next(r["raw_valid"] for r in rows if r["demos"] == label and r["scaling"] == s) for s in ("amplitude", "none"))
         print(f"| {label} | {a:.1%} | {n:.1%} |")
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    args.out.with_suffix(".json").write_text(json.dumps({"query_set": args.query_set, "queries": len(queries),
+    stem = new_output_stem(args.out, (".json",))  # never overwrite earlier results
+    stem.with_suffix(".json").write_text(json.dumps({"query_set": args.query_set, "queries": len(queries),
                                                          "per_pair": args.per_pair, "seed": args.seed, "rows": rows}, indent=1))
+    print(f"wrote {stem.with_suffix('.json')}")
     return 0
 
 

@@ -33,6 +33,7 @@ from pathlib import Path
 
 import numpy as np
 
+from tpee_ompl.benchmark import new_output_stem
 from tpee_ompl.path_library import PathLibrary, benchmark_queries, dimension_rrt_planner, path_length
 
 log = logging.getLogger("dmp_library_benchmark")
@@ -138,9 +139,10 @@ def main(argv: list[str] | None = None) -> int:
     t2 = time.perf_counter()
     if not args.no_reference:
         items = [(k, q.start.tolist(), q.goal.tolist(), q.from_sector, q.to_sector) for k, q in enumerate(queries)]
-        chunks = [items[w::workers] for w in range(workers)]
+        # small tasks: an interrupted run leaves no worker busy for long (each query's seed is its own)
+        chunks = [items[k:k + 10] for k in range(0, len(items), 10)]
         with ProcessPoolExecutor(workers, mp_context=ctx) as ex:
-            ref = dict(x for part in ex.map(_reference, chunks, [args.reference_samples] * workers, [7] * workers)
+            ref = dict(x for part in ex.map(_reference, chunks, [args.reference_samples] * len(chunks), [7] * len(chunks))
                        for x in part)
         for k, row in enumerate(rows):
             row["ref_length"] = ref[k]
@@ -156,12 +158,12 @@ def main(argv: list[str] | None = None) -> int:
     summary["seconds"] = {"query_generation": t_gen, "library_queries": t_lib, "reference": t_ref}
     summary["hardware"] = {"machine": platform.machine(), "processor": platform.processor(), "cpus": os.cpu_count(),
                            "python": platform.python_version()}
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    with open(args.out.with_suffix(".csv"), "w", newline="") as fh:
+    stem = new_output_stem(args.out, (".csv", ".json"))  # never overwrite earlier results
+    with open(stem.with_suffix(".csv"), "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=list(rows[0]))
         w.writeheader()
         w.writerows(rows)
-    args.out.with_suffix(".json").write_text(json.dumps(summary, indent=1))
+    stem.with_suffix(".json").write_text(json.dumps(summary, indent=1))
     for label in ("all", "planning_necessary"):
         a = summary[label]
         if a is None:
@@ -171,7 +173,7 @@ def main(argv: list[str] | None = None) -> int:
               f"(p95 {a['generation_time']['p95_ms']:.3f}); raw DMP valid {a['raw_dmp_valid_share']:.1%}; "
               f"outcomes {a['outcomes']}; fallback {a['fallback_share']:.1%}; "
               f"length ratio median {a['length_ratio_median']}, p95 {a['length_ratio_p95']}")
-    print(f"wrote {args.out.with_suffix('.csv')} and {args.out.with_suffix('.json')}")
+    print(f"wrote {stem.with_suffix('.csv')} and {stem.with_suffix('.json')}")
     return 0
 
 

@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 from ompl import util as ou
 
+from tpee_ompl.benchmark import new_output_stem
 from tpee_ompl.dimension_rrt import tpee_dimension_rrt
 from tpee_ompl.ompl_problem import make_simple_setup
 from tpee_ompl.path_library import N_FAKE_TIME_STEPS, PathLibrary, motion_is_valid
@@ -75,8 +76,9 @@ def main(argv: list[str] | None = None) -> int:
             out[label] = {"queries": len(sel), "seeded": _block(sel, "seeded"), "straight": _block(sel, "straight")}
             print(f"{label} ({len(sel)} queries, {args.samples} samples): seeded {out[label]['seeded']}; "
                   f"straight {out[label]['straight']}")
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    args.out.with_suffix(".json").write_text(json.dumps({**out, "rows": rows}, indent=1))
+    stem = new_output_stem(args.out, (".json",))  # never overwrite earlier results
+    stem.with_suffix(".json").write_text(json.dumps({**out, "rows": rows}, indent=1))
+    print(f"wrote {stem.with_suffix('.json')}")
     return 0
 
 

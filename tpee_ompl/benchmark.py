@@ -769,6 +769,20 @@ def make_results_dir(out: str | os.PathLike, name: str) -> Path:
     raise RuntimeError(f"could not create a new results folder under {out}")
 
 
+def new_output_stem(stem: str | os.PathLike, suffixes: Sequence[str] = (".csv", ".json")) -> Path:
+    """``stem`` if none of ``stem + suffix`` exists, else ``<stem>_<UTC timestamp>[_k]``: results are never overwritten."""
+    stem = Path(stem)
+    stem.parent.mkdir(parents=True, exist_ok=True)
+    if not any(stem.with_name(stem.name + s).exists() for s in suffixes):
+        return stem
+    stamp = _dt.datetime.now(_dt.timezone.utc).strftime("%Y%m%dT%H%M%SZ")
+    for k in range(1000):
+        cand = stem.with_name(f"{stem.name}_{stamp}" if k == 0 else f"{stem.name}_{stamp}_{k}")
+        if not any(cand.with_name(cand.name + s).exists() for s in suffixes):
+            return cand
+    raise RuntimeError(f"no free output name for {stem}")
+
+
 def build_database(logs: Sequence[os.PathLike], db_path: os.PathLike) -> tuple[Path | None, list[Path]]:
     """Build a Planner Arena SQLite database from OMPL ``.log`` files (ompl_benchmark_statistics).
 
