@@ -23,8 +23,16 @@ from tpee_ompl.path_library import DEMO_MARGINS, PathLibrary, motion_is_valid
 from tpee_ompl.queries import load_queries
 from tpee_ompl.robot import default_robot
 
-SETTINGS = {"2 cm (robot's margin)": (), "3 cm around links 3-4": (0.03,),
-            "3.5 / 3 / 2.5 cm around links 3-4 (default)": DEMO_MARGINS}
+LADDERS = ((), (0.03,), (0.04, 0.03, 0.025), (0.05, 0.04, 0.03, 0.025))
+"""Demo margins (m) around links 3-4, widest first; () = the robot's own 2 cm."""
+
+
+def _label(margins: tuple[float, ...]) -> str:
+    text = " / ".join(f"{m * 100:g}" for m in margins) + " cm around links 3-4" if margins else "2 cm (the robot's margin)"
+    return text + (" (default)" if tuple(margins) == tuple(DEMO_MARGINS) else "")
+
+
+SETTINGS = {_label(m): m for m in LADDERS}
 
 
 def raw_valid_share(lib: PathLibrary, queries: list) -> float:

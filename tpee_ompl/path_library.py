@@ -212,9 +212,10 @@ class DemoPlanner:
     """The default ``plan`` of :meth:`PathLibrary.build_default`: dimension-RRT, wide margins first.
 
     For each margin of ``margins`` (largest first, those above the robot's own only) the start and
-    goal are checked, and dimension-RRT is run, with that margin around ``links``; the first
-    exact path is returned, else the plan at the robot's own margin.  A path valid at a wider
-    margin is valid at the robot's.  ``last_margin`` is the margin of the last returned path;
+    goal are checked, and dimension-RRT is run, with that margin around ``links`` (never below the
+    robot's own ``link_margins``); the first exact path is returned, else the plan with the robot
+    itself.  Every rung is at least as strict as the robot, so a path valid on a rung is valid for
+    the robot.  ``last_margin`` is the margin of the last returned path;
     ``counts`` counts paths per margin ("margin_30mm", ...) and "failed".
     """
 
@@ -227,12 +228,15 @@ class DemoPlanner:
         seed: int = 0,
         timeout: float = 10.0,
     ) -> None:
+        margins = _check_margins(margins)
         srdf = robot.files.srdf if robot.files.srdf is not None else False
         rungs: list[tuple[float, WearerArm]] = []
-        for m in sorted({float(m) for m in margins}, reverse=True):
-            if m > robot.security_margin:
+        for m in sorted(set(margins), reverse=True):
+            wider = {name: max(m, robot.link_margins.get(name, 0.0)) for name in links}
+            if m > robot.security_margin and any(v > robot.link_margins.get(n, robot.security_margin)
+                                                 for n, v in wider.items()):
                 rungs.append((m, WearerArm(robot.files.urdf, srdf, security_margin=robot.security_margin,
-                                           link_margins={name: m for name in links}, n_threads=robot.n_threads)))
+                                           link_margins={**robot.link_margins, **wider}, n_threads=robot.n_threads)))
         rungs.append((robot.security_margin, robot))
         self.margins = tuple(m for m, _ in rungs)
         self._rungs = [(m, r, dimension_rrt_planner(r, max_samples=max_samples, seed=seed, timeout=timeout))
@@ -255,6 +259,16 @@ class DemoPlanner:
                 return W
         self.counts["failed"] += 1
         return None
+
+
+def _check_margins(margins: Sequence[float]) -> tuple[float, ...]:
+    try:
+        out = tuple(float(m) for m in margins)
+    except (TypeError, ValueError):
+        raise ValueError(f"demo margins must be numbers in [0, 1] metres, got {margins!r}") from None
+    if not all(np.isfinite(m) and 0.0 <= m <= 1.0 for m in out):
+        raise ValueError(f"demo margins must be numbers in [0, 1] metres, got {list(margins)!r}")
+    return out
 
 
 def _takes_initial_waypoints(plan: Callable) -> bool:
@@ -372,9 +386,11 @@ def _collect_pair(
 
 def _collect_default_pair(job: tuple, robot: WearerArm | None = None) -> tuple:
     """:func:`_collect_pair` with the default sampler and :class:`DemoPlanner` (runs in a worker process)."""
-    urdf, srdf, margin, i, j, child, per_pair, min_difference, max_attempts, max_samples, timeout, require, margins, seed = job
+    model, i, j, child, per_pair, min_difference, max_attempts, max_samples, timeout, require, margins, seed = job
     if robot is None:
-        robot = WearerArm(urdf, srdf if srdf is not None else False, security_margin=margin)
+        urdf, srdf, margin, link_margins, n_threads = model
+        robot = WearerArm(urdf, srdf if srdf is not None else False, security_margin=margin,
+                          link_margins=link_margins, n_threads=n_threads)
     plan = DemoPlanner(robot, margins=margins, max_samples=max_samples, seed=seed, timeout=timeout)
     return _collect_pair(query_sampler(robot, require_planning=require), plan, i, j, child, per_pair,
                          min_difference, max_attempts)
@@ -494,8 +510,9 @@ class PathLibrary:
 
         ``max_attempts`` (draws per pair) defaults to 3 per_pair: planning-necessary draws of
         the shoulder pairs (3 <-> 4) cost several seconds each and cluster within ~0.3 rad.
-        ``workers`` > 1 builds the pairs in that many processes; the result is the same as with
-        one (each pair has its own seed).  ``options``: the DMPs' (default
+        ``workers`` > 1 builds the pairs in that many processes, each with a copy of ``robot``
+        (same files and margins); the result is the same as with one (each pair has its own seed),
+        unless a demo hits the wall-clock ``timeout``.  ``options``: the DMPs' (default
         :data:`LIBRARY_DMP_OPTIONS`).  The fallback of the returned library is
         :func:`dimension_rrt_planner` at the robot's margin.
         """
@@ -505,8 +522,10 @@ class PathLibrary:
             raise ValueError(f"workers must be an integer >= 1, got {workers!r}")
         t0 = time.perf_counter()
         children = np.random.SeedSequence(seed).spawn(len(pair_list))
-        jobs = [(robot.files.urdf, robot.files.srdf, robot.security_margin, i, j, child, per_pair, min_difference,
-                 max_attempts, max_samples, timeout, require_planning, tuple(demo_margins), seed)
+        demo_margins = _check_margins(demo_margins)
+        model = (robot.files.urdf, robot.files.srdf, robot.security_margin, dict(robot.link_margins), robot.n_threads)
+        jobs = [(model, i, j, child, per_pair, min_difference, max_attempts, max_samples, timeout, require_planning,
+                 demo_margins, seed)
                 for (i, j), child in zip(pair_list, children)]
         if workers > 1 and len(jobs) > 1:
             with ProcessPoolExecutor(min(workers, len(jobs)), mp_context=get_context("spawn")) as ex:
@@ -537,6 +556,8 @@ class PathLibrary:
 
     def with_options(self, options: DMPOptions) -> PathLibrary:
         """The same demonstrations with DMPs learned anew with ``options`` (e.g. to compare scalings)."""
+        if not isinstance(options, DMPOptions):
+            raise ValueError(f"options must be a DMPOptions, got {options!r}")
         collected = {pair: (pd.starts, pd.goals, pd.waypoints, pd.margins, Counter()) for pair, pd in self.pairs.items()}
         lib = self._learn(self.robot, collected, Counter(self.build_stats), self.per_step, options, self.plan)
         lib.build_params = {**self.build_params, "dmp_options": asdict(options)}
@@ -555,8 +576,12 @@ class PathLibrary:
 
     def demo_order(self, start: np.ndarray, goal: np.ndarray, from_sector: int, to_sector: int) -> np.ndarray:
         """Indices of the pair's demonstrations, closest first in the DOF3/DOF4 (start, goal) 4-vector."""
-        pd = self.pairs[(from_sector, to_sector)]
-        key = _key(np.asarray(start, dtype=float), np.asarray(goal, dtype=float))
+        start, goal = self.robot.check_config(start), self.robot.check_config(goal)
+        pair = (check_sector(from_sector), check_sector(to_sector))
+        pd = self.pairs.get(pair)
+        if pd is None:
+            raise ValueError(f"the library has no demonstrations for {pair[0]}->{pair[1]} (pairs: {sorted(self.pairs)})")
+        key = _key(start, goal)
         return np.argsort(np.linalg.norm(pd.keys - key, axis=1), kind="stable")
 
     def generate(
@@ -607,7 +632,8 @@ class PathLibrary:
                 if motion_is_valid(self.robot, path, step):
                     outcome = "dmp" if rank == 0 else "repaired"
                     return self._result(path, outcome, int(k), tried, t0)
-            seed_path = self.generate(start, goal, i, j, int(order[0]), stride=self.per_step)
+            if self.plan is not None:
+                seed_path = self.generate(start, goal, i, j, int(order[0]), stride=self.per_step)
         if self.plan is not None:
             kw = {}
             if seed_path is not None and seed_path.shape == (N_FAKE_TIME_STEPS, 4) and _takes_initial_waypoints(self.plan):
@@ -738,6 +764,8 @@ class PathLibrary:
             for i, j in meta["pairs"]:
                 p = f"p{i}{j}_"
                 pd = _PairData(arrays[p + "starts"], arrays[p + "goals"], arrays[p + "waypoints"], arrays[p + "margins"])
+                if not (len(pd.starts) == len(pd.goals) == len(pd.waypoints) == len(pd.margins)):
+                    raise ValueError(f"pair {i}->{j}: starts, goals, waypoints and margins differ in length")
                 for W, fw, fs, rw, rs in zip(pd.waypoints, arrays[p + "fwd_weights"], arrays[p + "fwd_scaled"],
                                              arrays[p + "rev_weights"], arrays[p + "rev_scaled"], strict=True):
                     pd.forward.append(DMP.from_weights(fw, W[0, 2:], W[-1, 2:], fs, n_steps, options))

@@ -146,9 +146,10 @@ class WearerArm:
     n_threads : int or None
         Threads for batched checks (default: all cores, at most 2).
     link_margins : mapping {link name: metres}, optional
-        Larger margins for the pairs that involve a geometry of these links (the larger of the two
-        applies), e.g. ``{"link3": 0.03, "link4": 0.03}`` to plan demonstrations that keep more
-        room around the pointing system only.  Never smaller than ``security_margin``.
+        Larger margins between these arm links and the wearer, e.g. ``{"link3": 0.03, "link4":
+        0.03}`` to plan demonstrations that keep more room around the pointing system only.
+        Arm-arm pairs keep ``security_margin`` (some sit at a fixed distance, e.g. the barrel and
+        the boom 3.5 cm apart).  Never smaller than ``security_margin``.
     """
 
     def __init__(
@@ -313,16 +314,19 @@ class WearerArm:
         return out
 
     def _margin_matrix(self) -> np.ndarray:
-        """(ng, ng) security margins: the base margin, raised for the pairs touching ``link_margins``."""
+        """(ng, ng) security margins: the base margin, raised for the wearer pairs of ``link_margins``' links."""
         ng = self.gmodel.ngeoms
-        per_geom = np.full(ng, self.security_margin)
-        frames = {f.name for f in self.model.frames}
-        unknown = sorted(set(self.link_margins) - frames)
+        on_wearer = np.array([g.parentJoint == 0 for g in self.gmodel.geometryObjects])
+        with_geometry = {self.model.frames[g.parentFrame].name for g in self.gmodel.geometryObjects}
+        unknown = sorted(set(self.link_margins) - with_geometry)
         if unknown:
-            raise ValueError(f"link_margins names unknown link(s) {unknown}")
-        for k, g in enumerate(self.gmodel.geometryObjects):
-            per_geom[k] = max(per_geom[k], self.link_margins.get(self.model.frames[g.parentFrame].name, 0.0))
-        return np.maximum(per_geom[:, None], per_geom[None, :])
+            raise ValueError(f"link_margins names unknown link(s) or links without collision geometry {unknown}; "
+                             f"links with geometry: {sorted(with_geometry)}")
+        link_margin = np.array([self.link_margins.get(self.model.frames[g.parentFrame].name, self.security_margin)
+                                for g in self.gmodel.geometryObjects])
+        arm_wearer = on_wearer[:, None] != on_wearer[None, :]
+        wide = np.maximum(link_margin[:, None], link_margin[None, :])
+        return np.where(arm_wearer, wide, self.security_margin)
 
     def _rebuild_geometry_data(self) -> None:
         self.gdata = pin.GeometryData(self.gmodel)
@@ -441,7 +445,8 @@ class WearerArm:
 
     # ------------------------------------------------------------------ collision
     def is_valid(self, q: np.ndarray) -> bool:
-        """True if q is within limits and no checked pair (arm-wearer, arm-arm) is closer than the margin."""
+        """True if q is within limits and no checked pair (arm-wearer, arm-arm) is closer than its margin
+        (``security_margin``, or for an arm-wearer pair the arm link's ``link_margins`` entry)."""
         q = self.check_config(q)
         if not (np.all(q >= self.lower) and np.all(q <= self.upper)):
             return False
