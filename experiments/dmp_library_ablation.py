@@ -73,9 +73,9 @@ def main(argv: list[str] | None = None) -> int:
         a, n = (next(r["raw_valid"] for r in rows if r["demos"] == label and r["scaling"] == s) for s in ("amplitude", "none"))
         print(f"| {label} | {a:.1%} | {n:.1%} |")
     stem = new_output_stem(args.out, (".json",))  # never overwrite earlier results
-    stem.with_suffix(".json").write_text(json.dumps({"query_set": args.query_set, "queries": len(queries),
+    stem.with_name(stem.name + ".json").write_text(json.dumps({"query_set": args.query_set, "queries": len(queries),
                                                          "per_pair": args.per_pair, "seed": args.seed, "rows": rows}, indent=1))
-    print(f"wrote {stem.with_suffix('.json')}")
+    print(f"wrote {stem.with_name(stem.name + '.json')}")
     return 0
 
 

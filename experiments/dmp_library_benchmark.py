@@ -159,11 +159,11 @@ def main(argv: list[str] | None = None) -> int:
     summary["hardware"] = {"machine": platform.machine(), "processor": platform.processor(), "cpus": os.cpu_count(),
                            "python": platform.python_version()}
     stem = new_output_stem(args.out, (".csv", ".json"))  # never overwrite earlier results
-    with open(stem.with_suffix(".csv"), "w", newline="") as fh:
+    with open(stem.with_name(stem.name + ".csv"), "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=list(rows[0]))
         w.writeheader()
         w.writerows(rows)
-    stem.with_suffix(".json").write_text(json.dumps(summary, indent=1))
+    stem.with_name(stem.name + ".json").write_text(json.dumps(summary, indent=1))
     for label in ("all", "planning_necessary"):
         a = summary[label]
         if a is None:
@@ -173,7 +173,7 @@ def main(argv: list[str] | None = None) -> int:
               f"(p95 {a['generation_time']['p95_ms']:.3f}); raw DMP valid {a['raw_dmp_valid_share']:.1%}; "
               f"outcomes {a['outcomes']}; fallback {a['fallback_share']:.1%}; "
               f"length ratio median {a['length_ratio_median']}, p95 {a['length_ratio_p95']}")
-    print(f"wrote {stem.with_suffix('.csv')} and {stem.with_suffix('.json')}")
+    print(f"wrote {stem.with_name(stem.name + '.csv')} and {stem.with_name(stem.name + '.json')}")
     return 0
 
 

@@ -77,8 +77,8 @@ def main(argv: list[str] | None = None) -> int:
             print(f"{label} ({len(sel)} queries, {args.samples} samples): seeded {out[label]['seeded']}; "
                   f"straight {out[label]['straight']}")
     stem = new_output_stem(args.out, (".json",))  # never overwrite earlier results
-    stem.with_suffix(".json").write_text(json.dumps({**out, "rows": rows}, indent=1))
-    print(f"wrote {stem.with_suffix('.json')}")
+    stem.with_name(stem.name + ".json").write_text(json.dumps({**out, "rows": rows}, indent=1))
+    print(f"wrote {stem.with_name(stem.name + '.json')}")
     return 0
 
 

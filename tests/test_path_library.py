@@ -187,6 +187,23 @@ def test_fallback_starts_from_the_closest_dmp_path(robot: WearerArm, library: Pa
     np.testing.assert_allclose(W, library.generate(start, goal, i, j, 0)[:: library.per_step])
 
 
+@pytest.mark.parametrize(
+    "args, match",
+    [((np.full(4, np.nan), None, 1, 2), "NaN"), ((np.zeros(3), None, 1, 2), "shape"), ((None, None, 2, 2), "no demonstrations"),
+     ((None, None, 5, 1), "sector")],
+)
+def test_demo_order_rejects_bad_input_clearly(library: PathLibrary, args, match: str) -> None:
+    (i, j), pd = next(iter(library.pairs.items()))
+    start, goal, a, b = args
+    with pytest.raises(ValueError, match=match):
+        library.demo_order(pd.starts[0] if start is None else start, pd.goals[0] if goal is None else goal, a, b)
+
+
+def test_with_options_needs_dmp_options(library: PathLibrary) -> None:
+    with pytest.raises(ValueError, match="DMPOptions"):
+        library.with_options(None)  # type: ignore[arg-type]
+
+
 def test_library_round_trips_through_disk(robot: WearerArm, library: PathLibrary, tmp_path) -> None:
     f = library.save(tmp_path / "lib.npz")
     loaded = PathLibrary.load(f, robot)
@@ -300,6 +317,16 @@ def test_seeded_default_build_is_deterministic_with_one_or_two_workers(robot: We
     assert again.build_stats == rrt_library.build_stats
 
 
+def test_worker_processes_plan_with_the_callers_robot_and_its_margins() -> None:
+    strict = WearerArm(link_margins={"link3": 0.03, "link4": 0.03})
+    kw = {"per_pair": 1, "seed": 5, "pairs": ((1, 2), (2, 1)), "max_samples": 200, "timeout": 5.0, "demo_margins": ()}
+    one, two = PathLibrary.build_default(strict, workers=1, **kw), PathLibrary.build_default(strict, workers=2, **kw)
+    for pair in kw["pairs"]:
+        assert np.array_equal(one.pairs[pair].waypoints, two.pairs[pair].waypoints)
+        for W in two.pairs[pair].waypoints:
+            assert motion_is_valid(strict, W)
+
+
 def test_demonstrations_keep_the_wider_margin_they_were_planned_with(robot: WearerArm, rrt_library: PathLibrary) -> None:
     from tpee_ompl.path_library import DEMO_MARGINS, POINTING_LINKS
 
@@ -312,6 +339,27 @@ def test_demonstrations_keep_the_wider_margin_they_were_planned_with(robot: Wear
             assert motion_is_valid(wide, W, robot.max_joint_step())
     stored = sum(v for k, v in rrt_library.build_stats.items() if k.startswith("stored_at_"))
     assert stored == rrt_library.build_stats["stored"] == len(rrt_library)
+
+
+def test_demo_planner_rungs_are_never_looser_than_the_robot(rng) -> None:
+    from tpee_ompl.path_library import DemoPlanner
+
+    strict = WearerArm(link_margins={"link4": 0.05})
+    plan = DemoPlanner(strict, margins=(0.035, 0.01), max_samples=10)
+    assert plan.margins == (0.035, strict.security_margin)
+    Q = rng.uniform(strict.lower, strict.upper, size=(2000, 4))
+    for _, rung, _ in plan._rungs:
+        assert not np.any(rung.are_valid(Q) & ~strict.are_valid(Q))
+
+
+@pytest.mark.parametrize("margins", [(float("nan"),), (-0.01,), (2.0,), ("wide",)])
+def test_bad_demo_margins_raise_value_error(robot: WearerArm, margins) -> None:
+    from tpee_ompl.path_library import DemoPlanner
+
+    with pytest.raises(ValueError, match="demo margins"):
+        DemoPlanner(robot, margins=margins)
+    with pytest.raises(ValueError, match="demo margins"):
+        PathLibrary.build_default(robot, per_pair=1, pairs=((1, 2),), demo_margins=margins)
 
 
 def test_demo_planner_falls_back_to_the_robots_margin_when_the_wide_one_rejects_the_start(robot: WearerArm) -> None:
