@@ -31,7 +31,7 @@ bench-full: $(STAMP)
 	MPLBACKEND=Agg $(PY) experiments/run_benchmark.py --queries paper_random --name full_random --workers 2 \
 		--anytime
 
-# Default cross-sector DMP path library (12 pairs x <= 20 dimension-RRT demos, ~5 min on 2 cores).
+# Default cross-sector DMP path library (12 pairs x <= 20 dimension-RRT demos, ~3.5 min on 2 cores).
 library: $(STAMP)
 	$(PY) experiments/build_library.py --per-pair 20 --seed 0 --workers 2 --library experiments/library/default.npz
 

@@ -17,9 +17,11 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
+
 from tpee_ompl.benchmark import new_output_stem
 from tpee_ompl.dmp import DMPOptions
-from tpee_ompl.path_library import DEMO_MARGINS, PathLibrary, motion_is_valid
+from tpee_ompl.path_library import DEMO_MARGINS, PathLibrary, motion_is_valid, path_length
 from tpee_ompl.queries import load_queries
 from tpee_ompl.robot import default_robot
 
@@ -35,14 +37,16 @@ def _label(margins: tuple[float, ...]) -> str:
 SETTINGS = {_label(m): m for m in LADDERS}
 
 
-def raw_valid_share(lib: PathLibrary, queries: list) -> float:
-    """Share of queries whose closest demonstration's DMP path passes the motion check."""
-    ok = 0
+def raw_paths(lib: PathLibrary, queries: list) -> tuple[float, float]:
+    """Share of queries whose closest demonstration's DMP path passes the motion check, and the
+    median length (rad) of those paths (valid or not)."""
+    ok, lengths = 0, []
     for q in queries:
         k = int(lib.demo_order(q.start, q.goal, q.from_sector, q.to_sector)[0])
         path = lib.generate(q.start, q.goal, q.from_sector, q.to_sector, k, stride=lib.query_stride)
         ok += motion_is_valid(lib.robot, path)
-    return ok / len(queries)
+        lengths.append(path_length(path))
+    return ok / len(queries), float(np.median(lengths))
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -64,14 +68,17 @@ def main(argv: list[str] | None = None) -> int:
         build_s = time.perf_counter() - t0
         stored = {k: v for k, v in lib.build_stats.items() if k.startswith("stored")}
         for scaling in ("amplitude", "none"):
-            share = raw_valid_share(lib.with_options(DMPOptions(scaling=scaling)), queries)
+            share, length = raw_paths(lib.with_options(DMPOptions(scaling=scaling)), queries)
             rows.append({"demos": label, "margins": list(margins), "scaling": scaling, "raw_valid": share,
+                         "median_length_rad": length,
                          "n_demos": len(lib), "stored": stored, "build_s": round(build_s, 1)})
-            print(f"{label:45s} {scaling:9s} raw DMP valid {share:.1%} ({len(lib)} demos, {stored})", flush=True)
-    print("\n| demos planned at | eq. 13 scaling x(g - y0) | absolute forcing (S = 1) |\n|---|---|---|")
+            print(f"{label:45s} {scaling:9s} raw DMP valid {share:.1%}, median length {length:.3f} rad "
+                  f"({len(lib)} demos, {stored})", flush=True)
+    print("\n| demos planned at | eq. 13 scaling x(g - y0) | absolute forcing (S = 1) | median length, absolute (rad) |")
+    print("|---|---|---|---|")
     for label in SETTINGS:
-        a, n = (next(r["raw_valid"] for r in rows if r["demos"] == label and r["scaling"] == s) for s in ("amplitude", "none"))
-        print(f"| {label} | {a:.1%} | {n:.1%} |")
+        a, n = (next(r for r in rows if r["demos"] == label and r["scaling"] == s) for s in ("amplitude", "none"))
+        print(f"| {label} | {a['raw_valid']:.1%} | {n['raw_valid']:.1%} | {n['median_length_rad']:.3f} |")
     stem = new_output_stem(args.out, (".json",))  # never overwrite earlier results
     stem.with_name(stem.name + ".json").write_text(json.dumps({"query_set": args.query_set, "queries": len(queries),
                                                          "per_pair": args.per_pair, "seed": args.seed, "rows": rows}, indent=1))

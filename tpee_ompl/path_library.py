@@ -75,7 +75,7 @@ ALL_PAIRS: tuple[tuple[int, int], ...] = tuple((i, j) for i in range(1, 5) for j
 """The 12 ordered (from, to) posture-sector pairs."""
 POINTING_LINKS: tuple[str, ...] = ("link3", "link4")
 """Links moved by DOF3/DOF4, the DOFs the DMPs generate (DOF1/DOF2 follow Table 3 for every query)."""
-DEMO_MARGINS: tuple[float, ...] = (0.035, 0.03, 0.025)
+DEMO_MARGINS: tuple[float, ...] = (0.05, 0.04, 0.03, 0.025)
 """Metres. Margins around :data:`POINTING_LINKS` tried in turn when planning a demonstration, before
 the robot's own margin.  A demonstration planned at 2 cm hugs the wearer; its DMP generalisations
 then cross into the margin (docs/dmp.md has the measurements)."""
