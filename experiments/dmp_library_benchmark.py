@@ -25,6 +25,7 @@ import json
 import logging
 import os
 import platform
+import signal
 import sys
 import time
 from concurrent.futures import ProcessPoolExecutor
@@ -97,6 +98,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--generate-only", action="store_true", help="stop after generating (and caching) the queries")
     ap.add_argument("--out", type=Path, default=Path("experiments/library/benchmark"), help="output stem")
     args = ap.parse_args(argv)
+    signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))  # unwind, so worker pools shut down
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s: %(message)s")
     from tpee_ompl.queries import Query
     from tpee_ompl.robot import default_robot
@@ -141,9 +143,12 @@ def main(argv: list[str] | None = None) -> int:
         items = [(k, q.start.tolist(), q.goal.tolist(), q.from_sector, q.to_sector) for k, q in enumerate(queries)]
         # small tasks: an interrupted run leaves no worker busy for long (each query's seed is its own)
         chunks = [items[k:k + 10] for k in range(0, len(items), 10)]
-        with ProcessPoolExecutor(workers, mp_context=ctx) as ex:
+        ex = ProcessPoolExecutor(workers, mp_context=ctx)
+        try:
             ref = dict(x for part in ex.map(_reference, chunks, [args.reference_samples] * len(chunks), [7] * len(chunks))
                        for x in part)
+        finally:  # on Ctrl-C / SIGTERM: drop the queued tasks, let the running ones (<= 10 queries) end
+            ex.shutdown(wait=True, cancel_futures=True)
         for k, row in enumerate(rows):
             row["ref_length"] = ref[k]
             row["length_ratio"] = row["length"] / ref[k] if ref[k] > 0 else float("nan")
