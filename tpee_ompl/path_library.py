@@ -324,6 +324,10 @@ def _key(start: np.ndarray, goal: np.ndarray) -> np.ndarray:
     return np.concatenate([start[2:], goal[2:]])
 
 
+def _closest_first(pd: _PairData, start: np.ndarray, goal: np.ndarray) -> np.ndarray:
+    return np.argsort(np.linalg.norm(pd.keys - _key(start, goal), axis=1), kind="stable")
+
+
 def _check_build_args(
     pairs: Sequence[tuple[int, int]], per_pair: int, min_difference: float, max_attempts: int | None
 ) -> tuple[list[tuple[int, int]], int]:
@@ -581,8 +585,7 @@ class PathLibrary:
         pd = self.pairs.get(pair)
         if pd is None:
             raise ValueError(f"the library has no demonstrations for {pair[0]}->{pair[1]} (pairs: {sorted(self.pairs)})")
-        key = _key(start, goal)
-        return np.argsort(np.linalg.norm(pd.keys - key, axis=1), kind="stable")
+        return _closest_first(pd, start, goal)
 
     def generate(
         self, start: np.ndarray, goal: np.ndarray, from_sector: int, to_sector: int, demo_index: int, stride: int = 1
@@ -625,7 +628,7 @@ class PathLibrary:
         tried = 0
         seed_path = None
         if pd is not None and len(pd.starts):
-            order = self.demo_order(start, goal, i, j)
+            order = _closest_first(pd, start, goal)  # start, goal and pair already checked above
             for rank, k in enumerate(order[: self.n_candidates]):
                 tried += 1
                 path = self.generate(start, goal, i, j, int(k), stride=self.query_stride)
