@@ -1,7 +1,7 @@
 """Build the default cross-sector path library (``make library``).
 
 Same options as ``tpee-ompl library build`` (see ``--help``); the logic is
-:func:`tpee_ompl.library_cli.run_build`, so this script only parses and runs it.
+:func:`tpee_ompl.cli.library.run_build`, so this script only parses and runs it.
 """
 
 from __future__ import annotations
@@ -9,7 +9,7 @@ from __future__ import annotations
 import logging
 import sys
 
-from tpee_ompl.library_cli import build_parser
+from tpee_ompl.cli.library import build_parser
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -13,7 +13,7 @@ import time
 import numpy as np
 import pinocchio as pin
 
-from tpee_ompl.robot import WearerArm
+from tpee_ompl.model.wearer_arm import WearerArm
 
 
 def _median_us(fn, n: int, repeats: int) -> float:

@@ -20,10 +20,10 @@ from ompl import base as ob
 from ompl import geometric as og
 from ompl import util as ou
 
-from tpee_ompl.dimension_rrt import tpee_dimension_rrt
+from tpee_ompl.planning.tpee import tpee_dimension_rrt
 from tpee_ompl.examples.tpee_queries import PAIR_TYPES, cross_sector_query
-from tpee_ompl.ompl_problem import make_simple_setup
-from tpee_ompl.robot import WearerArm
+from tpee_ompl.planning.setup import make_simple_setup
+from tpee_ompl.model.wearer_arm import WearerArm
 
 
 def get_argument_parser() -> argparse.ArgumentParser:
@@ -67,7 +67,7 @@ def run(args: argparse.Namespace) -> list[dict]:
     robot = WearerArm(security_margin=args.margin)
     rng = np.random.default_rng(args.seed)
     if args.queries:
-        from tpee_ompl.queries import load_queries
+        from tpee_ompl.model.queries import load_queries
 
         stored = load_queries(args.queries, robot if args.margin == 0.02 else None)
         queries = [(q.from_sector, q.to_sector, np.asarray(q.start), np.asarray(q.goal)) for i, j in PAIR_TYPES

@@ -1,10 +1,10 @@
 """Benchmark the DMP path library on fresh planning-necessary queries (figures for issue 6).
 
-1. ``--per-pair`` queries per ordered sector pair from :func:`tpee_ompl.queries.generate_queries`
+1. ``--per-pair`` queries per ordered sector pair from :func:`tpee_ompl.planning.query_generation.generate_queries`
    (planning-necessary regions; seeds differ from the library's build seed), drawn in
    ``--workers`` processes.
 2. Every query through :meth:`PathLibrary.query` (validation, repair, dimension-RRT fallback) in this
-   process alone, so the timings are not disturbed: :func:`tpee_ompl.path_library.benchmark_queries`.
+   process alone, so the timings are not disturbed: :func:`tpee_ompl.library.path_library.benchmark_queries`.
 3. The same queries planned by dimension-RRT at ``--reference-samples`` samples (workers), for the
    path-length ratio.
 
@@ -34,22 +34,23 @@ from pathlib import Path
 
 import numpy as np
 
-from tpee_ompl.benchmark import new_output_stem
-from tpee_ompl.path_library import PathLibrary, benchmark_queries, dimension_rrt_planner, path_length
+from tpee_ompl.bench.campaign import new_output_stem
+from tpee_ompl.library.path_library import PathLibrary, benchmark_queries, dimension_rrt_planner
+from tpee_ompl.planning.paths import path_length
 
 log = logging.getLogger("dmp_library_benchmark")
 
 
 def _gen_queries(n_per_pair: int, seed: int) -> list[dict]:
-    from tpee_ompl.queries import generate_queries
-    from tpee_ompl.robot import default_robot
+    from tpee_ompl.planning.query_generation import generate_queries
+    from tpee_ompl.model.wearer_arm import default_robot
 
     qs, _ = generate_queries(default_robot(), n_per_pair=n_per_pair, seed=seed)
     return [q.to_dict() for q in qs]
 
 
 def _reference(items: list[tuple[int, list[float], list[float], int, int]], samples: int, seed: int) -> list[tuple[int, float]]:
-    from tpee_ompl.robot import default_robot
+    from tpee_ompl.model.wearer_arm import default_robot
 
     plan = dimension_rrt_planner(default_robot(), max_samples=samples, seed=seed)
     out = []
@@ -100,15 +101,15 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))  # unwind, so worker pools shut down
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s: %(message)s")
-    from tpee_ompl.queries import Query
-    from tpee_ompl.robot import default_robot
+    from tpee_ompl.model.queries import Query
+    from tpee_ompl.model.wearer_arm import default_robot
 
     t0 = time.perf_counter()
     workers = max(1, args.workers)
     shares = [args.per_pair // workers + (w < args.per_pair % workers) for w in range(workers)]
     ctx = get_context("spawn")
     if args.query_set is not None:
-        from tpee_ompl.queries import load_queries
+        from tpee_ompl.model.queries import load_queries
 
         queries = load_queries(args.query_set)
     elif args.queries_cache is not None and args.queries_cache.exists():
@@ -133,7 +134,7 @@ def main(argv: list[str] | None = None) -> int:
     t1 = time.perf_counter()
     rows = benchmark_queries(lib, queries)
     t_lib = time.perf_counter() - t1
-    from tpee_ompl.queries import straight_motion_valid
+    from tpee_ompl.planning.query_generation import straight_motion_valid
 
     for row, q in zip(rows, queries, strict=True):
         row["planning_necessary"] = not straight_motion_valid(robot, q.start, q.goal, q.from_sector, q.to_sector)

@@ -19,12 +19,13 @@ from pathlib import Path
 import numpy as np
 from ompl import util as ou
 
-from tpee_ompl.benchmark import new_output_stem
-from tpee_ompl.dimension_rrt import tpee_dimension_rrt
-from tpee_ompl.ompl_problem import make_simple_setup
-from tpee_ompl.path_library import N_FAKE_TIME_STEPS, PathLibrary, motion_is_valid
-from tpee_ompl.queries import load_queries
-from tpee_ompl.robot import default_robot
+from tpee_ompl.bench.campaign import new_output_stem
+from tpee_ompl.planning.tpee import tpee_dimension_rrt
+from tpee_ompl.planning.setup import make_simple_setup
+from tpee_ompl.library.path_library import N_FAKE_TIME_STEPS, PathLibrary
+from tpee_ompl.planning.paths import motion_is_valid
+from tpee_ompl.model.queries import load_queries
+from tpee_ompl.model.wearer_arm import default_robot
 
 
 def _run(robot, q, samples: int, seed: int, initial: np.ndarray | None) -> dict:

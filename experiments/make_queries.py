@@ -1,4 +1,4 @@
-"""Regenerate the named cross-sector query sets in experiments/queries/ (paper section 5.1).
+"""Regenerate the named cross-sector query sets in tpee_ompl/data/queries/ (paper section 5.1).
 
 Usage: python experiments/make_queries.py [--seed N] [--n-per-pair N] [--out DIR]
 """
@@ -9,8 +9,10 @@ import argparse
 import logging
 from pathlib import Path
 
-from tpee_ompl.queries import QUERY_DIR, generate_queries, planning_necessity, save_queries
-from tpee_ompl.robot import default_robot
+from tpee_ompl.planning.query_generation import generate_queries, planning_necessity
+from tpee_ompl.model.queries import save_queries
+from tpee_ompl.resources import data_path
+from tpee_ompl.model.wearer_arm import default_robot
 
 
 def get_argument_parser() -> argparse.ArgumentParser:
@@ -18,7 +20,7 @@ def get_argument_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--seed", type=int, default=2022, help="seed of the planning_necessary set (paper_random: seed + 1)")
     p.add_argument("--n-per-pair", type=int, default=10, help="queries per ordered sector pair (12 pairs)")
-    p.add_argument("--out", type=Path, default=QUERY_DIR, help="output directory")
+    p.add_argument("--out", type=Path, default=data_path("queries"), help="output directory")
     return p
 
 
@@ -31,7 +33,7 @@ def main(argv: list[str] | None = None) -> None:
         queries, stats = generate_queries(robot, n_per_pair=args.n_per_pair, seed=seed, require_planning=require)
         rate, per_pair = planning_necessity(robot, queries)
         extra = {
-            "generator": "tpee_ompl.queries.generate_queries",
+            "generator": "tpee_ompl.planning.query_generation.generate_queries",
             "n_per_pair": args.n_per_pair,
             "require_planning": require,
             "straight_motion_step_rad": 0.01,

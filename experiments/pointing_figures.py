@@ -14,9 +14,9 @@ import argparse
 
 import numpy as np
 
-from tpee_ompl.pointing import BlindAreaError, aim_batch, aim_checked, aim_errors
-from tpee_ompl.robot import default_robot
-from tpee_ompl.sectors import SECTORS, in_pointing_sector, sector_origin
+from tpee_ompl.model.pointing import BlindAreaError, aim_batch, aim_checked, aim_errors
+from tpee_ompl.model.wearer_arm import default_robot
+from tpee_ompl.model.sectors import SECTORS, in_pointing_sector, sector_origin
 
 
 def _sphere(rng: np.random.Generator, n: int) -> np.ndarray:

@@ -11,7 +11,7 @@ os.environ.setdefault("MPLBACKEND", "Agg")
 
 from ompl import util as ou  # noqa: E402
 
-from tpee_ompl.robot import WearerArm, default_robot  # noqa: E402
+from tpee_ompl.model.wearer_arm import WearerArm, default_robot
 
 ou.setLogLevel(ou.LOG_WARN)
 

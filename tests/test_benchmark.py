@@ -12,8 +12,8 @@ import pytest
 from ompl import base as ob
 from ompl import geometric as og
 
-from tpee_ompl.benchmark import CampaignConfig, PlannerContext, group_lengths, load_query_set, run_campaign
-from tpee_ompl.sectors import posture_preset
+from tpee_ompl.bench.campaign import CampaignConfig, PlannerContext, group_lengths, load_query_set, run_campaign
+from tpee_ompl.model.sectors import posture_preset
 
 
 class StandInPlanner(ob.Planner):

@@ -16,7 +16,7 @@ from ompl import base as ob
 from ompl import util as ou
 from test_benchmark import StandInPlanner, tiny_config, write_query_file
 
-from tpee_ompl.benchmark import (
+from tpee_ompl.bench.campaign import (
     PlannerContext,
     build_database,
     main,
@@ -154,7 +154,7 @@ def test_missing_dask_gives_a_clear_error(monkeypatch, capsys, tmp_path):
 
 
 def _launch(query_file: Path, out: Path) -> subprocess.Popen:
-    code = ("import sys; sys.path.insert(0, sys.argv[1]); from tpee_ompl.benchmark import main; "
+    code = ("import sys; sys.path.insert(0, sys.argv[1]); from tpee_ompl.bench.campaign import main; "
             "sys.exit(main(sys.argv[2:]))")
     args = ["--queries", str(query_file), "--name", "sig", "--samples", "30", "60", "--anytime", "0.05",
             "--planners", "test_benchmark:make_standin", "RRTstar",

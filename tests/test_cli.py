@@ -7,8 +7,8 @@ import json
 import numpy as np
 import pytest
 
-from tpee_ompl.cli import main
-from tpee_ompl.sectors import posture_preset
+from tpee_ompl.cli.main import main
+from tpee_ompl.model.sectors import posture_preset
 
 START = [*posture_preset(1), 0.0, 0.0]
 GOAL = [*posture_preset(4), 0.0, 0.0]

@@ -15,8 +15,8 @@ pytest.importorskip("distributed")
 
 from test_benchmark import StandInPlanner, tiny_config, write_query_file  # noqa: E402
 
-from tpee_ompl.benchmark import PlannerContext, run_campaign  # noqa: E402
-from tpee_ompl.executors import DaskExecutor, ProcessPoolExecutor  # noqa: E402
+from tpee_ompl.bench.campaign import PlannerContext, run_campaign
+from tpee_ompl.bench.executors import DaskExecutor, ProcessPoolExecutor
 
 KILL_MARKER_ENV = "TPEE_TEST_KILL_MARKER"
 

@@ -12,11 +12,13 @@ import pytest
 from ompl import base as ob
 from ompl import tools as ot
 
-from tpee_ompl.dimension_rrt import DimensionRRT, tpee_dimension_rrt
+from tpee_ompl.planning.dimension_rrt import DimensionRRT
+from tpee_ompl.planning.tpee import tpee_dimension_rrt
 from tpee_ompl.examples.planar_arm import make_planar_arm_setup
 from tpee_ompl.examples.tpee_queries import PAIR_TYPES, cross_sector_query
-from tpee_ompl.ompl_problem import make_simple_setup, path_to_array, set_state
-from tpee_ompl.robot import WearerArm
+from tpee_ompl.planning.setup import make_simple_setup
+from tpee_ompl.planning.paths import path_to_array, set_state
+from tpee_ompl.model.wearer_arm import WearerArm
 
 SAMPLES = 300
 

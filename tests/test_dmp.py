@@ -7,7 +7,7 @@ import time
 import numpy as np
 import pytest
 
-from tpee_ompl.dmp import (
+from tpee_ompl.library.dmp import (
     DMPOptions,
     basis_functions,
     blend_forward_reverse,

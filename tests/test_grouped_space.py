@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 from ompl import base as ob
 
-from tpee_ompl.grouped_space import GroupedSpace, RealVectorLayout, default_groups, interpolate_waypoints
-from tpee_ompl.sectors import cross_sector_trajectory
+from tpee_ompl.planning.grouped_space import GroupedSpace, RealVectorLayout, default_groups, interpolate_waypoints
+from tpee_ompl.model.sectors import cross_sector_trajectory
 
 
 def _space(n: int = 4) -> ob.RealVectorStateSpace:

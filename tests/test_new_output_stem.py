@@ -1,8 +1,8 @@
-"""Experiment outputs are never overwritten: :func:`tpee_ompl.benchmark.new_output_stem`."""
+"""Experiment outputs are never overwritten: :func:`tpee_ompl.bench.campaign.new_output_stem`."""
 
 from __future__ import annotations
 
-from tpee_ompl.benchmark import new_output_stem
+from tpee_ompl.bench.campaign import new_output_stem
 
 
 def test_existing_results_get_a_new_timestamped_stem(tmp_path) -> None:

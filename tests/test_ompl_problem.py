@@ -8,9 +8,10 @@ from ompl import base as ob
 from ompl import geometric as og
 from ompl import util as ou
 
-from tpee_ompl.ompl_problem import BatchedMotionValidator, make_simple_setup, motion_states, path_to_array, set_state
-from tpee_ompl.robot import WearerArm
-from tpee_ompl.sectors import posture_preset
+from tpee_ompl.planning.setup import BatchedMotionValidator, make_simple_setup
+from tpee_ompl.planning.paths import motion_states, path_to_array, set_state
+from tpee_ompl.model.wearer_arm import WearerArm
+from tpee_ompl.model.sectors import posture_preset
 
 
 def preset(k: int, pan: float = 0.0, tilt: float = 0.0) -> np.ndarray:

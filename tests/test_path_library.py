@@ -9,16 +9,12 @@ import pytest
 from ompl import geometric as og
 from ompl import util as ou
 
-from tpee_ompl.ompl_problem import make_simple_setup, path_to_array
-from tpee_ompl.path_library import (
-    N_FAKE_TIME_STEPS,
-    LibraryFileError,
-    PathLibrary,
-    motion_is_valid,
-    resample_waypoints,
-)
-from tpee_ompl.robot import WearerArm
-from tpee_ompl.sectors import cross_sector_trajectory, posture_preset
+from tpee_ompl.planning.setup import make_simple_setup
+from tpee_ompl.planning.paths import path_to_array
+from tpee_ompl.library.path_library import N_FAKE_TIME_STEPS, LibraryFileError, PathLibrary
+from tpee_ompl.planning.paths import motion_is_valid, resample_waypoints
+from tpee_ompl.model.wearer_arm import WearerArm
+from tpee_ompl.model.sectors import cross_sector_trajectory, posture_preset
 
 PAIRS = ((1, 2), (2, 3))  # straight stand-in paths are often valid here (never for 3 <-> 4)
 
@@ -144,7 +140,7 @@ def test_query_at_a_demonstration_reproduces_it(library: PathLibrary) -> None:
 
 
 def test_colliding_dmp_path_is_never_returned(robot: WearerArm, library: PathLibrary, monkeypatch) -> None:
-    import tpee_ompl.path_library as pl
+    import tpee_ompl.library.path_library as pl
 
     calls = {"n": 0}
 
@@ -165,7 +161,7 @@ def test_colliding_dmp_path_is_never_returned(robot: WearerArm, library: PathLib
 
 
 def test_fallback_starts_from_the_closest_dmp_path(robot: WearerArm, library: PathLibrary, monkeypatch) -> None:
-    import tpee_ompl.path_library as pl
+    import tpee_ompl.library.path_library as pl
 
     seen = {}
     straight = _straight_plan(robot)
@@ -225,7 +221,7 @@ def test_truncated_library_file_is_refused(robot: WearerArm, library: PathLibrar
 
 
 def test_library_from_another_model_or_version_is_refused(robot: WearerArm, library: PathLibrary, tmp_path, monkeypatch) -> None:
-    import tpee_ompl.path_library as pl
+    import tpee_ompl.library.path_library as pl
 
     f = library.save(tmp_path / "lib.npz")
 
@@ -251,13 +247,13 @@ def rrt_library(robot: WearerArm) -> PathLibrary:
 
 
 def _necessary_queries(pairs, n: int):
-    from tpee_ompl.queries import load_queries
+    from tpee_ompl.model.queries import load_queries
 
     return [q for q in load_queries("planning_necessary") if (q.from_sector, q.to_sector) in pairs][:n]
 
 
 def test_polyline_motion_states_are_the_ompl_motion_states_of_every_segment(robot: WearerArm, rng) -> None:
-    from tpee_ompl.ompl_problem import motion_states, polyline_motion_states
+    from tpee_ompl.planning.paths import motion_states, polyline_motion_states
 
     path = np.cumsum(rng.uniform(-0.05, 0.05, (30, 4)), axis=0)
     path[10] = path[9]  # a zero-length segment still checks its end state once
@@ -267,8 +263,8 @@ def test_polyline_motion_states_are_the_ompl_motion_states_of_every_segment(robo
 
 
 def test_default_sampler_draws_planning_necessary_motions_from_the_presets(robot: WearerArm) -> None:
-    from tpee_ompl.path_library import query_sampler
-    from tpee_ompl.queries import straight_motion_valid
+    from tpee_ompl.library.path_library import query_sampler
+    from tpee_ompl.planning.query_generation import straight_motion_valid
 
     sample = query_sampler(robot)
     rng = np.random.default_rng(5)
@@ -291,8 +287,8 @@ def test_dimension_rrt_builder_stores_planned_demos_that_pass_the_motion_check(r
 
 
 def test_every_returned_path_passes_si_check_motion_segment_by_segment(robot: WearerArm, rrt_library: PathLibrary) -> None:
-    from tpee_ompl.ompl_problem import set_state
-    from tpee_ompl.path_library import dimension_rrt_planner
+    from tpee_ompl.planning.paths import set_state
+    from tpee_ompl.library.path_library import dimension_rrt_planner
 
     rrt_library.plan = dimension_rrt_planner(robot, max_samples=300, timeout=5.0)
     for q in _necessary_queries(RRT_PAIRS, 40)[::5]:
@@ -328,7 +324,7 @@ def test_worker_processes_plan_with_the_callers_robot_and_its_margins() -> None:
 
 
 def test_demonstrations_keep_the_wider_margin_they_were_planned_with(robot: WearerArm, rrt_library: PathLibrary) -> None:
-    from tpee_ompl.path_library import DEMO_MARGINS, POINTING_LINKS
+    from tpee_ompl.library.path_library import DEMO_MARGINS, POINTING_LINKS
 
     margins = np.concatenate([pd.margins for pd in rrt_library.pairs.values()])
     assert set(margins) <= {*DEMO_MARGINS, robot.security_margin}
@@ -342,7 +338,7 @@ def test_demonstrations_keep_the_wider_margin_they_were_planned_with(robot: Wear
 
 
 def test_demo_planner_rungs_are_never_looser_than_the_robot(rng) -> None:
-    from tpee_ompl.path_library import DemoPlanner
+    from tpee_ompl.library.path_library import DemoPlanner
 
     strict = WearerArm(link_margins={"link4": 0.05})
     plan = DemoPlanner(strict, margins=(0.035, 0.01), max_samples=10)
@@ -354,7 +350,7 @@ def test_demo_planner_rungs_are_never_looser_than_the_robot(rng) -> None:
 
 @pytest.mark.parametrize("margins", [(float("nan"),), (-0.01,), (2.0,), ("wide",)])
 def test_bad_demo_margins_raise_value_error(robot: WearerArm, margins) -> None:
-    from tpee_ompl.path_library import DemoPlanner
+    from tpee_ompl.library.path_library import DemoPlanner
 
     with pytest.raises(ValueError, match="demo margins"):
         DemoPlanner(robot, margins=margins)
@@ -363,7 +359,7 @@ def test_bad_demo_margins_raise_value_error(robot: WearerArm, margins) -> None:
 
 
 def test_demo_planner_falls_back_to_the_robots_margin_when_the_wide_one_rejects_the_start(robot: WearerArm) -> None:
-    from tpee_ompl.path_library import POINTING_LINKS, DemoPlanner
+    from tpee_ompl.library.path_library import POINTING_LINKS, DemoPlanner
 
     q = next(q for q in _necessary_queries(((1, 2), (2, 1), (3, 4), (4, 3), (4, 2), (2, 4)), 120)
              if not WearerArm(link_margins={n: 0.03 for n in POINTING_LINKS}).is_valid(q.start))
@@ -389,7 +385,7 @@ def test_strided_query_path_is_a_subsequence_of_the_dense_rollout(rrt_library: P
 
 
 def test_planner_adapter_raises_when_nothing_valid_is_found(rrt_library: PathLibrary, monkeypatch) -> None:
-    import tpee_ompl.path_library as pl
+    import tpee_ompl.library.path_library as pl
 
     monkeypatch.setattr(pl, "motion_is_valid", lambda *a, **k: False)
     monkeypatch.setattr(rrt_library, "plan", None)
@@ -399,9 +395,9 @@ def test_planner_adapter_raises_when_nothing_valid_is_found(rrt_library: PathLib
 
 
 def test_library_plugs_into_the_tracker_as_its_cross_sector_planner(robot: WearerArm, rrt_library: PathLibrary) -> None:
-    from tpee_ompl.ompl_problem import motion_states
-    from tpee_ompl.sectors import sector_origin
-    from tpee_ompl.tracker import Tracker
+    from tpee_ompl.planning.paths import motion_states
+    from tpee_ompl.model.sectors import sector_origin
+    from tpee_ompl.library.tracker import Tracker
 
     q = _necessary_queries(((3, 4),), 1)[0]
     tracker = Tracker(robot, rrt_library.as_planner(step=0.01), initial=q.start, initial_sector=3)
@@ -417,7 +413,8 @@ def test_library_plugs_into_the_tracker_as_its_cross_sector_planner(robot: Weare
 
 
 def test_benchmark_rows_report_outcome_time_and_length(robot: WearerArm, rrt_library: PathLibrary) -> None:
-    from tpee_ompl.path_library import benchmark_queries, path_length
+    from tpee_ompl.library.path_library import benchmark_queries
+    from tpee_ompl.planning.paths import path_length
 
     qs = _necessary_queries(RRT_PAIRS, 3)
     rows = benchmark_queries(rrt_library, qs, reference=lambda s, g, i, j: np.array([s, g]))

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from ompl import base as ob
 
-from tpee_ompl.dimension_rrt import DimensionRRT
+from tpee_ompl.planning.dimension_rrt import DimensionRRT
 from tpee_ompl.examples.planar_arm import make_planar_arm_setup
 
 

@@ -17,10 +17,11 @@ from ompl import base as ob
 from ompl import geometric as og
 from ompl import util as ou
 
-from tpee_ompl.dimension_rrt import tpee_dimension_rrt
-from tpee_ompl.ompl_problem import make_simple_setup, motion_states, path_to_array
-from tpee_ompl.queries import Query, load_queries
-from tpee_ompl.robot import WearerArm
+from tpee_ompl.planning.tpee import tpee_dimension_rrt
+from tpee_ompl.planning.setup import make_simple_setup
+from tpee_ompl.planning.paths import motion_states, path_to_array
+from tpee_ompl.model.queries import Query, load_queries
+from tpee_ompl.model.wearer_arm import WearerArm
 
 PER_PAIR = 10
 """Queries per ordered sector pair in the stored set (query k * 10 is the first of pair k)."""

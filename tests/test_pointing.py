@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tpee_ompl.pointing import (
+from tpee_ompl.model.pointing import (
     AimingError,
     BlindAreaError,
     PointingGeometry,
@@ -17,7 +17,7 @@ from tpee_ompl.pointing import (
     default_geometry,
     pointing_frame,
 )
-from tpee_ompl.sectors import SECTORS, in_pointing_sector, sector_origin
+from tpee_ompl.model.sectors import SECTORS, in_pointing_sector, sector_origin
 
 
 def _targets_in_sector(rng: np.random.Generator, k: int, n: int, lo: float, hi: float) -> np.ndarray:

@@ -22,9 +22,11 @@ from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 from ompl import base as ob
 
-from tpee_ompl.dimension_rrt import DimensionRRT, tpee_dimension_rrt
-from tpee_ompl.ompl_problem import MIN_JOINT_STEP, make_simple_setup, set_state
-from tpee_ompl.pointing import (
+from tpee_ompl.planning.dimension_rrt import DimensionRRT
+from tpee_ompl.planning.tpee import tpee_dimension_rrt
+from tpee_ompl.planning.paths import MIN_JOINT_STEP, set_state
+from tpee_ompl.planning.setup import make_simple_setup
+from tpee_ompl.model.pointing import (
     AimingError,
     UnreachableTargetError,
     aim,
@@ -34,9 +36,11 @@ from tpee_ompl.pointing import (
     check_target,
     default_geometry,
 )
-from tpee_ompl.queries import QuerySetError, load_queries, save_queries
-from tpee_ompl.robot import MAX_TARGET_DISTANCE, WearerArm, find_model_file
-from tpee_ompl.sectors import (
+from tpee_ompl.model.queries import QuerySetError, load_queries, save_queries
+from tpee_ompl.model.wearer_arm import MAX_TARGET_DISTANCE, WearerArm
+from tpee_ompl.resources import model_file as find_model_file
+from tpee_ompl.resources import query_set_path
+from tpee_ompl.model.sectors import (
     SECTORS,
     cross_sector_trajectory,
     in_pointing_sector,
@@ -44,7 +48,7 @@ from tpee_ompl.sectors import (
     posture_sector,
     select_sector,
 )
-from tpee_ompl.tracker import Tracker, TrackerOptions
+from tpee_ompl.library.tracker import Tracker, TrackerOptions
 
 SETTINGS = settings(
     max_examples=60, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.function_scoped_fixture]
@@ -430,7 +434,7 @@ def test_dimension_rrt_reports_invalid_endpoints_as_statuses(robot: WearerArm, d
 @FEW
 @given(cut=st.integers(0, 4000))
 def test_truncated_query_file_raises_query_set_error_naming_the_file(tmp_path_factory, robot, cut: int) -> None:
-    text = (Path(__file__).parent.parent / "experiments" / "queries" / "planning_necessary.json").read_text()
+    text = query_set_path("planning_necessary").read_text()
     p = tmp_path_factory.mktemp("q") / "cut.json"
     p.write_text(text[:cut])
     with pytest.raises(QuerySetError, match=re.escape(str(p))):

@@ -8,18 +8,10 @@ from collections import Counter
 import numpy as np
 import pytest
 
-from tpee_ompl.pointing import aim_errors
-from tpee_ompl.queries import (
-    FORMAT_VERSION,
-    Query,
-    generate_queries,
-    load_queries,
-    load_query_set,
-    planning_necessity,
-    save_queries,
-    straight_motion,
-)
-from tpee_ompl.sectors import cross_sector_trajectory, in_pointing_sector, posture_preset
+from tpee_ompl.model.pointing import aim_errors
+from tpee_ompl.model.queries import FORMAT_VERSION, Query, load_queries, load_query_set, save_queries, straight_motion
+from tpee_ompl.planning.query_generation import generate_queries, planning_necessity
+from tpee_ompl.model.sectors import cross_sector_trajectory, in_pointing_sector, posture_preset
 
 
 @pytest.fixture(scope="module")

@@ -13,8 +13,9 @@ import pytest
 from matplotlib.colors import to_hex
 from PIL import Image
 
-from tpee_ompl import default_robot, render
-from tpee_ompl.sectors import cross_sector_trajectory, posture_preset
+from tpee_ompl import default_robot
+from tpee_ompl.viz import scene as render
+from tpee_ompl.model.sectors import cross_sector_trajectory, posture_preset
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 

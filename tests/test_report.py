@@ -6,8 +6,8 @@ import math
 
 import pytest
 
-from tpee_ompl.benchmark import stratified_subset
-from tpee_ompl.report import PAPER_TABLE4, length_quality_table, ratio_table, success_table, summarize
+from tpee_ompl.bench.campaign import stratified_subset
+from tpee_ompl.bench.report import PAPER_TABLE4, length_quality_table, ratio_table, success_table, summarize
 
 
 def run(planner, qid, cap, time, length, l12, l34, ok=True, straight=1.0):

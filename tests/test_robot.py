@@ -10,8 +10,9 @@ import coal
 import numpy as np
 import pytest
 
-from tpee_ompl.robot import ARM_JOINTS, WearerArm, find_model_file
-from tpee_ompl.sectors import SECTORS, posture_preset
+from tpee_ompl.model.wearer_arm import ARM_JOINTS, WearerArm
+from tpee_ompl.resources import model_file as find_model_file
+from tpee_ompl.model.sectors import SECTORS, posture_preset
 
 MOUNT = np.array([-0.30, 0.0, 1.51])  # urdf/build_urdf.py
 T = np.array([0.1545, 0.0, 0.468])
@@ -230,6 +231,9 @@ def test_negative_security_margin_raises_value_error():
         WearerArm(security_margin=-0.01)
 
 
-def test_packaged_files_exist_under_urdf_folder():
-    assert find_model_file("wearer_arm.urdf").parent.name == "urdf"
-    assert Path(find_model_file("wearer_arm.srdf")).is_file()
+def test_packaged_model_files_are_package_data_with_the_urdf_folders_content():
+    root = Path(__file__).resolve().parent.parent
+    for name in ("wearer_arm.urdf", "wearer_arm.srdf"):
+        packaged = find_model_file(name)
+        assert packaged.parent.name == "model" and packaged.parent.parent.name == "data"
+        assert packaged.read_bytes() == (root / "urdf" / name).read_bytes()

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tpee_ompl.pointing import aim_checked
-from tpee_ompl.sectors import (
+from tpee_ompl.model.pointing import aim_checked
+from tpee_ompl.model.sectors import (
     CROSS_SECTOR_TRAJECTORIES,
     POINTING_AZIMUTH,
     POSTURE_AZIMUTH,

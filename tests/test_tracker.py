@@ -7,11 +7,11 @@ import itertools
 import numpy as np
 import pytest
 
-from tpee_ompl.ompl_problem import motion_states
-from tpee_ompl.pointing import aim_errors
-from tpee_ompl.queries import straight_motion
-from tpee_ompl.sectors import posture_sector, sector_origin
-from tpee_ompl.tracker import Tracker, make_default_planner
+from tpee_ompl.planning.paths import motion_states
+from tpee_ompl.model.pointing import aim_errors
+from tpee_ompl.model.queries import straight_motion
+from tpee_ompl.model.sectors import posture_sector, sector_origin
+from tpee_ompl.library.tracker import Tracker, make_default_planner
 
 
 def _direction(az_deg: float, el_deg: float) -> np.ndarray:
@@ -93,7 +93,7 @@ def test_bad_targets_give_events_and_the_arm_holds_still(robot, planner):
 
 
 def test_blind_area_target_triggers_a_posture_change(robot, planner):
-    from tpee_ompl.pointing import default_geometry
+    from tpee_ompl.model.pointing import default_geometry
 
     tracker = Tracker(robot, planner, initial_sector=3)
     origin, rot = default_geometry().pan_frame(np.deg2rad([-50.0, 20.0]))
@@ -113,7 +113,7 @@ def test_default_planner_returns_straight_motion_when_it_is_free(robot, planner)
 
 
 def test_tracker_rejects_a_colliding_planner_path(robot):
-    from tpee_ompl.sectors import posture_preset
+    from tpee_ompl.model.sectors import posture_preset
 
     into_backpack = np.r_[posture_preset(1), np.deg2rad(100.0), np.deg2rad(-50.0)]
     assert not robot.is_valid(into_backpack)

@@ -4,21 +4,14 @@ Implements Zou et al., "A Path Planning Strategy of Wearable Manipulators with T
 End Effectors", Electronics 2022, 11, 1615.
 """
 
-from .ompl_problem import (
-    BatchedMotionValidator,
-    WearerValidityChecker,
-    array_to_path,
-    make_simple_setup,
-    make_space,
-    motion_states,
-    path_to_array,
-)
-from .dmp import DMP, DMPOptions, generate, generate_blended, learn_dmp
-from .path_library import LibraryFileError, PathLibrary, QueryResult
-from .pointing import AimingError, BlindAreaError, UnreachableTargetError, aim, aim_batch, aim_checked
-from .queries import Query, load_queries
-from .robot import WearerArm, default_robot
-from .sectors import (
+from .planning.setup import BatchedMotionValidator, WearerValidityChecker, make_simple_setup, make_space
+from .planning.paths import array_to_path, motion_states, path_to_array
+from .library.dmp import DMP, DMPOptions, generate, generate_blended, learn_dmp
+from .library.path_library import LibraryFileError, PathLibrary, QueryResult
+from .model.pointing import AimingError, BlindAreaError, UnreachableTargetError, aim, aim_batch, aim_checked
+from .model.queries import Query, load_queries
+from .model.wearer_arm import WearerArm, default_robot
+from .model.sectors import (
     CROSS_SECTOR_TRAJECTORIES,
     POSTURE_PRESETS,
     cross_sector_trajectory,
@@ -27,7 +20,7 @@ from .sectors import (
     posture_sector,
     select_sector,
 )
-from .tracker import Tracker, make_default_planner
+from .library.tracker import Tracker, make_default_planner
 
 __all__ = [
     "AimingError",

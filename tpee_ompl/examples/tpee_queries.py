@@ -10,10 +10,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..grouped_space import interpolate_waypoints
-from ..ompl_problem import motion_states
-from ..robot import WearerArm
-from ..sectors import cross_sector_trajectory, posture_preset
+from ..planning.grouped_space import interpolate_waypoints
+from ..planning.paths import motion_states
+from ..model.wearer_arm import WearerArm
+from ..model.sectors import cross_sector_trajectory, posture_preset
 
 __all__ = ["PAIR_TYPES", "straight_motion_valid", "cross_sector_query"]
 

@@ -1,7 +1,7 @@
 """Campaign report: the paper's Table-4 ratios and honest length figures, as Markdown and CSV.
 
 Everything is read back from the campaign's SQLite database (Planner Arena format, see
-:mod:`tpee_ompl.benchmark`).  A run *succeeds* when its status is an exact solution,
+:mod:`tpee_ompl.bench.campaign`).  A run *succeeds* when its status is an exact solution,
 OMPL's ``correct_solution`` is 1, the raw path starts at the start and ends at the goal
 (``reaches_goal``; OMPL 2.0.1's AORRTC sometimes returns a zero-length path with status "Invalid
 goal" that Benchmark still marks solved) and every raw-path segment passes ``si.checkMotion``

@@ -49,6 +49,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..resources import data_path
+
 __all__ = [
     "ANYTIME_PLANNERS",
     "CampaignConfig",
@@ -81,7 +83,7 @@ CHECKERS = ("batched", "discrete")
 """Motion validators: one batched Pinocchio call per motion, or OMPL's DiscreteMotionValidator."""
 PROGRESS_PROPERTIES = ["best cost REAL", "iterations INTEGER", "time REAL"]  # sorted, as OMPL's map
 REPO_ROOT = Path(__file__).resolve().parent.parent
-QUERY_DIR = REPO_ROOT / "experiments" / "queries"
+QUERY_DIR = data_path("queries")
 
 
 # --------------------------------------------------------------------------- configuration
@@ -173,7 +175,7 @@ def _native(cls_name: str) -> PlannerFactory:
 
 
 def _dimension_rrt(si, ctx: PlannerContext):
-    from .dimension_rrt import tpee_dimension_rrt
+    from ..planning.tpee import tpee_dimension_rrt
 
     q = ctx.query
     return tpee_dimension_rrt(si, int(q["from_sector"]), int(q["to_sector"]), max_samples=ctx.max_samples, seed=ctx.seed)
@@ -376,7 +378,7 @@ def _fmt(v) -> str:
 def load_query_set(name_or_path: str) -> tuple[str, list[dict]]:
     """The set's name and its queries as plain dicts (picklable): id, from/to sector, start, goal."""
     try:
-        from .queries import load_queries  # written in parallel; fall back to the JSON format
+        from ..model.queries import load_queries
     except ImportError:
         load_queries = None
     path = Path(name_or_path)
@@ -504,7 +506,7 @@ def run_query_task(task: dict) -> dict:
     """
     from ompl import util as ou
 
-    from .robot import WearerArm
+    from ..model.wearer_arm import WearerArm
 
     t0 = time.perf_counter()
     cfg, query, qpos = task["config"], task["query"], int(task["qpos"])
@@ -558,7 +560,7 @@ def _run_experiment(robot, cfg: dict, task: dict, spec: dict) -> tuple[str, dict
     from ompl import tools as ot
     from ompl import util as ou
 
-    from .ompl_problem import make_simple_setup
+    from ..planning.setup import make_simple_setup
 
     query, qpos = task["query"], int(task["qpos"])
     start, goal = np.asarray(query["start"], float), np.asarray(query["goal"], float)
@@ -897,7 +899,7 @@ def run_campaign(
 ) -> CampaignResult:
     """Run a campaign into a new timestamped folder, build the DB, the report and the plots.
 
-    ``executor`` (:mod:`tpee_ompl.executors`) runs the per-query tasks; default: a local spawn
+    ``executor`` (:mod:`tpee_ompl.bench.executors`) runs the per-query tasks; default: a local spawn
     pool of ``config.workers`` processes (0 = this process).  ``on_task_done`` is called in this
     process with each finished query's log paths.  Ctrl-C or SIGTERM (or a KeyboardInterrupt from
     ``on_task_done``) stops the campaign: finished logs are kept, the database is still built from

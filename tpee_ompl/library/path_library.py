@@ -1,7 +1,7 @@
 """The cross-sector path library (paper sections 4.2.2, 4.2.3 and 5.2).
 
 One library holds, for each ordered pair of posture sectors (12 in all), demonstrations planned by
-dimension-RRT and, for each, a forward and a reverse DMP of DOF3/DOF4 (:mod:`tpee_ompl.dmp`).
+dimension-RRT and, for each, a forward and a reverse DMP of DOF3/DOF4 (:mod:`tpee_ompl.library.dmp`).
 DOF1/DOF2 always follow Table 3.  A query picks the closest demonstration, blends the forward and
 reverse rollouts, and returns the path only if every segment passes the motion check; otherwise it
 tries the next closest demonstrations, then the planner (fallback).
@@ -13,10 +13,10 @@ any particular planner::
     plan(start, goal, from_sector, to_sector) -> waypoints (7, 4) at the fake-time steps, or None
 
 Default builders: :func:`query_sampler` (the planning-necessary query generator's sampling,
-:mod:`tpee_ompl.queries`) and :class:`DemoPlanner` (dimension-RRT, 2500 samples, with a wider margin
+:mod:`tpee_ompl.model.queries`) and :class:`DemoPlanner` (dimension-RRT, 2500 samples, with a wider margin
 around the pointing system first, so demonstrations keep room that their DMP generalisations can
 use); :meth:`PathLibrary.build_default` uses both, in parallel over the pairs with ``workers``.  :meth:`PathLibrary.as_planner` plugs a library
-into :class:`tpee_ompl.tracker.Tracker`.
+into :class:`tpee_ompl.library.tracker.Tracker`.
 
 Resampling: each straight segment between consecutive fake-time steps gets ``per_step`` samples
 with a quintic time scaling (zero velocity and acceleration at every step), applied to all four
@@ -42,9 +42,9 @@ from pathlib import Path
 import numpy as np
 
 from .dmp import DMP, DMPOptions, generate_blended, learn_dmp
-from .ompl_problem import polyline_motion_states
-from .robot import WearerArm
-from .sectors import check_sector, cross_sector_trajectory
+from ..planning.paths import motion_is_valid, path_length, resample_waypoints
+from ..model.wearer_arm import WearerArm
+from ..model.sectors import check_sector, cross_sector_trajectory
 
 __all__ = [
     "ALL_PAIRS",
@@ -92,38 +92,6 @@ class LibraryFileError(ValueError):
     """A library file that cannot be used: truncated, wrong format version, or another model."""
 
 
-def resample_waypoints(waypoints: np.ndarray, per_step: int = 100) -> np.ndarray:
-    """Put ``per_step`` samples on each straight segment, quintic in fake time; shape ((S-1) per_step + 1, n).
-
-    Every sample lies on the segment between its two waypoints (same geometry as the input path).
-    """
-    W = np.asarray(waypoints, dtype=float)
-    if W.ndim != 2 or W.shape[0] < 2:
-        raise ValueError(f"waypoints must have shape (S >= 2, n); got {W.shape}")
-    if per_step < 1:
-        raise ValueError(f"per_step must be >= 1, got {per_step}")
-    u = np.arange(per_step) / per_step
-    s = u**3 * (10.0 - 15.0 * u + 6.0 * u**2)
-    seg = W[:-1, None, :] + s[None, :, None] * (W[1:] - W[:-1])[:, None, :]
-    return np.vstack([seg.reshape(-1, W.shape[1]), W[-1:]])
-
-
-def motion_is_valid(robot: WearerArm, path: np.ndarray, step: float | None = None) -> bool:
-    """True if the first state and every straight segment of ``path`` (K, 4) pass the motion check.
-
-    Checks the states of :func:`~tpee_ompl.ompl_problem.polyline_motion_states` (those ``si.checkMotion`` checks in a
-    :func:`~tpee_ompl.ompl_problem.make_simple_setup` setup at resolution ``step``, default
-    ``robot.max_joint_step()``) in ONE batched ``robot.are_valid`` call.
-    """
-    step = robot.max_joint_step() if step is None else float(step)
-    return bool(robot.are_valid(polyline_motion_states(path, step)).all())
-
-
-def path_length(path: np.ndarray) -> float:
-    """Euclidean joint-space length of a polyline (K, n), radians (the setups' path-length objective)."""
-    return float(np.linalg.norm(np.diff(np.asarray(path, dtype=float), axis=0), axis=1).sum())
-
-
 def query_sampler(
     robot: WearerArm,
     regions: dict | None = None,
@@ -132,14 +100,14 @@ def query_sampler(
 ) -> SampleQuery:
     """The default ``sample_query``: random cross-sector motions as the query generator draws them.
 
-    Start and goal aim at random targets of :data:`tpee_ompl.queries.NECESSITY_REGIONS` (or
+    Start and goal aim at random targets of :data:`tpee_ompl.planning.query_generation.NECESSITY_REGIONS` (or
     ``regions``) from postures i and j (goal pan nearest the start pan), as in
-    :func:`tpee_ompl.queries.generate_queries`.  With ``require_planning`` a draw is kept only if
+    :func:`tpee_ompl.planning.query_generation.generate_queries`.  With ``require_planning`` a draw is kept only if
     its straight motion collides (about 2 % of draws: slow, ~1 s per pair); after ``max_draws``
     the last valid draw is returned.  Deterministic given the generator passed in.
     """
-    from .pointing import PointingGeometry, aim_checked
-    from .queries import NECESSITY_REGIONS, _sample_aimable, straight_motion_valid
+    from ..model.pointing import PointingGeometry, aim_checked
+    from ..planning.query_generation import NECESSITY_REGIONS, _sample_aimable, straight_motion_valid
 
     geometry = PointingGeometry.from_robot(robot)
     origin = geometry.pivot
@@ -170,8 +138,8 @@ def dimension_rrt_planner(
 ) -> Plan:
     """The default ``plan``: dimension-RRT (sec. 4.1.2) with Table 3's DOF1/DOF2, 7 waypoints or None.
 
-    Each call builds :func:`~tpee_ompl.ompl_problem.make_simple_setup` and runs
-    :func:`~tpee_ompl.dimension_rrt.tpee_dimension_rrt` for ``max_samples`` samples (or
+    Each call builds :func:`~tpee_ompl.planning.setup.make_simple_setup` and runs
+    :func:`~tpee_ompl.planning.tpee.tpee_dimension_rrt` for ``max_samples`` samples (or
     ``timeout`` s); the planner's seed is ``seed`` mixed with a CRC of (start, goal), so a query
     gets the same path whatever was planned before.  ``initial_waypoints`` (7, 4), e.g. a DMP path
     at the fake-time steps, is the planner's first guess (clipped to the joint limits; checked like
@@ -180,8 +148,9 @@ def dimension_rrt_planner(
     """
     from ompl import util as ou
 
-    from .dimension_rrt import tpee_dimension_rrt
-    from .ompl_problem import make_simple_setup, path_to_array
+    from ..planning.tpee import tpee_dimension_rrt
+    from ..planning.setup import make_simple_setup
+    from ..planning.paths import path_to_array
 
     ou.setLogLevel(ou.LOG_WARN)
 
@@ -676,14 +645,14 @@ class PathLibrary:
     def as_planner(
         self, step: float | None = None, same_sector: Callable[[np.ndarray, np.ndarray, int, int], np.ndarray] | None = None
     ) -> Callable[[np.ndarray, np.ndarray, int, int], np.ndarray]:
-        """The library as a :class:`tpee_ompl.tracker.Tracker` planner: ``(start, goal, i, j) -> (K, 4)``.
+        """The library as a :class:`tpee_ompl.library.tracker.Tracker` planner: ``(start, goal, i, j) -> (K, 4)``.
 
         Cross-sector calls go to :meth:`query` at resolution ``step`` (pass the tracker's
         ``options.check_step`` so its own check sees exactly the states checked here; default
         ``min(robot.max_joint_step(), 0.01)``, 0.01 being the tracker's default).  Raises
         RuntimeError when the outcome is "failed".  Same-sector calls (the tracker's re-aim
         around an obstacle) have no demonstrations: they go to ``same_sector``, by default
-        :func:`tpee_ompl.tracker.make_default_planner`.
+        :func:`tpee_ompl.library.tracker.make_default_planner`.
         """
         step = min(self.robot.max_joint_step(), 0.01) if step is None else float(step)
         fallback = same_sector

@@ -1,6 +1,6 @@
 """Dimension-RRT (Zou et al. 2022, sec. 4.1.2) as an OMPL planner.
 
-The path is ``h`` fake-time waypoints (see :mod:`tpee_ompl.grouped_space`).  Groups of DOFs are
+The path is ``h`` fake-time waypoints (see :mod:`tpee_ompl.planning.grouped_space`).  Groups of DOFs are
 handled in order; a prescribed group (Table 3 for DOF1/DOF2) is taken as given.  For a planned group
 each iteration draws ONE ``k_i``-dimensional sample ``c`` and tries it at every intermediate step
 ``t``: the candidate waypoint is ``W[t]`` with the group's values replaced by ``c``.
@@ -47,9 +47,8 @@ import numpy as np
 from ompl import base as ob
 
 from .grouped_space import GroupedSpace, RealVectorLayout
-from .sectors import cross_sector_trajectory
 
-__all__ = ["DimensionRRT", "tpee_dimension_rrt"]
+__all__ = ["DimensionRRT"]
 
 log = logging.getLogger(__name__)
 
@@ -473,7 +472,7 @@ class DimensionRRT(ob.Planner):
     batch : bool
         Use the checker's batched ``are_valid`` when it has one (default True).
     initial_waypoints : array (h, n), optional
-        A first guess of the path (e.g. a DMP path from :mod:`tpee_ompl.path_library`): the
+        A first guess of the path (e.g. a DMP path from :mod:`tpee_ompl.library.path_library`): the
         planned groups' intermediate waypoints start there instead of on the straight line
         (see :meth:`set_initial_waypoints`).
 
@@ -710,13 +709,3 @@ class DimensionRRT(ob.Planner):
             best_cost=best_cost,
         )
         return status
-
-
-def tpee_dimension_rrt(si: ob.SpaceInformation, from_sector: int, to_sector: int, **kw: Any) -> DimensionRRT:
-    """DimensionRRT for the wearer arm: groups ``[[0, 1], [2, 3]]``, DOF1/DOF2 prescribed by Table 3.
-
-    Keyword arguments go to :class:`DimensionRRT` (``h`` is 7, the length of the Table 3 rows).
-    """
-    kw.setdefault("groups", [[0, 1], [2, 3]])
-    prescribed = {0: cross_sector_trajectory(from_sector, to_sector)}
-    return DimensionRRT(si, prescribed=prescribed, **kw)

@@ -31,13 +31,13 @@ import coal
 import numpy as np
 import pinocchio as pin
 
-from .sectors import SECTORS, posture_preset
+from ..model.sectors import SECTORS, posture_preset
 
 if TYPE_CHECKING:  # matplotlib is imported lazily so that importing the package stays cheap
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
-    from .robot import WearerArm
+    from ..model.wearer_arm import WearerArm
 
 __all__ = [
     "SECTOR_COLORS",

@@ -122,7 +122,7 @@ def _die_with_parent() -> None:
             ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
 
 
-def run_task_in_subprocess(task: dict, fn_path: str = "tpee_ompl.benchmark:run_query_task") -> dict:
+def run_task_in_subprocess(task: dict, fn_path: str = "tpee_ompl.bench.campaign:run_query_task") -> dict:
     """Run ``fn(task)`` in a fresh Python process and return its (JSON) result.
 
     ``task["sys_path"]`` entries that exist here are put on the child's ``sys.path`` (so planner
@@ -137,7 +137,7 @@ def run_task_in_subprocess(task: dict, fn_path: str = "tpee_ompl.benchmark:run_q
         if extra:
             env["PYTHONPATH"] = os.pathsep.join(extra + [env.get("PYTHONPATH", "")]).rstrip(os.pathsep)
         proc = subprocess.run(
-            [sys.executable, "-m", "tpee_ompl.executors", fn_path, str(src), str(dst)],
+            [sys.executable, "-m", "tpee_ompl.bench.executors", fn_path, str(src), str(dst)],
             env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, check=False,
         )
         if proc.returncode != 0 or not dst.is_file():

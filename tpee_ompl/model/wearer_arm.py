@@ -20,6 +20,8 @@ import coal
 import numpy as np
 import pinocchio as pin
 
+from ..resources import model_file
+
 __all__ = [
     "ARM_JOINTS",
     "DEFAULT_SECURITY_MARGIN",
@@ -29,7 +31,6 @@ __all__ = [
     "DEFAULT_URDF",
     "WearerArm",
     "default_robot",
-    "find_model_file",
 ]
 
 log = logging.getLogger(__name__)
@@ -46,15 +47,6 @@ MAX_SECURITY_MARGIN = 1.0
 MAX_TARGET_DISTANCE = 1.0e6
 """Metres. Targets with a coordinate beyond +-this are refused (no physical target is that far; beyond
 it the line-of-sight and aiming arithmetic would lose its precision or overflow)."""
-
-
-def find_model_file(name: str) -> Path:
-    """Path of a packaged model file (wheel: inside the package; source tree: ``urdf/``)."""
-    here = Path(__file__).resolve().parent
-    for candidate in (here / "urdf" / name, here.parent / "urdf" / name):
-        if candidate.is_file():
-            return candidate
-    raise FileNotFoundError(f"packaged model file {name!r} not found next to {here}")
 
 
 DEFAULT_URDF = "wearer_arm.urdf"
@@ -177,9 +169,9 @@ class WearerArm:
                 raise ValueError(f"{what} must be a path, None or (srdf_path only) False, got {value!r}")
         if urdf_path is False:
             raise ValueError("urdf_path must be a path or None, got False")
-        urdf = Path(urdf_path) if urdf_path is not None else find_model_file(DEFAULT_URDF)
+        urdf = Path(urdf_path) if urdf_path is not None else model_file(DEFAULT_URDF)
         if srdf_path is None:
-            srdf = find_model_file(DEFAULT_SRDF) if urdf_path is None else None
+            srdf = model_file(DEFAULT_SRDF) if urdf_path is None else None
         elif srdf_path is False:
             srdf = None
         else:

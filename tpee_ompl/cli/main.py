@@ -16,6 +16,8 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
+from ..resources import default_library_path
+
 __all__ = ["get_argument_parser", "main", "PLANNERS", "CliError"]
 
 log = logging.getLogger(__name__)
@@ -50,7 +52,7 @@ def _positive_float(text: str) -> float:
 
 
 def _sector(text: str) -> int:
-    from .sectors import check_sector
+    from ..model.sectors import check_sector
 
     try:
         return check_sector(int(text))
@@ -65,7 +67,7 @@ def _make_planner(name: str, si, from_sector: int, to_sector: int, samples: int 
     from ompl import geometric as og
 
     if name == "dimension-rrt":
-        from .dimension_rrt import tpee_dimension_rrt
+        from ..planning.tpee import tpee_dimension_rrt
 
         planner = tpee_dimension_rrt(si, from_sector, to_sector, max_samples=samples, seed=seed)
         return planner, None
@@ -85,7 +87,7 @@ def _make_planner(name: str, si, from_sector: int, to_sector: int, samples: int 
 
 
 def _load_robot(args: argparse.Namespace):
-    from .robot import WearerArm
+    from ..model.wearer_arm import WearerArm
 
     if getattr(args, "srdf", None) and not getattr(args, "urdf", None):
         raise CliError("--srdf needs --urdf")
@@ -97,7 +99,8 @@ def _plan(args: argparse.Namespace) -> dict:
     from ompl import base as ob
     from ompl import util as ou
 
-    from .ompl_problem import make_simple_setup, path_to_array
+    from ..planning.setup import make_simple_setup
+    from ..planning.paths import path_to_array
 
     ou.setLogLevel(ou.LOG_WARN)
     if args.seed is not None:
@@ -106,7 +109,7 @@ def _plan(args: argparse.Namespace) -> dict:
     if args.start is not None and args.goal is not None:
         start, goal, qid = np.array(args.start), np.array(args.goal), None
     elif args.start is None and args.goal is None:
-        from .queries import load_queries
+        from ..model.queries import load_queries
 
         matching = [q for q in load_queries(args.queries) if (q.from_sector, q.to_sector) == (args.from_sector, args.to_sector)]
         if not matching:
@@ -161,8 +164,8 @@ def cmd_plan(args: argparse.Namespace) -> int:
 # ---------------------------------------------------------------------------------------- aim / track
 def cmd_aim(args: argparse.Namespace) -> int:
     """Closed-form aiming IK for one target (eqs. 1-11) with the collision and line-of-sight verdict."""
-    from .pointing import aim, aim_errors, check_target
-    from .sectors import select_sector
+    from ..model.pointing import aim, aim_errors, check_target
+    from ..model.sectors import select_sector
 
     robot = _load_robot(args)
     target = check_target(np.array(args.target), robot)
@@ -203,11 +206,11 @@ def _scripted_targets(name: str, duration: float, rate: float) -> list[tuple]:
 
 def cmd_track(args: argparse.Namespace) -> int:
     """Run the Fig. 10 tracking strategy on a scripted target stream and report its events."""
-    from .tracker import Tracker, make_default_planner
+    from ..library.tracker import Tracker, make_default_planner
 
     robot = _load_robot(args)
     if args.planner == "dimension-rrt":
-        from .path_library import dimension_rrt_planner
+        from ..library.path_library import dimension_rrt_planner
 
         plan = dimension_rrt_planner(robot, max_samples=args.samples, seed=args.seed)
 
@@ -217,7 +220,7 @@ def cmd_track(args: argparse.Namespace) -> int:
                 raise RuntimeError(f"dimension-RRT found no path {i}->{j}")
             return path
     elif args.planner == "library":
-        from .path_library import PathLibrary, dimension_rrt_planner
+        from ..library.path_library import PathLibrary, dimension_rrt_planner
 
         lib = PathLibrary.load(args.library, robot, plan=dimension_rrt_planner(robot, max_samples=args.samples))
         planner = lib.as_planner()
@@ -260,7 +263,7 @@ def _register_aim_track(sub: argparse._SubParsersAction, fmt: type) -> None:
     p.add_argument("--script", choices=("circle", "jitter", "jump"), default="circle")
     p.add_argument("--planner", choices=("default", "dimension-rrt", "library"), default="default",
                    help="cross-sector planner: default (Table 3 straight motion, else RRTConnect), dimension-rrt, library")
-    p.add_argument("--library", default="experiments/library/default.npz", help="path library file (with --planner library)")
+    p.add_argument("--library", default=str(default_library_path()), help="path library file (with --planner library; default: the packaged one)")
     p.add_argument("--samples", type=_positive_int, default=2500, help="dimension-RRT sample cap")
     p.add_argument("--duration", type=_positive_float, default=20.0, help="seconds of target motion")
     p.add_argument("--rate", type=_positive_float, default=10.0, help="target samples per second")
@@ -278,7 +281,7 @@ DEFAULT_SCENE_TARGET = (4.0, 1.5, 1.9)
 
 def cmd_show(args: argparse.Namespace) -> int:
     """Draw the wearer, the arm at q and the line of sight to the target into a PNG."""
-    from . import render
+    from ..viz import scene as render
 
     robot = _load_robot(args)
     q = np.array(args.q) if args.q is not None else np.radians(DEFAULT_SCENE_Q)
@@ -290,7 +293,7 @@ def cmd_show(args: argparse.Namespace) -> int:
 
 def cmd_animate(args: argparse.Namespace) -> int:
     """Plan a cross-sector motion (or read one from --path JSON) and write an animation."""
-    from . import render
+    from ..viz import scene as render
 
     if args.path:
         try:
@@ -313,7 +316,7 @@ def cmd_animate(args: argparse.Namespace) -> int:
 
 def cmd_workspace(args: argparse.Namespace) -> int:
     """Monte-Carlo pointing workspace (the paper's Fig. 4) into a PNG."""
-    from . import render
+    from ..viz import scene as render
 
     robot = _load_robot(args)
     render.pointing_workspace(robot, args.samples, np.random.default_rng(args.seed), args.output)
@@ -323,7 +326,7 @@ def cmd_workspace(args: argparse.Namespace) -> int:
 
 def cmd_view(args: argparse.Namespace) -> int:
     """Interactive 3-D view in meshcat (optional extra `viewer`)."""
-    from . import render
+    from ..viz import scene as render
 
     robot = _load_robot(args)
     q = np.array(args.q) if args.q is not None else np.radians(DEFAULT_SCENE_Q)
@@ -336,13 +339,13 @@ def cmd_view(args: argparse.Namespace) -> int:
 
 
 def _register_library(sub: argparse._SubParsersAction, fmt: type) -> None:
-    from .library_cli import register
+    from .library import register
 
     register(sub, fmt)
 
 
 def _register_bench(sub: argparse._SubParsersAction, fmt: type) -> None:
-    from .benchmark import build_parser
+    from ..bench.campaign import build_parser
 
     template = build_parser("tpee-ompl bench")
     p = sub.add_parser("bench", help="head-to-head benchmark campaign (OMPL Benchmark, SQLite, Table 4)",
@@ -353,8 +356,8 @@ def _register_bench(sub: argparse._SubParsersAction, fmt: type) -> None:
 
 
 def cmd_bench(args: argparse.Namespace) -> int:
-    """Run a benchmark campaign (delegates to :mod:`tpee_ompl.benchmark`)."""
-    from . import benchmark
+    """Run a benchmark campaign (delegates to :mod:`tpee_ompl.bench.campaign`)."""
+    from ..bench import campaign as benchmark
 
     argv = args._argv
     return int(benchmark.main(argv[argv.index("bench") + 1 :]) or 0)

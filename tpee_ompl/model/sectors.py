@@ -138,7 +138,7 @@ def sector_origin() -> np.ndarray:
     """World position (3,), metres, that sector directions are measured from: the packaged model's j1 pivot."""
     global _DEFAULT_ORIGIN
     if _DEFAULT_ORIGIN is None:
-        from .robot import default_robot  # late import: the tables above need no model
+        from .wearer_arm import default_robot
 
         _DEFAULT_ORIGIN = default_robot().model.jointPlacements[1].translation.copy()
         _DEFAULT_ORIGIN.setflags(write=False)

@@ -43,7 +43,7 @@ import coal
 import numpy as np
 import pinocchio as pin
 
-from .robot import MAX_TARGET_DISTANCE, MUZZLE_FRAME, WearerArm, _as_float_array, default_robot
+from .wearer_arm import MAX_TARGET_DISTANCE, MUZZLE_FRAME, WearerArm, _as_float_array, default_robot
 from .sectors import posture_preset
 
 __all__ = [

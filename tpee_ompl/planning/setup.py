@@ -21,95 +21,15 @@ import numpy as np
 from ompl import base as ob
 from ompl import geometric as og
 
-from .robot import WearerArm
+from ..model.wearer_arm import WearerArm
+from .paths import MIN_JOINT_STEP, motion_states, set_state
 
 __all__ = [
     "WearerValidityChecker",
     "BatchedMotionValidator",
     "make_space",
     "make_simple_setup",
-    "state_to_array",
-    "set_state",
-    "path_to_array",
-    "array_to_path",
-    "motion_states",
-    "polyline_motion_states",
-    "MIN_JOINT_STEP",
 ]
-
-
-def state_to_array(state: ob.State, n: int) -> np.ndarray:
-    """Copy the first n values of a RealVector state into a numpy array."""
-    return np.array([state[i] for i in range(n)], dtype=float)
-
-
-def set_state(state: ob.State, values: Sequence[float]) -> ob.State:
-    """Write values into a RealVector state and return it."""
-    state[0 : len(values)] = [float(v) for v in values]
-    return state
-
-
-def path_to_array(path: og.PathGeometric, n: int) -> np.ndarray:
-    """Waypoints of a geometric path as an array (K, n)."""
-    return np.array([[s[i] for i in range(n)] for s in path.getStates()], dtype=float)
-
-
-def array_to_path(si: ob.SpaceInformation, waypoints: np.ndarray) -> og.PathGeometric:
-    """An ``og.PathGeometric`` through the given (K, n) waypoints."""
-    path = og.PathGeometric(si)
-    for w in np.asarray(waypoints, dtype=float):
-        s = si.allocState()
-        set_state(s, w)
-        path.append(s)
-    return path
-
-
-MIN_JOINT_STEP = 1e-4
-"""Radians. Smallest accepted motion-check step: finer steps make one motion check take millions of states."""
-
-
-def motion_states(a: np.ndarray, b: np.ndarray, step: float, include_start: bool = False) -> np.ndarray:
-    """States checked along the straight motion a -> b, as OMPL's DiscreteMotionValidator picks them.
-
-    ``ceil(|b - a| / step)`` segments; the end state is included, the start only on request.
-
-    Raises
-    ------
-    ValueError
-        If a or b is not finite, their shapes differ, or step is not a finite number > 0.
-    """
-    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
-    if a.shape != b.shape or a.ndim != 1:
-        raise ValueError(f"motion ends must be two vectors of the same length, got shapes {a.shape} and {b.shape}")
-    if not (np.all(np.isfinite(a)) and np.all(np.isfinite(b))):
-        raise ValueError(f"motion ends must be finite, got {a} -> {b}")
-    if not (isinstance(step, (int, float, np.integer, np.floating)) and math.isfinite(step) and step > 0):
-        raise ValueError(f"step must be a finite number > 0, got {step!r}")
-    n = max(1, math.ceil(float(np.linalg.norm(b - a)) / step))
-    t = np.arange(0 if include_start else 1, n + 1) / n
-    return a + t[:, None] * (b - a)
-
-
-def polyline_motion_states(path: np.ndarray, step: float) -> np.ndarray:
-    """All states ``si.checkMotion`` checks along the polyline ``path`` (K, n), plus its first state.
-
-    For each segment a -> b: ``n = max(1, ceil(|b - a| / step))`` states ``a + (k / n)(b - a)``,
-    k = 1..n, exactly those of :func:`motion_states` (OMPL's discrete motion validator), built
-    for all segments at once; shape (1 + sum n, n).
-    """
-    path = np.asarray(path, dtype=float)
-    if path.ndim != 2 or len(path) < 1:
-        raise ValueError(f"path must have shape (K >= 1, n); got {path.shape}")
-    if not step > 0:
-        raise ValueError(f"step must be > 0, got {step!r}")
-    delta = np.diff(path, axis=0)
-    if len(delta) == 0:
-        return path[:1].copy()
-    counts = np.maximum(1, np.ceil(np.linalg.norm(delta, axis=1) / step)).astype(np.int64)
-    seg = np.repeat(np.arange(len(delta)), counts)
-    k = np.arange(1, counts.sum() + 1) - np.repeat(np.cumsum(counts) - counts, counts)
-    states = path[seg] + (k / counts[seg])[:, None] * delta[seg]
-    return np.vstack([path[:1], states])
 
 
 class WearerValidityChecker(ob.StateValidityChecker):

@@ -15,18 +15,20 @@ from pathlib import Path
 
 import numpy as np
 
-from .dmp import DMPOptions
-from .path_library import ALL_PAIRS, DEMO_MARGINS, LIBRARY_DMP_OPTIONS, PathLibrary, dimension_rrt_planner, path_length
+from ..library.dmp import DMPOptions
+from ..library.path_library import ALL_PAIRS, DEMO_MARGINS, LIBRARY_DMP_OPTIONS, PathLibrary, dimension_rrt_planner
+from ..planning.paths import path_length
+from ..resources import default_library_path
 
 __all__ = ["DEFAULT_LIBRARY", "build_parser", "register", "run_build", "run_query", "run_stats"]
 
 log = logging.getLogger(__name__)
 
-DEFAULT_LIBRARY = Path("experiments/library/default.npz")
-"""Default library file (relative to the working directory; ``make library`` writes it)."""
+DEFAULT_LIBRARY = default_library_path()
+"""Default library file, shipped inside the package (``make library`` rebuilds it)."""
 
 _BUILD_EXAMPLE = """example:
-  tpee-ompl library build --per-pair 20 --seed 0 --workers 2 --library experiments/library/default.npz
+  tpee-ompl library build --per-pair 20 --seed 0 --workers 2 --library /tmp/default.npz
   tpee-ompl library build --pairs 1-2 3-4 --per-pair 3 --max-samples 500 --library /tmp/small.npz
 """
 _QUERY_EXAMPLE = """example:
@@ -34,7 +36,7 @@ _QUERY_EXAMPLE = """example:
   tpee-ompl library query --from 1 --to 3 --start -2.2 1.1 0.3 0.2 --goal 0.4 1.3 -0.5 0.1 --json
 """
 _STATS_EXAMPLE = """example:
-  tpee-ompl library stats --library experiments/library/default.npz
+  tpee-ompl library stats                       # the packaged default library
 """
 
 
@@ -49,7 +51,7 @@ def _pair(text: str) -> tuple[int, int]:
 
 
 def _load(path: Path, fallback: bool = True, max_samples: int = 2500) -> PathLibrary:
-    from .robot import default_robot
+    from ..model.wearer_arm import default_robot
 
     if not path.exists():
         raise FileNotFoundError(f"path library {path} not found: build it with 'make library' or 'tpee-ompl library build'")
@@ -60,7 +62,7 @@ def _load(path: Path, fallback: bool = True, max_samples: int = 2500) -> PathLib
 
 def run_build(args: argparse.Namespace) -> int:
     """Build a library with the default sampler and dimension-RRT and save it."""
-    from .robot import default_robot
+    from ..model.wearer_arm import default_robot
 
     if args.per_pair < 1:
         raise ValueError(f"--per-pair must be >= 1, got {args.per_pair}")
@@ -90,7 +92,7 @@ def run_build(args: argparse.Namespace) -> int:
 def run_query(args: argparse.Namespace) -> int:
     """Answer one query from the library and print the outcome (and the path with --json)."""
     if args.query_set is not None:
-        from .queries import load_queries
+        from ..model.queries import load_queries
 
         queries = load_queries(args.query_set)
         if not 0 <= args.index < len(queries):

@@ -2,7 +2,7 @@
 
 The :class:`Tracker` consumes a stream of target positions (and "lock a new target" events).
 While the target stays in the current pointing sector it only re-aims with the closed-form IK
-(:func:`tpee_ompl.pointing.aim`), no planning.  When the target leaves the pointing sector, a new
+(:func:`tpee_ompl.model.pointing.aim`), no planning.  When the target leaves the pointing sector, a new
 target lies outside it, or the target falls in the blind area or out of the line of sight, it
 switches to the target's posture sector (or another sector that can aim at it) through a
 cross-sector motion produced by a pluggable planner::
@@ -22,10 +22,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .ompl_problem import MIN_JOINT_STEP, motion_states, polyline_motion_states
-from .pointing import AimingError, PointingGeometry, aim_batch, check_target
-from .robot import WearerArm, _as_float_array
-from .sectors import SECTORS, check_sector, in_pointing_sector, posture_preset, posture_sector
+from ..planning.paths import MIN_JOINT_STEP, motion_states, polyline_motion_states
+from ..model.pointing import AimingError, PointingGeometry, aim_batch, check_target
+from ..model.wearer_arm import WearerArm, _as_float_array
+from ..model.sectors import SECTORS, check_sector, in_pointing_sector, posture_preset, posture_sector
 
 __all__ = [
     "Planner",
@@ -267,15 +267,16 @@ class Tracker:
 def make_default_planner(robot: WearerArm, *, timeout: float = 2.0, seed: int | None = 0) -> Planner:
     """A simple cross-sector planner: Table 3's straight motion when collision-free, else OMPL RRTConnect.
 
-    The straight motion is :func:`tpee_ompl.queries.straight_motion` (sector to itself: a straight
-    joint motion).  RRTConnect runs on :func:`tpee_ompl.ompl_problem.make_simple_setup` for at most
+    The straight motion is :func:`tpee_ompl.model.queries.straight_motion` (sector to itself: a straight
+    joint motion).  RRTConnect runs on :func:`tpee_ompl.planning.setup.make_simple_setup` for at most
     ``timeout`` seconds and its path is simplified; raises RuntimeError if it finds none.
     """
     from ompl import geometric as og
     from ompl import util as ou
 
-    from .ompl_problem import make_simple_setup, path_to_array
-    from .queries import straight_motion
+    from ..planning.setup import make_simple_setup
+    from ..planning.paths import path_to_array
+    from ..model.queries import straight_motion
 
     ou.setLogLevel(ou.LOG_WARN)
     if seed is not None:

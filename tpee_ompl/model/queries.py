@@ -1,0 +1,188 @@
+"""Cross-sector benchmark queries (paper section 5.1): the query record, the straight motion, JSON I/O.
+
+A query is a target A in sector i and a target B in sector j != i; start = (Table 1 preset i,
+aimed at A), goal = (preset j, aimed at B), both collision-free with a clear line of sight.  Two
+named sets ship inside the package (``tpee_ompl/data/queries/``, see :mod:`tpee_ompl.resources`):
+
+* ``planning_necessary`` (default): targets drawn from per-sector regions where the straight
+  motion tends to hit the wearer, kept only if it does when such queries can be found (see
+  :mod:`tpee_ompl.planning.query_generation`).
+* ``paper_random``: targets uniform over directions in the posture sector, 2-10 m, above the
+  floor, as in the paper.
+
+The straight motion is Table 3's seven (DOF1, DOF2) waypoints with DOF3/DOF4 linear from start to
+goal over the same fake-time steps (:func:`straight_motion`).
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import os
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..resources import query_set_path
+from .sectors import check_sector, cross_sector_trajectory
+from .wearer_arm import WearerArm
+
+__all__ = [
+    "FORMAT_VERSION",
+    "Query",
+    "QuerySetError",
+    "load_queries",
+    "load_query_set",
+    "save_queries",
+    "straight_motion",
+]
+
+log = logging.getLogger(__name__)
+
+FORMAT_VERSION = 1
+
+
+@dataclass(frozen=True, eq=False)
+class Query:
+    """One cross-sector planning query.
+
+    Attributes
+    ----------
+    id : int
+    from_sector, to_sector : int, 1-4
+    target_a, target_b : ndarray (3,), metres, world frame
+    start, goal : ndarray (4,), radians: preset DOF1/DOF2 plus the aiming DOF3/DOF4
+    """
+
+    id: int
+    from_sector: int
+    to_sector: int
+    target_a: np.ndarray = field(repr=False)
+    target_b: np.ndarray = field(repr=False)
+    start: np.ndarray = field(repr=False)
+    goal: np.ndarray = field(repr=False)
+
+    def __post_init__(self) -> None:
+        check_sector(self.from_sector)
+        check_sector(self.to_sector)
+        if self.from_sector == self.to_sector:
+            raise ValueError(f"query {self.id}: from_sector == to_sector == {self.from_sector}")
+        for name, n in (("target_a", 3), ("target_b", 3), ("start", 4), ("goal", 4)):
+            try:
+                a = np.array(getattr(self, name), dtype=float)
+            except (TypeError, ValueError) as exc:
+                raise ValueError(f"query {self.id}: {name} must be {n} finite numbers, got {getattr(self, name)!r}") from exc
+            if a.shape != (n,) or not np.all(np.isfinite(a)):
+                raise ValueError(f"query {self.id}: {name} must be {n} finite numbers, got {a!r}")
+            a.setflags(write=False)
+            object.__setattr__(self, name, a)
+
+    def to_dict(self) -> dict:
+        """JSON-ready dict (lists of floats)."""
+        return {
+            "id": self.id,
+            "from_sector": self.from_sector,
+            "to_sector": self.to_sector,
+            "target_a": self.target_a.tolist(),
+            "target_b": self.target_b.tolist(),
+            "start": self.start.tolist(),
+            "goal": self.goal.tolist(),
+        }
+
+    @classmethod
+    def from_dict(cls, d: dict) -> Query:
+        """Inverse of :meth:`to_dict`."""
+        return cls(int(d["id"]), int(d["from_sector"]), int(d["to_sector"]),
+                   d["target_a"], d["target_b"], d["start"], d["goal"])
+
+
+def straight_motion(start: np.ndarray, goal: np.ndarray, i: int, j: int) -> np.ndarray:
+    """Waypoints (7, 4): Table 3's (DOF1, DOF2) from sector i to j, DOF3/DOF4 linear start -> goal.
+
+    The first and last waypoints are start and goal themselves.
+    """
+    start, goal = np.asarray(start, dtype=float), np.asarray(goal, dtype=float)
+    w = np.zeros((7, 4))
+    w[:, :2] = cross_sector_trajectory(i, j)
+    s = np.linspace(0.0, 1.0, 7)[:, None]
+    w[:, 2:] = start[2:] + s * (goal[2:] - start[2:])
+    w[0], w[-1] = start, goal
+    return w
+
+
+def save_queries(
+    path: str | os.PathLike,
+    queries: Sequence[Query],
+    *,
+    name: str,
+    seed: int,
+    model_hash: str,
+    extra: dict | None = None,
+) -> Path:
+    """Write a versioned JSON query set: format_version, name, seed, model_hash, queries (+ extra keys)."""
+    doc = {"format_version": FORMAT_VERSION, "name": name, "seed": seed, "model_hash": model_hash}
+    doc.update(extra or {})
+    doc["queries"] = [q.to_dict() for q in queries]
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(json.dumps(doc, indent=1) + "\n")
+    return path
+
+
+class QuerySetError(ValueError):
+    """A query set file that cannot be used: not JSON, wrong format_version, bad entries, other model."""
+
+
+def load_query_set(name_or_path: str | os.PathLike, robot: WearerArm | None = None) -> tuple[list[Query], dict]:
+    """Queries and the file's header (everything but ``queries``); see :func:`load_queries`."""
+    if isinstance(name_or_path, bool) or not isinstance(name_or_path, (str, os.PathLike)):
+        raise ValueError(f"query set must be a name or a path, got {name_or_path!r}")
+    p = Path(name_or_path)
+    if not p.suffix and not p.exists():
+        p = query_set_path(str(name_or_path))
+    if not p.is_file():
+        raise FileNotFoundError(f"query set {str(name_or_path)!r} not found (looked at {p})")
+    try:
+        doc = json.loads(p.read_text(encoding="utf-8"))
+    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise QuerySetError(f"{p}: not a JSON query set (truncated or corrupt?): {exc}") from exc
+    if not isinstance(doc, dict):
+        raise QuerySetError(f"{p}: expected a JSON object at the top level, got {type(doc).__name__}")
+    version = doc.get("format_version")
+    if isinstance(version, bool) or version != FORMAT_VERSION:
+        raise QuerySetError(f"{p}: unsupported format_version {version!r} (expected {FORMAT_VERSION})")
+    entries = doc.get("queries")
+    if not isinstance(entries, list):
+        raise QuerySetError(f"{p}: 'queries' must be a list, got {type(entries).__name__}")
+    queries = []
+    for k, d in enumerate(entries):
+        try:
+            if not isinstance(d, dict):
+                raise ValueError(f"expected an object, got {type(d).__name__}")
+            queries.append(Query.from_dict(d))
+        except (KeyError, TypeError, ValueError) as exc:
+            raise QuerySetError(f"{p}: query {k} is malformed: {exc!r}") from exc
+    header = {k: v for k, v in doc.items() if k != "queries"}
+    if robot is not None and header.get("model_hash") != robot.model_hash:
+        raise QuerySetError(
+            f"{p}: made for model_hash {header.get('model_hash')!r}, but the robot's is {robot.model_hash!r} "
+            "(regenerate the set for this model)"
+        )
+    return queries, header
+
+
+def load_queries(name_or_path: str | os.PathLike, robot: WearerArm | None = None) -> list[Query]:
+    """Load a query set by name (``"planning_necessary"``, ``"paper_random"``) or JSON path.
+
+    With ``robot``, refuse a set made for another model (its ``model_hash`` differs).
+
+    Raises
+    ------
+    FileNotFoundError
+        No such set or file.
+    QuerySetError (a ValueError)
+        Not JSON (e.g. truncated), wrong ``format_version``, malformed queries, or another model.
+    """
+    return load_query_set(name_or_path, robot)[0]
