@@ -37,18 +37,21 @@ final path passed ``si.checkMotion``.
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import math
 import time
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from ompl import base as ob
 
+from ..validation import check_bool, check_int, check_name, check_number
 from .grouped_space import GroupedSpace, RealVectorLayout
 
-__all__ = ["DimensionRRT"]
+__all__ = ["DimensionRRT", "DimensionRRTOptions"]
 
 log = logging.getLogger(__name__)
 
@@ -444,19 +447,16 @@ class _LayeredTrees:
         return W
 
 
-class DimensionRRT(ob.Planner):
-    """Dimension-RRT (paper sec. 4.1.2): anytime, fake-time, DOF-grouped path optimisation.
+@dataclass(frozen=True)
+class DimensionRRTOptions:
+    """Settings of :class:`DimensionRRT`, checked once here.
 
-    Parameters
+    Attributes
     ----------
-    si : ob.SpaceInformation
-        A RealVector space, or a compound of RealVector spaces.
-    groups : list of lists of int, optional
+    groups : sequence of sequences of int, optional
         DOF indices per group in planning order (default ``[[0, 1], [2, 3]]`` for 4-D, else pairs).
-    prescribed : dict {group index: array (h, k_i)}, optional
-        Group trajectories taken as given, start and goal rows included (``{0: Table 3 row}``).
     h : int
-        Fake-time steps including start and goal (default 7).
+        Fake-time steps including start and goal (default 7, the length of the Table 3 rows).
     max_samples : int, optional
         Stop after this many samples even if the termination condition still allows time.
     seed : int, optional
@@ -465,86 +465,116 @@ class DimensionRRT(ob.Planner):
         Samples of a group (and a valid path) before its sampling region narrows (default 200).
     narrowing : float in (0, 1]
         Factor by which the padding of the narrowed region shrinks every 100 samples (default 0.5).
-    range_ : float or array (n,), optional
+    range_ : float or sequence of float, optional
         Smallest padding of the narrowed region, in the DOFs' units (default 2 % of each bound width).
     name : str
         Planner name (``geometric_<name>`` in a Benchmark database).
     batch : bool
         Use the checker's batched ``are_valid`` when it has one (default True).
+    """
+
+    groups: Sequence[Sequence[int]] | None = None
+    h: int = 7
+    max_samples: int | None = None
+    seed: int | None = None
+    narrow_after: int = 200
+    narrowing: float = 0.5
+    range_: float | Sequence[float] | None = None
+    name: str = "DimensionRRT"
+    batch: bool = True
+
+    def __post_init__(self) -> None:
+        check_name("name", self.name)
+        set_ = lambda field_, value: object.__setattr__(self, field_, value)  # noqa: E731 (frozen dataclass)
+        set_("max_samples", check_int("max_samples", self.max_samples, minimum=1, optional=True))
+        set_("seed", check_int("seed", self.seed, minimum=0, optional=True))
+        set_("narrow_after", check_int("narrow_after", self.narrow_after, minimum=0))
+        set_("narrowing", check_number("narrowing", self.narrowing, low=0.0, high=1.0, low_open=True))
+        set_("batch", check_bool("batch", self.batch))
+        if self.range_ is not None:
+            try:
+                arr = np.asarray(self.range_, dtype=float)
+            except (TypeError, ValueError):
+                arr = None
+            if arr is None or arr.ndim > 1 or arr.size == 0 or not np.all(np.isfinite(arr)) or np.any(arr <= 0):
+                raise ValueError(f"range_ must be a positive number or array, got {self.range_!r}")
+
+
+def _resolve_options(options: DimensionRRTOptions | None, overrides: Mapping[str, Any]) -> DimensionRRTOptions:
+    """``options`` (default settings if None) with the keyword overrides applied, validated."""
+    if options is None:
+        options = DimensionRRTOptions()
+    elif not isinstance(options, DimensionRRTOptions):
+        raise ValueError(f"options must be a DimensionRRTOptions, got {type(options).__name__}")
+    return dataclasses.replace(options, **overrides) if overrides else options
+
+
+class DimensionRRT(ob.Planner):
+    """Dimension-RRT (paper sec. 4.1.2): anytime, fake-time, DOF-grouped path optimisation.
+
+    Parameters
+    ----------
+    si : ob.SpaceInformation
+        A RealVector space, or a compound of RealVector spaces.
+    options : DimensionRRTOptions, optional
+        The planner's settings (defaults if omitted).
+    prescribed : dict {group index: array (h, k_i)}, optional
+        Group trajectories taken as given, start and goal rows included (``{0: Table 3 row}``).
     initial_waypoints : array (h, n), optional
         A first guess of the path (e.g. a DMP path from :mod:`tpee_ompl.library.path_library`): the
         planned groups' intermediate waypoints start there instead of on the straight line
         (see :meth:`set_initial_waypoints`).
+    **overrides
+        Fields of :class:`DimensionRRTOptions` replacing those of ``options``
+        (``DimensionRRT(si, max_samples=500, seed=1)``); an unknown name raises ``TypeError``.
 
     Raises
     ------
     ValueError
         Overlapping, missing or out-of-range DOF indices, ``h < 3``, ``max_samples < 1``, bad
         ``narrowing``/``narrow_after``/``range_``, or a space that is not RealVector-based.
+    TypeError
+        An override that is not a field of :class:`DimensionRRTOptions`.
     """
 
     def __init__(
         self,
         si: ob.SpaceInformation,
-        groups: Sequence[Sequence[int]] | None = None,
-        prescribed: Mapping[int, np.ndarray] | None = None,
-        h: int = 7,
-        max_samples: int | None = None,
-        seed: int | None = None,
-        narrow_after: int = 200,
-        narrowing: float = 0.5,
-        range_: float | np.ndarray | None = None,
-        name: str = "DimensionRRT",
+        options: DimensionRRTOptions | None = None,
         *,
-        batch: bool = True,
+        prescribed: Mapping[int, np.ndarray] | None = None,
         initial_waypoints: np.ndarray | None = None,
+        **overrides: Any,
     ) -> None:
         # Validate everything BEFORE super().__init__: an exception raised after it leaves a
         # half-constructed nanobind trampoline whose collection crashed the interpreter.
-        if not isinstance(name, str) or not name:
-            raise ValueError(f"name must be a non-empty string, got {name!r}")
+        opts = _resolve_options(options, overrides)
         if not isinstance(si, ob.SpaceInformation):
             raise ValueError(f"si must be an ompl.base.SpaceInformation, got {type(si).__name__}")
-        grouped = GroupedSpace(si, groups, h, prescribed)
-        if max_samples is not None and (
-            isinstance(max_samples, bool) or not isinstance(max_samples, (int, np.integer)) or max_samples < 1
-        ):
-            raise ValueError(f"max_samples must be None or an integer >= 1 (zero samples cannot plan), got {max_samples!r}")
-        if isinstance(narrow_after, bool) or not isinstance(narrow_after, (int, np.integer)) or narrow_after < 0:
-            raise ValueError(f"narrow_after must be an integer >= 0, got {narrow_after!r}")
-        if (
-            isinstance(narrowing, bool)
-            or not isinstance(narrowing, (int, float, np.integer, np.floating))
-            or not 0.0 < float(narrowing) <= 1.0
-        ):
-            raise ValueError(f"narrowing must be a number in (0, 1], got {narrowing!r}")
-        if seed is not None and (isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0):
-            raise ValueError(f"seed must be None or an integer >= 0, got {seed!r}")
+        grouped = GroupedSpace(si, opts.groups, opts.h, prescribed)
         layout = grouped.layout
         span = layout.upper - layout.lower
-        if range_ is None:
+        if opts.range_ is None:
             rng_full = 0.02 * span
         else:
-            try:
-                arr = np.asarray(range_, dtype=float)
-                rng_full = np.broadcast_to(arr, (layout.n,)).copy() if arr.ndim <= 1 else None
-            except (TypeError, ValueError):
-                rng_full = None
-            if rng_full is None or not np.all(np.isfinite(rng_full)) or np.any(rng_full <= 0):
-                raise ValueError(f"range_ must be a positive number or array of {layout.n}, got {range_!r}")
+            arr = np.asarray(opts.range_, dtype=float)
+            if arr.ndim > 1 or (arr.ndim == 1 and len(arr) != layout.n):
+                raise ValueError(f"range_ must be a positive number or array of {layout.n}, got {opts.range_!r}")
+            rng_full = np.broadcast_to(arr, (layout.n,)).copy()
         initial = self._check_initial(grouped, initial_waypoints)
-        super().__init__(si, name)
+        super().__init__(si, opts.name)
+        self.options = opts
         self.grouped = grouped
         self.h = self.grouped.h
         self.groups = self.grouped.groups
         self.prescribed = self.grouped.prescribed
-        self.max_samples = None if max_samples is None else int(max_samples)
-        self.seed = seed
-        self.narrow_after = int(narrow_after)
-        self.narrowing = float(narrowing)
+        self.max_samples = opts.max_samples
+        self.seed = opts.seed
+        self.narrow_after = opts.narrow_after
+        self.narrowing = opts.narrowing
         self.range_ = rng_full
-        self.batch = bool(batch)
-        self._rng = np.random.default_rng(seed)
+        self.batch = opts.batch
+        self._rng = np.random.default_rng(opts.seed)
         self._stats: dict[str, Any] = self._empty_stats()
         self._ranges = {gi: rng_full[self.grouped.group_dims(gi)] for gi in self.grouped.planned}
         self._initial = initial

@@ -8,19 +8,31 @@ from __future__ import annotations
 
 from typing import Any
 
+import numpy as np
 from ompl import base as ob
 
 from ..model.sectors import cross_sector_trajectory
-from .dimension_rrt import DimensionRRT
+from .dimension_rrt import DimensionRRT, DimensionRRTOptions
 
 __all__ = ["tpee_dimension_rrt"]
 
 
-def tpee_dimension_rrt(si: ob.SpaceInformation, from_sector: int, to_sector: int, **kw: Any) -> DimensionRRT:
-    """DimensionRRT for the wearer arm: groups ``[[0, 1], [2, 3]]``, DOF1/DOF2 prescribed by Table 3.
+def tpee_dimension_rrt(
+    si: ob.SpaceInformation,
+    from_sector: int,
+    to_sector: int,
+    options: DimensionRRTOptions | None = None,
+    *,
+    initial_waypoints: np.ndarray | None = None,
+    **overrides: Any,
+) -> DimensionRRT:
+    """DimensionRRT for the wearer arm from sector ``from_sector`` to ``to_sector``.
 
-    Keyword arguments go to :class:`DimensionRRT` (``h`` is 7, the length of the Table 3 rows).
+    Groups ``[[0, 1], [2, 3]]`` unless ``options`` says otherwise; DOF1/DOF2 follow the Table 3 row
+    (7 fake-time steps).  ``options``, ``initial_waypoints`` and the keyword overrides are those of
+    :class:`DimensionRRT`.
     """
-    kw.setdefault("groups", [[0, 1], [2, 3]])
+    if options is None or options.groups is None:
+        overrides.setdefault("groups", ((0, 1), (2, 3)))
     prescribed = {0: cross_sector_trajectory(from_sector, to_sector)}
-    return DimensionRRT(si, prescribed=prescribed, **kw)
+    return DimensionRRT(si, options, prescribed=prescribed, initial_waypoints=initial_waypoints, **overrides)

@@ -1,0 +1,57 @@
+"""Small argument checks shared by every options dataclass and public entry point.
+
+Each returns the value in its canonical Python type or raises ``ValueError`` naming the argument,
+so a bad setting is refused with one clear line instead of a crash deep in the bindings.
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+from typing import Any
+
+__all__ = ["check_bool", "check_int", "check_number", "check_name"]
+
+
+def check_int(name: str, value: Any, *, minimum: int | None = None, maximum: int | None = None,
+              optional: bool = False) -> int | None:
+    """``value`` as an int (a bool is refused), within [minimum, maximum]; None passes when ``optional``."""
+    if value is None and optional:
+        return None
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+        raise ValueError(f"{name} must be {'None or ' if optional else ''}an integer, got {value!r}")
+    v = int(value)
+    if (minimum is not None and v < minimum) or (maximum is not None and v > maximum):
+        bounds = f">= {minimum}" if maximum is None else f"<= {maximum}" if minimum is None else f"in [{minimum}, {maximum}]"
+        raise ValueError(f"{name} must be an integer {bounds}, got {value!r}")
+    return v
+
+
+def check_number(name: str, value: Any, *, low: float | None = None, high: float | None = None,
+                 low_open: bool = False, high_open: bool = False, optional: bool = False) -> float | None:
+    """``value`` as a finite float (a bool is refused) within the given bounds; None passes when ``optional``."""
+    if value is None and optional:
+        return None
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(float(value)):
+        raise ValueError(f"{name} must be {'None or ' if optional else ''}a finite number, got {value!r}")
+    v = float(value)
+    if low is not None and (v <= low if low_open else v < low) or high is not None and (v >= high if high_open else v > high):
+        lo = "" if low is None else ("(" if low_open else "[") + f"{low:g}"
+        hi = "" if high is None else f"{high:g}" + (")" if high_open else "]")
+        interval = f"in {lo}, {hi}" if low is not None and high is not None else (f"> {low:g}" if low_open else f">= {low:g}") if high is None else (f"< {high:g}" if high_open else f"<= {high:g}")
+        raise ValueError(f"{name} must be a number {interval}, got {value!r}")
+    return v
+
+
+def check_bool(name: str, value: Any) -> bool:
+    """``value`` if it is a bool (or numpy bool)."""
+    if not isinstance(value, (bool,)) and type(value).__name__ != "bool_":
+        raise ValueError(f"{name} must be True or False, got {value!r}")
+    return bool(value)
+
+
+def check_name(name: str, value: Any) -> str:
+    """``value`` if it is a non-empty string."""
+    if not isinstance(value, str) or not value:
+        raise ValueError(f"{name} must be a non-empty string, got {value!r}")
+    return value
