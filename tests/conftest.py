@@ -1,17 +1,28 @@
-"""Shared fixtures: the packaged model, loaded once per test session."""
+"""Shared fixtures: the packaged model, loaded once per test session.
+
+Test modules are imported with ``--import-mode=importlib`` (see pyproject.toml), so they never
+import each other; what several modules share lives in ``tests/helpers/`` (importable as
+``helpers.<name>``: this folder is put on ``sys.path`` here, also for worker processes that
+inherit it).
+"""
 
 from __future__ import annotations
 
 import os
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
 
+TESTS_DIR = Path(__file__).resolve().parent
+if str(TESTS_DIR) not in sys.path:
+    sys.path.insert(0, str(TESTS_DIR))
 os.environ.setdefault("MPLBACKEND", "Agg")
 
 from ompl import util as ou  # noqa: E402
 
-from tpee_ompl.model.wearer_arm import WearerArm, default_robot
+from tpee_ompl.model.wearer_arm import WearerArm, default_robot  # noqa: E402
 
 ou.setLogLevel(ou.LOG_WARN)
 
