@@ -10,7 +10,9 @@ import math
 import numbers
 from typing import Any
 
-__all__ = ["check_bool", "check_int", "check_number", "check_name"]
+import numpy as np
+
+__all__ = ["as_float_array", "check_bool", "check_int", "check_name", "check_number"]
 
 
 def check_int(name: str, value: Any, *, minimum: int | None = None, maximum: int | None = None,
@@ -55,3 +57,11 @@ def check_name(name: str, value: Any) -> str:
     if not isinstance(value, str) or not value:
         raise ValueError(f"{name} must be a non-empty string, got {value!r}")
     return value
+
+
+def as_float_array(x: object, what: str) -> np.ndarray:
+    """``np.asarray(x, dtype=float)``, raising ValueError (naming ``what``) for non-numeric input."""
+    try:
+        return np.asarray(x, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{what} must be numbers, got {x!r} ({exc})") from exc

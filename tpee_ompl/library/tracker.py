@@ -24,7 +24,8 @@ import numpy as np
 
 from ..planning.paths import MIN_JOINT_STEP, motion_states, polyline_motion_states
 from ..model.pointing import AimingError, PointingGeometry, aim_batch, check_target
-from ..model.wearer_arm import WearerArm, _as_float_array
+from ..model.wearer_arm import WearerArm
+from ..validation import as_float_array
 from ..model.sectors import SECTORS, check_sector, in_pointing_sector, posture_preset, posture_sector
 
 __all__ = [
@@ -207,7 +208,7 @@ class Tracker:
         """
         if isinstance(t, bool) or not isinstance(t, (int, float, np.integer, np.floating)) or not math.isfinite(t):
             raise ValueError(f"time t must be a finite number (seconds), got {t!r}")
-        raw = _as_float_array(target, "target")
+        raw = as_float_array(target, "target")
         if raw.shape != (3,):
             raise ValueError(f"target must have shape (3,); got {raw.shape}")
         t = max(float(t), self.time)

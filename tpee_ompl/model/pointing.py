@@ -43,7 +43,8 @@ import coal
 import numpy as np
 import pinocchio as pin
 
-from .wearer_arm import MAX_TARGET_DISTANCE, MUZZLE_FRAME, WearerArm, _as_float_array, default_robot
+from ..validation import as_float_array
+from .wearer_arm import MAX_TARGET_DISTANCE, MUZZLE_FRAME, WearerArm, default_robot
 from .sectors import posture_preset
 
 __all__ = [
@@ -202,7 +203,7 @@ def _as_dof12(posture: int | np.ndarray, n: int) -> np.ndarray:
         return np.broadcast_to(posture_preset(int(posture)), (n, 2))
     if isinstance(posture, bool):
         raise ValueError(f"unknown sector {posture!r}: sectors are 1, 2, 3, 4")  # noqa: TRY004 (bad input value)
-    d = _as_float_array(posture, "posture")
+    d = as_float_array(posture, "posture")
     if d.shape == (2,):
         d = np.broadcast_to(d, (n, 2))
     if d.shape != (n, 2) or not np.all(np.isfinite(d)):
@@ -211,7 +212,7 @@ def _as_dof12(posture: int | np.ndarray, n: int) -> np.ndarray:
 
 
 def _as_targets(targets: np.ndarray) -> np.ndarray:
-    t = _as_float_array(targets, "targets")
+    t = as_float_array(targets, "targets")
     if t.ndim == 1:
         t = t[None, :]
     if t.ndim != 2 or t.shape[1] != 3:
@@ -259,7 +260,7 @@ def aim_batch(
     n = len(t)
     dof12 = _as_dof12(posture, n)
     try:
-        ref = np.broadcast_to(_as_float_array(pan_reference, "pan_reference"), (n,))
+        ref = np.broadcast_to(as_float_array(pan_reference, "pan_reference"), (n,))
     except ValueError as exc:
         raise ValueError(f"pan_reference must be a number or an array of {n}, got {pan_reference!r}") from exc
     out = np.full((n, 4), np.nan)
@@ -338,7 +339,7 @@ def aim(
     pan_reference: float = 0.0,
 ) -> np.ndarray:
     """Configuration (4,), radians, that aims the barrel at one world target (3,), metres; see :func:`aim_batch`."""
-    t = _as_float_array(target, "target")
+    t = as_float_array(target, "target")
     if t.shape != (3,):
         raise ValueError(f"target must have shape (3,); got {t.shape}")
     return aim_batch(t[None], posture, geometry=geometry, pan_reference=pan_reference)[0]
@@ -370,7 +371,7 @@ def check_target(target: np.ndarray, robot: WearerArm | None = None) -> np.ndarr
     line of sight can reach them.
     """
     try:
-        t = _as_float_array(target, "target")
+        t = as_float_array(target, "target")
     except ValueError as exc:
         raise UnreachableTargetError(str(exc)) from exc
     if t.shape != (3,):

@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..validation import as_float_array
+
 __all__ = [
     "CROSS_SECTOR_TRAJECTORIES",
     "POINTING_AZIMUTH",
@@ -15,6 +17,7 @@ __all__ = [
     "POSTURE_AZIMUTH",
     "POSTURE_PRESETS",
     "SECTORS",
+    "SECTOR_PAIRS",
     "check_sector",
     "cross_sector_trajectory",
     "in_pointing_sector",
@@ -56,15 +59,11 @@ CROSS_SECTOR_TRAJECTORIES: dict[tuple[int, int], np.ndarray] = {
 }
 """(from, to) -> array (7, 2) of (DOF1, DOF2) in radians at the fake-time steps (Table 3)."""
 
+SECTOR_PAIRS: tuple[tuple[int, int], ...] = tuple(sorted(CROSS_SECTOR_TRAJECTORIES))
+"""The 12 ordered cross-sector pairs (from, to), from != to, in lexicographic order."""
+
 for _arr in (*POSTURE_PRESETS.values(), *CROSS_SECTOR_TRAJECTORIES.values()):
     _arr.setflags(write=False)
-
-
-def _as_float_array(x: object, what: str) -> np.ndarray:
-    try:
-        return np.asarray(x, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"{what} must be numbers, got {x!r} ({exc})") from exc
 
 
 def check_sector(k: object) -> int:
@@ -150,7 +149,7 @@ def target_direction(targets: np.ndarray, origin: np.ndarray | None = None) -> t
 
     Raises ValueError for non-finite targets or a target at the origin (no direction).
     """
-    t = _as_float_array(targets, "targets")
+    t = as_float_array(targets, "targets")
     single = t.ndim == 1
     t = np.atleast_2d(t)
     if t.ndim != 2 or t.shape[1] != 3:
@@ -162,7 +161,7 @@ def target_direction(targets: np.ndarray, origin: np.ndarray | None = None) -> t
     if origin is None:
         o = sector_origin()
     else:
-        o = _as_float_array(origin, "origin")
+        o = as_float_array(origin, "origin")
         if o.shape != (3,) or not np.all(np.isfinite(o)):
             raise ValueError(f"origin must be 3 finite numbers, got {origin!r}")
     with np.errstate(over="ignore", invalid="ignore"):

@@ -8,12 +8,9 @@ and is the line of sight from the muzzle to a target clear of the wearer.
 
 from __future__ import annotations
 
-import hashlib
 import logging
 import os
-import xml.etree.ElementTree as ET
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 
 import coal
@@ -21,6 +18,8 @@ import numpy as np
 import pinocchio as pin
 
 from ..resources import model_file
+from ..validation import as_float_array
+from .urdf_loading import ARM_JOINTS, MUZZLE_FRAME, ModelFiles, bounding_radius, load_wearer_model
 
 __all__ = [
     "ARM_JOINTS",
@@ -35,11 +34,8 @@ __all__ = [
 
 log = logging.getLogger(__name__)
 
-ARM_JOINTS = ("j1", "j2", "j3", "j4")
-"""Joint names in configuration order: DOF1 (about x), DOF2 (about -y), pan, tilt."""
 ARM_LINKS = ("link1", "link2", "link3", "link4")
 BOOM_LINKS = ("link1", "link2")
-MUZZLE_FRAME = "muzzle"
 DEFAULT_SECURITY_MARGIN = 0.02
 """Metres. A configuration is valid only if every checked pair is at least this far apart."""
 MAX_SECURITY_MARGIN = 1.0
@@ -53,16 +49,8 @@ DEFAULT_URDF = "wearer_arm.urdf"
 DEFAULT_SRDF = "wearer_arm.srdf"
 
 
-def _as_float_array(x: object, what: str) -> np.ndarray:
-    """``np.asarray(x, dtype=float)``, raising ValueError (naming ``what``) for non-numeric input."""
-    try:
-        return np.asarray(x, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"{what} must be numbers, got {x!r} ({exc})") from exc
-
-
 def _as_config_batch(Q: np.ndarray, nq: int) -> np.ndarray:
-    Q = _as_float_array(Q, "configurations")
+    Q = as_float_array(Q, "configurations")
     if Q.ndim == 1:
         Q = Q[None, :]
     if Q.ndim != 2 or Q.shape[1] != nq:
@@ -76,54 +64,12 @@ def _as_config_batch(Q: np.ndarray, nq: int) -> np.ndarray:
 
 def _check_finite_target(target: object) -> np.ndarray:
     """Return target as a (3,) float array within MAX_TARGET_DISTANCE, or raise ValueError naming it."""
-    t = _as_float_array(target, "target")
+    t = as_float_array(target, "target")
     if t.shape != (3,) or not np.all(np.isfinite(t)):
         raise ValueError(f"target must be 3 finite numbers, got {target!r}")
     if np.max(np.abs(t)) > MAX_TARGET_DISTANCE:
         raise ValueError(f"target {t} is farther than MAX_TARGET_DISTANCE = {MAX_TARGET_DISTANCE:g} m")
     return t
-
-
-def _read_text(path: Path, kind: str) -> str:
-    try:
-        return path.read_text(encoding="utf-8")
-    except UnicodeDecodeError as exc:
-        raise ValueError(f"malformed {kind} {path}: not UTF-8 text ({exc})") from exc
-
-
-def _check_shape_sizes(geom: coal.CollisionGeometry, name: str, urdf: Path) -> None:
-    """Refuse zero, negative or non-finite primitive sizes (Coal would silently give wrong answers)."""
-    sizes: list[float] = []
-    if isinstance(geom, coal.Capsule) or isinstance(geom, coal.Cylinder):
-        sizes = [geom.radius]
-        if not (np.isfinite(geom.halfLength) and geom.halfLength >= 0):
-            raise ValueError(f"URDF {urdf}: geometry {name!r} has length {2 * geom.halfLength}")
-    elif isinstance(geom, coal.Sphere):
-        sizes = [geom.radius]
-    elif isinstance(geom, coal.Box):
-        sizes = list(2 * np.asarray(geom.halfSide))
-    for v in sizes:
-        if not (np.isfinite(v) and v > 0):
-            raise ValueError(f"URDF {urdf}: geometry {name!r} has a size of {v} (must be finite and > 0)")
-
-
-def _bounding_radius(geom: coal.CollisionGeometry) -> float:
-    if isinstance(geom, coal.Capsule):
-        return geom.radius + geom.halfLength
-    if isinstance(geom, coal.Sphere):
-        return geom.radius
-    if isinstance(geom, coal.Box):
-        return float(np.linalg.norm(geom.halfSide))
-    if isinstance(geom, coal.Cylinder):
-        return float(np.hypot(geom.radius, geom.halfLength))
-    geom.computeLocalAABB()
-    return float(geom.aabb_radius)
-
-
-@dataclass(frozen=True)
-class _LoadedFiles:
-    urdf: Path
-    srdf: Path | None
 
 
 class WearerArm:
@@ -176,7 +122,7 @@ class WearerArm:
             srdf = None
         else:
             srdf = Path(srdf_path)
-        self.files = _LoadedFiles(urdf, srdf)
+        self.files = ModelFiles(urdf, srdf)
         self.security_margin = float(security_margin)
         self.link_margins = self._check_link_margins(link_margins, self.security_margin)
         self.n_threads = int(n_threads) if n_threads is not None else min(2, os.cpu_count() or 1)
@@ -188,54 +134,10 @@ class WearerArm:
     # ------------------------------------------------------------------ loading
     def _load(self) -> None:
         urdf, srdf = self.files.urdf, self.files.srdf
-        if not urdf.is_file():
-            raise FileNotFoundError(f"URDF file not found: {urdf}")
-        text = _read_text(urdf, "URDF")
-        try:
-            root = ET.fromstring(text)
-        except ET.ParseError as exc:
-            raise ValueError(f"malformed URDF {urdf}: {exc}") from exc
-        if root.tag != "robot":
-            raise ValueError(f"malformed URDF {urdf}: root element is <{root.tag}>, expected <robot>")
-        if any(c.tag == "capsule" for c in root.iter()):
-            raise ValueError(f"URDF {urdf} uses <capsule>, which urdfdom drops silently; use <cylinder> (loaded as capsules)")
-        joints = {j.get("name"): j.get("type") for j in root.iter("joint")}
-        for name in ARM_JOINTS:
-            if joints.get(name) != "revolute":
-                raise ValueError(f"URDF {urdf} lacks revolute joint {name!r} (found: {sorted(k for k in joints if k)})")
-        if MUZZLE_FRAME not in {link.get("name") for link in root.iter("link")}:
-            raise ValueError(f"URDF {urdf} lacks the {MUZZLE_FRAME!r} link")
-        self._n_collision_elements = sum(1 for _ in root.iter("collision"))
-        digest = hashlib.sha256(text.encode())
-        if srdf is not None and srdf.is_file():
-            digest.update(srdf.read_bytes())
-        self.model_hash = digest.hexdigest()[:16]
+        loaded = load_wearer_model(urdf, srdf)
+        self.model, self.gmodel = loaded.model, loaded.gmodel
+        self.model_hash = loaded.model_hash
         """Short SHA-256 of the URDF (+ SRDF) text: stored with query sets and path libraries."""
-
-        try:
-            self.model = pin.buildModelFromXML(text)
-            self.gmodel = pin.buildGeomFromUrdfString(self.model, text, pin.GeometryType.COLLISION)
-        except Exception as exc:  # the bindings raise RuntimeError/ValueError with C++ text
-            raise ValueError(f"Pinocchio could not load URDF {urdf}: {exc}") from exc
-        if tuple(self.model.names[1:]) != ARM_JOINTS:
-            raise ValueError(f"URDF {urdf}: moving joints must be exactly {ARM_JOINTS}, got {tuple(self.model.names[1:])}")
-        if self.gmodel.ngeoms != self._n_collision_elements:
-            raise ValueError(
-                f"URDF {urdf}: {self._n_collision_elements} <collision> elements but only "
-                f"{self.gmodel.ngeoms} geometries were loaded (unsupported shape?)"
-            )
-        lo, hi = self.model.lowerPositionLimit, self.model.upperPositionLimit
-        for k, name in enumerate(ARM_JOINTS):
-            if not (np.isfinite(lo[k]) and np.isfinite(hi[k]) and lo[k] < hi[k]):
-                raise ValueError(f"URDF {urdf}: joint {name!r} has limits [{lo[k]}, {hi[k]}] (need finite lower < upper)")
-        for go in self.gmodel.geometryObjects:  # every URDF cylinder is a capsule (urdf/README.md)
-            _check_shape_sizes(go.geometry, go.name, urdf)
-            if isinstance(go.geometry, coal.Cylinder):
-                go.geometry = coal.Capsule(go.geometry.radius, 2.0 * go.geometry.halfLength)
-
-        self.gmodel.addAllCollisionPairs()
-        if srdf is not None:
-            self._apply_srdf(srdf)
         self.data = self.model.createData()
         self._prune_unreachable_pairs()
         self._rebuild_geometry_data()
@@ -246,22 +148,6 @@ class WearerArm:
         self._upper_list = self.upper.tolist()
         self._build_line_of_sight_shapes()
         log.debug("loaded %s: %d geometries, %d pairs", urdf, self.gmodel.ngeoms, len(self.gmodel.collisionPairs))
-
-    def _apply_srdf(self, srdf: Path) -> None:
-        if not srdf.is_file():
-            raise FileNotFoundError(f"SRDF file not found: {srdf}")
-        try:
-            root = ET.fromstring(_read_text(srdf, "SRDF"))
-        except ET.ParseError as exc:
-            raise ValueError(f"malformed SRDF {srdf}: {exc}") from exc
-        if root.tag != "robot":
-            raise ValueError(f"malformed SRDF {srdf}: root element is <{root.tag}>, expected <robot>")
-        links = {f.name for f in self.model.frames}
-        for dc in root.iter("disable_collisions"):
-            for key in ("link1", "link2"):
-                if dc.get(key) not in links:
-                    raise ValueError(f"SRDF {srdf} names unknown link {dc.get(key)!r}")
-        pin.removeCollisionPairs(self.model, self.gmodel, str(srdf))
 
     def _prune_unreachable_pairs(self) -> None:
         """Drop arm-wearer pairs whose wearer part lies beyond the arm's reach from joint 1 (plus margin).
@@ -277,7 +163,7 @@ class WearerArm:
             wearer = a if a.parentJoint == 0 else b if b.parentJoint == 0 else None
             if wearer is None:
                 continue
-            gap = np.linalg.norm(wearer.placement.translation - pivot) - _bounding_radius(wearer.geometry)
+            gap = np.linalg.norm(wearer.placement.translation - pivot) - bounding_radius(wearer.geometry)
             if gap > reach:
                 removed.append(cp)
         for cp in removed:
@@ -307,7 +193,6 @@ class WearerArm:
 
     def _margin_matrix(self) -> np.ndarray:
         """(ng, ng) security margins: the base margin, raised for the wearer pairs of ``link_margins``' links."""
-        ng = self.gmodel.ngeoms
         on_wearer = np.array([g.parentJoint == 0 for g in self.gmodel.geometryObjects])
         with_geometry = {self.model.frames[g.parentFrame].name for g in self.gmodel.geometryObjects}
         unknown = sorted(set(self.link_margins) - with_geometry)
@@ -380,7 +265,7 @@ class WearerArm:
                     continue
                 # chain of joint offsets from joint j down to the geometry's joint, then the shape itself
                 dist = sum(np.linalg.norm(self.model.jointPlacements[m].translation) for m in range(j + 1, k + 1))
-                dist += np.linalg.norm(go.placement.translation) + _bounding_radius(go.geometry)
+                dist += np.linalg.norm(go.placement.translation) + bounding_radius(go.geometry)
                 best = max(best, dist)
             for f in self.model.frames:  # the muzzle tip too
                 if f.parentJoint >= j and f.name == MUZZLE_FRAME:
@@ -403,7 +288,7 @@ class WearerArm:
     # ------------------------------------------------------------------ kinematics
     def check_config(self, q: np.ndarray) -> np.ndarray:
         """Return q as a float array of shape (nq,), or raise ValueError naming the problem."""
-        q = _as_float_array(q, "configuration")
+        q = as_float_array(q, "configuration")
         if q.shape != (self.nq,):
             raise ValueError(f"configuration must have shape ({self.nq},); got {q.shape}")
         if not np.all(np.isfinite(q)):
