@@ -5,7 +5,7 @@ VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 
-.PHONY: test bench bench-full library env clean-env
+.PHONY: test test-fast bench bench-full library env clean-env
 
 env: $(STAMP)
 
@@ -15,8 +15,13 @@ $(STAMP): pyproject.toml
 	$(PY) -m pip install -q -e '.[dev]'
 	touch $(STAMP)
 
+# Everything, as CI runs it (slow tests included: the installed-wheel check, native planners, campaigns).
 test: $(STAMP)
 	MPLBACKEND=Agg $(PY) -m pytest -q
+
+# The fast loop while editing: everything not marked slow.
+test-fast: $(STAMP)
+	MPLBACKEND=Agg $(PY) -m pytest -q -m "not slow"
 
 # Default campaign (<= 10 min on 2 cores): 24 queries at 500 and 2500 samples (batched motion
 # validator; OMPL's per-state validator on 4 queries at 500 beside it) plus a short anytime run.

@@ -2,61 +2,79 @@
 
 Implements Zou et al., "A Path Planning Strategy of Wearable Manipulators with Target Pointing
 End Effectors", Electronics 2022, 11, 1615.
+
+The package is layered, lowest floor first: ``model`` (the wearer and arm, aiming, sectors, query
+files) -> ``planning`` (OMPL set-up, paths, dimension-RRT) and ``viz`` -> ``library`` (DMP path
+library, tracker) -> ``bench`` (campaigns) -> ``cli``.  What a user needs first is exported here.
 """
 
-from .planning.setup import BatchedMotionValidator, WearerValidityChecker, make_simple_setup, make_space
-from .planning.paths import array_to_path, motion_states, path_to_array
 from .library.dmp import DMP, DMPOptions, generate, generate_blended, learn_dmp
 from .library.path_library import LibraryFileError, PathLibrary, QueryResult
+from .library.tracker import Tracker, TrackerOptions, make_default_planner
 from .model.pointing import AimingError, BlindAreaError, UnreachableTargetError, aim, aim_batch, aim_checked
-from .model.queries import Query, load_queries
-from .model.wearer_arm import WearerArm, default_robot
+from .model.queries import Query, QuerySetError, load_queries
 from .model.sectors import (
     CROSS_SECTOR_TRAJECTORIES,
     POSTURE_PRESETS,
+    SECTOR_PAIRS,
     cross_sector_trajectory,
     in_pointing_sector,
     posture_preset,
     posture_sector,
     select_sector,
 )
-from .library.tracker import Tracker, make_default_planner
+from .model.wearer_arm import WearerArm, default_robot
+from .planning.dimension_rrt import DimensionRRT, DimensionRRTOptions
+from .planning.paths import array_to_path, motion_states, path_length, path_to_array
+from .planning.setup import BatchedMotionValidator, WearerValidityChecker, make_simple_setup, make_space
+from .planning.tpee import tpee_dimension_rrt
 
 __all__ = [
-    "AimingError",
+    # the wearer model and the headline planner
+    "WearerArm",
+    "default_robot",
+    "DimensionRRT",
+    "DimensionRRTOptions",
+    "tpee_dimension_rrt",
+    "make_simple_setup",
+    "make_space",
+    "WearerValidityChecker",
     "BatchedMotionValidator",
-    "BlindAreaError",
-    "DMP",
-    "DMPOptions",
-    "LibraryFileError",
-    "PathLibrary",
-    "Query",
-    "QueryResult",
-    "Tracker",
-    "UnreachableTargetError",
+    # aiming, sectors, queries
     "aim",
     "aim_batch",
     "aim_checked",
-    "generate",
-    "generate_blended",
-    "in_pointing_sector",
-    "learn_dmp",
-    "load_queries",
-    "make_default_planner",
-    "posture_sector",
+    "AimingError",
+    "BlindAreaError",
+    "UnreachableTargetError",
     "select_sector",
+    "posture_sector",
+    "in_pointing_sector",
+    "posture_preset",
+    "cross_sector_trajectory",
     "CROSS_SECTOR_TRAJECTORIES",
     "POSTURE_PRESETS",
-    "WearerArm",
-    "WearerValidityChecker",
+    "SECTOR_PAIRS",
+    "Query",
+    "QuerySetError",
+    "load_queries",
+    # paths
     "array_to_path",
-    "cross_sector_trajectory",
-    "default_robot",
-    "make_simple_setup",
-    "make_space",
-    "motion_states",
     "path_to_array",
-    "posture_preset",
+    "path_length",
+    "motion_states",
+    # the real-time layer
+    "PathLibrary",
+    "QueryResult",
+    "LibraryFileError",
+    "Tracker",
+    "TrackerOptions",
+    "make_default_planner",
+    "DMP",
+    "DMPOptions",
+    "learn_dmp",
+    "generate",
+    "generate_blended",
 ]
 
 __version__ = "0.1.0"

@@ -10,9 +10,9 @@ import coal
 import numpy as np
 import pytest
 
+from tpee_ompl.model.sectors import SECTORS, posture_preset
 from tpee_ompl.model.wearer_arm import ARM_JOINTS, WearerArm
 from tpee_ompl.resources import model_file as find_model_file
-from tpee_ompl.model.sectors import SECTORS, posture_preset
 
 MOUNT = np.array([-0.30, 0.0, 1.51])  # urdf/build_urdf.py
 T = np.array([0.1545, 0.0, 0.468])
@@ -203,19 +203,20 @@ def test_truncated_urdf_raises_value_error(tmp_path):
         WearerArm(bad)
 
 
-def test_urdf_without_the_tilt_joint_raises_value_error(tmp_path):
-    text = find_model_file("wearer_arm.urdf").read_text().replace('name="j4" type="revolute"', 'name="j4" type="fixed"')
-    bad = tmp_path / "no_j4.urdf"
-    bad.write_text(text)
-    with pytest.raises(ValueError, match="revolute joint 'j4'"):
-        WearerArm(bad)
-
-
-def test_urdf_with_capsule_element_is_refused(tmp_path):
-    text = find_model_file("wearer_arm.urdf").read_text().replace("<sphere radius=\"0.145\"/>", "<capsule radius=\"0.1\" length=\"0.2\"/>")
-    bad = tmp_path / "capsule.urdf"
-    bad.write_text(text)
-    with pytest.raises(ValueError, match="capsule"):
+@pytest.mark.parametrize(
+    ("old", "new", "match"),
+    [
+        ('name="j4" type="revolute"', 'name="j4" type="fixed"', "revolute joint 'j4'"),
+        ('<sphere radius="0.145"/>', '<capsule radius="0.1" length="0.2"/>', "capsule"),
+    ],
+    ids=["tilt joint fixed", "capsule element"],
+)
+def test_urdf_without_the_tilt_joint_or_with_a_capsule_is_refused(tmp_path, old, new, match):
+    text = find_model_file("wearer_arm.urdf").read_text()
+    assert old in text
+    bad = tmp_path / "edited.urdf"
+    bad.write_text(text.replace(old, new))
+    with pytest.raises(ValueError, match=match):
         WearerArm(bad)
 
 
@@ -232,7 +233,7 @@ def test_negative_security_margin_raises_value_error():
 
 
 def test_packaged_model_files_are_package_data_with_the_urdf_folders_content():
-    root = Path(__file__).resolve().parent.parent
+    root = Path(__file__).resolve().parents[2]
     for name in ("wearer_arm.urdf", "wearer_arm.srdf"):
         packaged = find_model_file(name)
         assert packaged.parent.name == "model" and packaged.parent.parent.name == "data"

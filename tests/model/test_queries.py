@@ -1,4 +1,4 @@
-"""Cross-sector query sets: stored sets, planning necessity, generator determinism, JSON round trip."""
+"""Cross-sector query files: the stored sets, the straight motion, bad files and queries."""
 
 from __future__ import annotations
 
@@ -9,19 +9,8 @@ import numpy as np
 import pytest
 
 from tpee_ompl.model.pointing import aim_errors
-from tpee_ompl.model.queries import FORMAT_VERSION, Query, load_queries, load_query_set, save_queries, straight_motion
-from tpee_ompl.planning.query_generation import generate_queries, planning_necessity
+from tpee_ompl.model.queries import FORMAT_VERSION, Query, load_queries, load_query_set, straight_motion
 from tpee_ompl.model.sectors import cross_sector_trajectory, in_pointing_sector, posture_preset
-
-
-@pytest.fixture(scope="module")
-def necessary():
-    return load_query_set("planning_necessary")
-
-
-@pytest.fixture(scope="module")
-def paper_random():
-    return load_query_set("paper_random")
 
 
 @pytest.mark.parametrize("name", ["planning_necessary", "paper_random"])
@@ -47,20 +36,6 @@ def test_stored_queries_aim_at_their_targets_collision_free(robot, name):
             assert in_pointing_sector(target, k) and target[2] >= 0.0
 
 
-def test_default_set_makes_planning_necessary(robot, necessary):
-    queries, header = necessary
-    rate, per_pair = planning_necessity(robot, queries)
-    assert rate >= 0.5 and min(per_pair.values()) >= 3
-    assert rate == pytest.approx(header["planning_necessity_rate"])
-
-
-def test_paper_random_rate_matches_its_header(robot, paper_random):
-    queries, header = paper_random
-    rate, per_pair = planning_necessity(robot, queries)
-    assert rate == pytest.approx(header["planning_necessity_rate"])
-    assert {f"{i}->{j}": n for (i, j), n in per_pair.items()} == header["planning_necessary_per_pair"]
-
-
 def test_straight_motion_follows_table3_and_interpolates_pan_tilt():
     start = np.r_[posture_preset(1), 0.3, -0.2]
     goal = np.r_[posture_preset(3), -1.0, 0.4]
@@ -69,18 +44,6 @@ def test_straight_motion_follows_table3_and_interpolates_pan_tilt():
     np.testing.assert_allclose(w[:, 2], np.linspace(0.3, -1.0, 7))
     np.testing.assert_array_equal(w[0], start)
     np.testing.assert_array_equal(w[-1], goal)
-
-
-def test_generator_is_deterministic_and_round_trips_through_json(robot, tmp_path):
-    a, stats = generate_queries(robot, n_per_pair=1, seed=7, require_planning=False)
-    b, _ = generate_queries(robot, n_per_pair=1, seed=7, require_planning=False)
-    assert len(a) == 12 and stats["drawn"] >= 12
-    for qa, qb in zip(a, b):
-        np.testing.assert_array_equal(qa.start, qb.start)
-        np.testing.assert_array_equal(qa.target_b, qb.target_b)
-    path = save_queries(tmp_path / "x.json", a, name="x", seed=7, model_hash=robot.model_hash)
-    loaded = load_queries(path)
-    assert [q.to_dict() for q in loaded] == [q.to_dict() for q in a]
 
 
 def test_bad_query_files_and_queries_raise(tmp_path):

@@ -1,0 +1,22 @@
+"""The top-level package exports the public API a user needs first, and nothing it lists is missing."""
+
+from __future__ import annotations
+
+import importlib.metadata
+
+import tpee_ompl
+
+
+def test_every_name_in_all_is_importable_from_the_top_level():
+    missing = [name for name in tpee_ompl.__all__ if not hasattr(tpee_ompl, name)]
+    assert not missing
+
+
+def test_the_headline_names_are_exported():
+    for name in ("WearerArm", "DimensionRRT", "DimensionRRTOptions", "tpee_dimension_rrt", "make_simple_setup",
+                 "PathLibrary", "Tracker", "aim", "aim_batch", "aim_checked", "load_queries"):
+        assert name in tpee_ompl.__all__, name
+
+
+def test_version_has_one_source():
+    assert importlib.metadata.version("tpee_ompl") == tpee_ompl.__version__
