@@ -1,0 +1,45 @@
+"""The tpee-ompl entry point: argument errors, one-line errors with exit code 2, the command groups wired in."""
+
+from __future__ import annotations
+
+import pytest
+from helpers.cli_queries import start_goal_args
+
+from tpee_ompl.cli.main import main
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["plan", "--from", "1", "--to", "9"], "unknown sector 9"),
+        (["plan", "--from", "1", "--to", "4", "--planner", "magic"], "invalid choice"),
+        (["plan", "--from", "1", "--to", "4", "--start", "nan", "0", "0", "0", "--goal", "0", "1", "0", "0"],
+         "not a finite number"),
+        (["plan", "--from", "1", "--to", "4", "--samples", "0"], "positive integer"),
+    ],
+)
+def test_bad_arguments_exit_non_zero_with_one_line(capsys, argv, message):
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    assert exc.value.code != 0
+    err = capsys.readouterr().err
+    assert message in err and "Traceback" not in err
+
+
+def test_missing_urdf_is_one_line_on_stderr(capsys, tmp_path):
+    argv = ["plan", "--from", "1", "--to", "4", *start_goal_args(), "--urdf", str(tmp_path / "missing.urdf")]
+    assert main(argv) == 2
+    assert "URDF file not found" in capsys.readouterr().err
+
+
+def test_bench_help_shows_an_example(capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["bench", "--help"])
+    assert exc.value.code == 0
+    assert "example:" in capsys.readouterr().out
+
+
+def test_library_query_without_a_library_file_is_one_line(capsys, tmp_path):
+    assert main(["library", "stats", "--library", str(tmp_path / "none.npz")]) == 2
+    err = capsys.readouterr().err
+    assert "not found" in err and err.count("\n") == 1

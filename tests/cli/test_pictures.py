@@ -1,0 +1,40 @@
+"""``tpee-ompl show|animate|view``: pictures written, one-line errors."""
+
+from __future__ import annotations
+
+import pytest
+from helpers.cli_queries import start_goal_args
+from helpers.pictures import GIF_SIGNATURE, PNG_SIGNATURE, assert_image
+
+from tpee_ompl.cli.main import main
+
+
+def test_show_without_arguments_draws_the_default_scene(tmp_path, capsys):
+    out = tmp_path / "scene.png"
+    assert main(["show", "-o", str(out)]) == 0
+    assert_image(out, PNG_SIGNATURE, 20)
+
+
+def test_animate_writes_a_gif_of_a_planned_motion(tmp_path):
+    out = tmp_path / "m.gif"
+    argv = ["animate", "--planner", "rrtconnect", "--time", "2", *start_goal_args(), "--frames", "6", "-o", str(out)]
+    assert main(argv) == 0
+    assert out.read_bytes()[:6] in (b"GIF89a", b"GIF87a")
+    assert_image(out, GIF_SIGNATURE, 1)
+
+
+def test_animate_with_unreadable_path_file_is_one_line(tmp_path, capsys):
+    bad = tmp_path / "p.json"
+    bad.write_text("{not json")
+    assert main(["animate", "--path", str(bad), "-o", str(tmp_path / "m.gif")]) == 2
+    assert "cannot read a path" in capsys.readouterr().err
+
+
+def test_view_without_meshcat_says_what_to_install(capsys):
+    try:
+        import meshcat  # noqa: F401
+    except ImportError:
+        assert main(["view", "--no-browser"]) == 2
+        assert "pip install" in capsys.readouterr().err
+    else:
+        pytest.skip("meshcat is installed: the viewer would block")

@@ -1,0 +1,54 @@
+"""``tpee-ompl plan|aim|track``: output, JSON, and one-line errors with non-zero exit codes."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+from helpers.cli_queries import GOAL, START, start_goal_args
+
+from tpee_ompl.cli.main import main
+
+
+def _args(*extra: str) -> list[str]:
+    return ["plan", "--from", "1", "--to", "4", *start_goal_args(), *extra]
+
+
+def test_plan_with_rrtconnect_prints_a_valid_path_as_json(capsys):
+    assert main(_args("--planner", "rrtconnect", "--time", "2", "--json")) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["exact"] and out["valid"]
+    np.testing.assert_allclose(out["path"][0], START, atol=1e-6)
+    np.testing.assert_allclose(out["path"][-1], GOAL, atol=1e-6)
+    assert out["collision_checks"] > 0
+
+
+def test_plan_prints_validity_and_length_in_text(capsys):
+    assert main(_args("--planner", "rrtconnect", "--time", "2")) == 0
+    out = capsys.readouterr().out
+    assert "valid (checkMotion on every segment): True" in out and "length" in out
+
+
+def test_start_in_collision_is_one_line_on_stderr(capsys):
+    argv = ["plan", "--from", "1", "--to", "4", "--start", "-0.085", "0.299", "-0.799", "-1.202",
+            "--goal", *map(str, GOAL)]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "in collision" in err
+
+
+def test_aim_prints_a_collision_free_aim_with_clear_line_of_sight(capsys):
+    assert main(["aim", "--target", "5", "2", "1.5", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["collision_free"] and out["line_of_sight_clear"] and out["aim_error_m"] < 1e-9
+
+
+def test_aim_at_a_target_inside_the_body_is_one_line(capsys):
+    assert main(["aim", "--target", "0", "0", "1.2"]) == 2
+    assert "inside" in capsys.readouterr().err
+
+
+def test_track_jitter_on_a_boundary_causes_no_cross_sector_motion(capsys):
+    assert main(["track", "--script", "jitter", "--duration", "5", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["events"]["cross-sector"] <= 1 and out["events"]["aim"] > 0

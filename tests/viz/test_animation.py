@@ -1,0 +1,49 @@
+"""Animations of joint-space paths and the arc-length resampling behind them."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from helpers.pictures import GIF_SIGNATURE, assert_image
+from PIL import Image
+
+from tpee_ompl.model.sectors import cross_sector_trajectory
+from tpee_ompl.viz import animate_path, resample_path
+
+
+def test_resample_path_is_even_in_arc_length_and_keeps_the_ends():
+    W = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 3.0]])
+    R = resample_path(W, 9)
+    assert R.shape == (9, 2)
+    np.testing.assert_allclose(R[0], W[0])
+    np.testing.assert_allclose(R[-1], W[-1])
+    np.testing.assert_allclose(np.linalg.norm(np.diff(R, axis=0), axis=1), 0.5)
+    assert resample_path(W[:1], 4).shape == (4, 2)
+
+
+def test_animate_path_writes_a_bounded_gif(robot, aimed, tmp_path):
+    q, target_b = aimed
+    W = np.hstack([cross_sector_trajectory(1, 4), np.linspace([0.0, 0.0], q[2:], 7)])
+    W = resample_path(W, 300)  # a long path: the animation must still have `frames` frames
+    p0, u0 = robot.muzzle(W[0])
+    out = animate_path(robot, W, tmp_path / "motion.gif", target_a=p0 + 3 * u0, target_b=target_b, frames=12, fps=8)
+    assert_image(out, GIF_SIGNATURE, 30)
+    with Image.open(out) as im:
+        assert im.n_frames == 12
+        width, height = im.size
+        im.seek(11)
+        last = np.asarray(im.convert("RGB"), dtype=float)
+        im.seek(0)
+        first = np.asarray(im.convert("RGB"), dtype=float)
+    assert (width, height) == (480, 480)  # 6 in at the default 80 dpi
+    # bounded by the frame count, not the 300 waypoints: at most one byte per pixel per frame
+    assert out.stat().st_size < 12 * width * height
+    assert np.abs(last - first).mean() > 0.1, "the arm should move between the first and last frames"
+
+
+def test_bad_animation_inputs_raise_with_a_message(robot, aimed, tmp_path):
+    q, _ = aimed
+    with pytest.raises(ValueError, match=r"waypoints must have shape \(K, 4\)"):
+        animate_path(robot, np.zeros((5, 3)), tmp_path / "a.gif")
+    with pytest.raises(ValueError, match="unsupported animation format"):
+        animate_path(robot, np.tile(q, (3, 1)), tmp_path / "a.avi")

@@ -1,0 +1,63 @@
+"""Still pictures: the scene, the line of sight, invalid configurations, the sectors overlay."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from helpers.pictures import PNG_SIGNATURE, assert_image
+from matplotlib.colors import to_hex
+
+from tpee_ompl.model.sectors import cross_sector_trajectory
+from tpee_ompl.viz import LOS_BLOCKED, LOS_CLEAR, render_scene, save_scene
+from tpee_ompl.viz.meshes import scene_mesh
+
+
+def test_save_scene_writes_a_non_blank_png_and_reuses_the_scene_mesh(robot, aimed, tmp_path):
+    q, target = aimed
+    mesh = scene_mesh(robot)
+    out = save_scene(robot, q, tmp_path / "scene.png", target=target)
+    assert scene_mesh(robot) is mesh, "the wearer's faces are computed once per robot, then cached"
+    assert_image(out, PNG_SIGNATURE, 20)
+
+
+def test_scene_line_of_sight_is_green_when_clear_and_red_when_blocked(robot, aimed):
+    q, target = aimed
+    assert robot.line_of_sight_clear(q, target)
+    fig = render_scene(robot, q, target=target)
+    colors = {to_hex(line.get_color()) for line in fig.axes[0].lines}
+    assert LOS_CLEAR in colors and LOS_BLOCKED not in colors
+    assert "LOS clear" in fig.axes[0].get_title()
+
+    p, _ = robot.muzzle(q)
+    helmet_centre = np.array([-0.005, 0.0, 1.69])
+    blocked = p + 2.0 * (helmet_centre - p)  # straight through the wearer's helmet
+    assert not robot.line_of_sight_clear(q, blocked)
+    fig = render_scene(robot, q, target=blocked)
+    colors = {to_hex(line.get_color()) for line in fig.axes[0].lines}
+    assert LOS_BLOCKED in colors
+    assert "BLOCKED" in fig.axes[0].get_title()
+
+
+def test_invalid_configuration_is_flagged(robot):
+    rng = np.random.default_rng(3)
+    Q = rng.uniform(robot.lower, robot.upper, size=(400, 4))
+    q_bad = Q[~robot.are_valid(Q)][0]
+    fig = render_scene(robot, q_bad)
+    assert "INVALID" in fig.axes[0].get_title()
+
+
+def test_scene_with_sectors_and_path(robot, aimed, tmp_path):
+    q, target = aimed
+    W = np.hstack([cross_sector_trajectory(1, 4), np.linspace([0.0, 0.0], q[2:], 7)])
+    out = save_scene(robot, q, tmp_path / "sectors.png", target=target, sectors=True, path=W)
+    assert_image(out, PNG_SIGNATURE, 20)
+    texts = {t.get_text().strip() for t in render_scene(robot, q, sectors=True).axes[0].texts}
+    assert {"S1", "S2", "S3", "S4"} <= texts
+
+
+def test_bad_scene_inputs_raise_with_a_message(robot, aimed):
+    q, _ = aimed
+    with pytest.raises(ValueError, match="target must be 3"):
+        render_scene(robot, q, target=[1.0, 2.0])
+    with pytest.raises(ValueError, match="shape"):
+        render_scene(robot, q[:3])

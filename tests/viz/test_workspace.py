@@ -1,0 +1,40 @@
+"""Where the barrel can point: sector pointing ranges and the Monte Carlo pointing workspace."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from helpers.pictures import PNG_SIGNATURE, assert_image
+
+from tpee_ompl.viz import pointing_workspace, sample_pointing_workspace, sector_pointing_range
+
+
+def test_sample_pointing_workspace_is_seeded_and_line_of_sight_clear(robot):
+    a = sample_pointing_workspace(robot, 300, np.random.default_rng(7), ranges=(0.3, 0.8))
+    b = sample_pointing_workspace(robot, 300, np.random.default_rng(7), ranges=(0.3, 0.8))
+    np.testing.assert_array_equal(a.points, b.points)
+    assert 0 < a.n_valid <= 300
+    assert a.points.shape == (len(a.range), 3) == (len(a.sector), 3)
+    assert set(np.unique(a.range)) <= {0.3, 0.8}
+    assert set(np.unique(a.sector)) <= {1, 2, 3, 4}
+    # every configuration contributes at most one point per range
+    assert len(a.points) <= 2 * a.n_valid
+
+
+def test_pointing_workspace_figure(robot, tmp_path):
+    out = tmp_path / "workspace.png"
+    fig = pointing_workspace(robot, 600, np.random.default_rng(0), out, color_by="range")
+    assert len(fig.axes) == 4
+    assert_image(out, PNG_SIGNATURE, 40)
+
+
+def test_pointing_workspace_rejects_an_unknown_colouring(robot):
+    with pytest.raises(ValueError, match="color_by"):
+        pointing_workspace(robot, 10, np.random.default_rng(0), color_by="x")
+
+
+def test_sector_pointing_range_marks_reachable_directions(robot):
+    dirs, ok = sector_pointing_range(robot, 4, n_dirs=200)
+    assert dirs.shape == (200, 3)
+    np.testing.assert_allclose(np.linalg.norm(dirs, axis=1), 1.0)
+    assert 0.5 < ok.mean() < 1.0  # most directions reachable, some blind (behind the body)

@@ -1,0 +1,125 @@
+"""``tpee-ompl show|animate|workspace|view``: pictures of the wearer and the arm (see :mod:`tpee_ompl.viz`)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+import numpy as np
+
+from ..viz.animation import animate_path
+from ._common import CliError, add_model_args, default_of, finite, load_robot, positive_int
+from .plan import add_plan_args, plan_motion
+
+__all__ = ["DEFAULT_SCENE_Q", "DEFAULT_SCENE_TARGET", "cmd_animate", "cmd_show", "cmd_view", "cmd_workspace", "register"]
+
+DEFAULT_SCENE_Q = (50.0, 20.0, 17.0, -37.0)
+"""Degrees: the sector 4 preset aiming forward-left-up (``show`` and ``view`` without ``--q``)."""
+DEFAULT_SCENE_TARGET = (4.0, 1.5, 1.9)
+"""Metres: the target ``show`` draws without ``--q`` and ``--target``."""
+
+
+def cmd_show(args: argparse.Namespace) -> int:
+    """Draw the wearer, the arm at q and the line of sight to the target into a PNG."""
+    from ..viz.scene import save_scene
+
+    robot = load_robot(args)
+    q = np.array(args.q) if args.q is not None else np.radians(DEFAULT_SCENE_Q)
+    if args.target is not None:
+        target = np.array(args.target)
+    else:
+        target = np.array(DEFAULT_SCENE_TARGET) if args.q is None else None
+    out = save_scene(robot, robot.check_config(q), args.output, target=target, sectors=args.sectors)
+    print(f"wrote {out} (q = {np.round(q, 4).tolist()} rad, valid: {robot.is_valid(q)})")
+    return 0
+
+
+def _read_path(file: str) -> np.ndarray:
+    """The 'path' list of waypoints in a JSON file (e.g. from ``plan --json``)."""
+    try:
+        with open(file) as fh:
+            return np.asarray(json.load(fh)["path"], dtype=float)
+    except (OSError, KeyError, json.JSONDecodeError, TypeError) as exc:
+        raise CliError(f"cannot read a path from {file}: {exc}") from None
+
+
+def cmd_animate(args: argparse.Namespace) -> int:
+    """Plan a cross-sector motion (or read one from --path JSON) and write an animation."""
+    if args.path:
+        W = _read_path(args.path)
+        robot = load_robot(args)
+    else:
+        result, robot = plan_motion(args)
+        if not result["exact"]:
+            raise CliError(f"{args.planner} found no exact path ({result['status']}); nothing to animate")
+        W = np.asarray(result["path"])
+    (pa, ua), (pb, ub) = robot.muzzle(W[0]), robot.muzzle(W[-1])
+    out = animate_path(robot, W, args.output, target_a=pa + 3 * ua, target_b=pb + 3 * ub, frames=args.frames)
+    print(f"wrote {out} ({len(W)} waypoints, {args.frames} frames)")
+    return 0
+
+
+def cmd_workspace(args: argparse.Namespace) -> int:
+    """Monte-Carlo pointing workspace (the paper's Fig. 4) into a PNG."""
+    from ..viz.workspace import pointing_workspace
+
+    robot = load_robot(args)
+    pointing_workspace(robot, args.samples, np.random.default_rng(args.seed), args.output)
+    print(f"wrote {args.output} ({args.samples} samples, seed {args.seed})")
+    return 0
+
+
+def cmd_view(args: argparse.Namespace) -> int:
+    """Interactive 3-D view in meshcat (optional extra `viewer`)."""
+    import time
+
+    from ..viz.meshcat import view_meshcat
+
+    robot = load_robot(args)
+    q = np.array(args.q) if args.q is not None else np.radians(DEFAULT_SCENE_Q)
+    view_meshcat(robot, robot.check_config(q), open_browser=not args.no_browser)
+    print("meshcat viewer running; press Ctrl-C to stop")
+    while True:
+        time.sleep(1.0)
+
+
+def register(sub: argparse._SubParsersAction, fmt: type) -> None:
+    """Add the ``show``, ``animate``, ``workspace`` and ``view`` subcommands."""
+    p = sub.add_parser("show", help="draw a scene into a PNG", formatter_class=fmt,
+                       description="Draw the wearer, the arm and the line of sight.\n\nexample:\n"
+                                   "  tpee-ompl show -o scene.png\n"
+                                   "  tpee-ompl show --q 0.87 0.35 0.3 -0.6 --target 4 1.5 1.9 --sectors -o s.png")
+    p.add_argument("--q", type=finite, nargs=4, metavar="Q", help="DOF1..DOF4 in radians (default: a sector-4 scene)")
+    p.add_argument("--target", type=finite, nargs=3, metavar=("X", "Y", "Z"), help="target point (m, world frame)")
+    p.add_argument("--sectors", action="store_true", help="overlay the posture sectors")
+    p.add_argument("-o", "--output", default="scene.png")
+    add_model_args(p)
+    p.set_defaults(func=cmd_show)
+
+    p = sub.add_parser("animate", help="animate a cross-sector motion (GIF/MP4)", formatter_class=fmt,
+                       description="Plan a cross-sector motion and animate it, muzzle trace drawn.\n\nexample:\n"
+                                   "  tpee-ompl animate --from 1 --to 4 --planner dimension-rrt -o motion.gif\n"
+                                   "  tpee-ompl plan --from 2 --to 3 --json > p.json && "
+                                   "tpee-ompl animate --path p.json -o m.gif")
+    add_plan_args(p)
+    p.add_argument("--path", help="JSON file with a 'path' list of waypoints (e.g. from plan --json)")
+    p.add_argument("--frames", type=positive_int, default=default_of(animate_path, "frames"))
+    p.add_argument("-o", "--output", default="motion.gif")
+    p.set_defaults(func=cmd_animate)
+
+    p = sub.add_parser("workspace", help="Monte-Carlo pointing workspace (Fig. 4)", formatter_class=fmt,
+                       description="Sample collision-free configurations and draw where the barrel can point.\n\n"
+                                   "example:\n  tpee-ompl workspace --samples 4000 -o workspace.png")
+    p.add_argument("--samples", type=positive_int, default=4000)
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("-o", "--output", default="workspace.png")
+    add_model_args(p)
+    p.set_defaults(func=cmd_workspace)
+
+    p = sub.add_parser("view", help="interactive meshcat view (pip install 'tpee_ompl[viewer]')", formatter_class=fmt,
+                       description="Open the model in Pinocchio's MeshcatVisualizer.\n\n"
+                                   "example:\n  tpee-ompl view --q 0.87 0.35 0 0")
+    p.add_argument("--q", type=finite, nargs=4, metavar="Q")
+    p.add_argument("--no-browser", action="store_true")
+    add_model_args(p)
+    p.set_defaults(func=cmd_view)

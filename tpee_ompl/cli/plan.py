@@ -1,0 +1,257 @@
+"""``tpee-ompl plan|aim|track``: plan one cross-sector motion, aim at a target, track a scripted target."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ..library.path_library import dimension_rrt_planner
+from ..model.pointing import aim
+from ..resources import default_library_path
+from ._common import CliError, add_model_args, default_of, finite, load_robot, positive_float, positive_int, sector
+
+if TYPE_CHECKING:
+    from ..model.wearer_arm import WearerArm
+
+__all__ = ["PLANNERS", "add_plan_args", "cmd_aim", "cmd_plan", "cmd_track", "plan_motion", "register"]
+
+PLANNERS = {
+    "dimension-rrt": "DimensionRRT",
+    "rrtstar": "RRTstar",
+    "informedrrtstar": "InformedRRTstar",
+    "rrtconnect": "RRTConnect",
+    "aorrtc": "AORRTC",
+    "bitstar": "BITstar",
+}
+"""``--planner`` choices: CLI name -> planner class name (``ompl.geometric.<name>``; DimensionRRT is this package's)."""
+
+
+# ---------------------------------------------------------------------------------------- plan
+def _make_planner(name: str, si: Any, from_sector: int, to_sector: int, samples: int | None, seed: int):
+    """Planner instance and a termination-condition factory for it."""
+    from ompl import base as ob
+    from ompl import geometric as og
+
+    if name == "dimension-rrt":
+        from ..planning.tpee import tpee_dimension_rrt
+
+        planner = tpee_dimension_rrt(si, from_sector, to_sector, max_samples=samples, seed=seed)
+        return planner, None
+    planner = getattr(og, PLANNERS[name])(si)
+    if samples is not None:
+        if not hasattr(planner, "numIterations"):
+            raise CliError(f"--samples needs a planner that counts iterations; {name} does not (use --time)")
+        return planner, lambda: ob.PlannerTerminationCondition(lambda: planner.numIterations() >= samples)
+    return planner, None
+
+
+def _start_and_goal(args: argparse.Namespace) -> tuple[np.ndarray, np.ndarray, str | None]:
+    """--start/--goal, or the --query-index'th query of --queries for the sector pair; and the query id."""
+    if args.start is not None and args.goal is not None:
+        return np.array(args.start), np.array(args.goal), None
+    if args.start is not None or args.goal is not None:
+        raise CliError("give both --start and --goal, or neither")
+    from ..model.queries import load_queries
+
+    pair = (args.from_sector, args.to_sector)
+    matching = [q for q in load_queries(args.queries) if (q.from_sector, q.to_sector) == pair]
+    if not matching:
+        raise CliError(f"query set {args.queries!r} has no query from sector {args.from_sector} to {args.to_sector}")
+    if args.query_index >= len(matching):
+        raise CliError(f"--query-index {args.query_index}: the set has {len(matching)} queries for that pair")
+    q = matching[args.query_index]
+    return np.asarray(q.start), np.asarray(q.goal), q.id
+
+
+def plan_motion(args: argparse.Namespace) -> tuple[dict, WearerArm]:
+    """Plan the motion the arguments describe; returns a JSON-ready result and the robot it used."""
+    from ompl import base as ob
+    from ompl import util as ou
+
+    from ..planning.paths import path_to_array
+    from ..planning.setup import make_simple_setup
+
+    ou.setLogLevel(ou.LOG_WARN)
+    if args.seed is not None:
+        ou.RNG.setSeed(args.seed)
+    robot = load_robot(args)
+    start, goal, qid = _start_and_goal(args)
+    ss = make_simple_setup(robot, start, goal)
+    si = ss.getSpaceInformation()
+    planner, ptc_factory = _make_planner(args.planner, si, args.from_sector, args.to_sector, args.samples, args.seed or 0)
+    ss.setPlanner(planner)
+    checks0 = robot.collision_checks
+    if ptc_factory is not None:
+        status = ss.solve(ob.plannerOrTerminationCondition(ptc_factory(), ob.timedPlannerTerminationCondition(args.time)))
+    else:
+        status = ss.solve(args.time)
+    result: dict = {"planner": args.planner, "from_sector": args.from_sector, "to_sector": args.to_sector,
+                    "query_id": qid, "status": str(status), "exact": bool(ss.haveExactSolutionPath()),
+                    "time_s": ss.getLastPlanComputationTime(), "collision_checks": robot.collision_checks - checks0}
+    if ss.haveSolutionPath():
+        path = ss.getSolutionPath()
+        states = path.getStates()
+        result["valid"] = bool(all(si.checkMotion(a, b) for a, b in zip(states[:-1], states[1:])))
+        result["length_rad"] = float(path.length())
+        result["path"] = path_to_array(path, robot.nq).round(6).tolist()
+    return result, robot
+
+
+def cmd_plan(args: argparse.Namespace) -> int:
+    """Plan one cross-sector motion and print the path, its validity and length."""
+    result, _ = plan_motion(args)
+    if args.json:
+        print(json.dumps(result))
+    else:
+        print(f"{args.planner}: sector {args.from_sector} -> {args.to_sector}, status {result['status']}, "
+              f"{result['time_s']:.3f} s, {result['collision_checks']} collision checks")
+        if "path" in result:
+            print(f"valid (checkMotion on every segment): {result['valid']}, length {result['length_rad']:.4f} rad, "
+                  f"{len(result['path'])} waypoints (DOF1..DOF4, rad):")
+            for w in result["path"]:
+                print("  " + " ".join(f"{v:+.4f}" for v in w))
+    return 0 if result["exact"] else 1
+
+
+def add_plan_args(p: argparse.ArgumentParser, required: bool = False) -> None:
+    """The arguments of one planning problem (sectors, planner, limits, start/goal or a stored query)."""
+    p.add_argument("--from", dest="from_sector", type=sector, required=required, default=1,
+                   help="start posture sector (1-4)")
+    p.add_argument("--to", dest="to_sector", type=sector, required=required, default=4, help="goal posture sector (1-4)")
+    p.add_argument("--planner", choices=tuple(PLANNERS), default="dimension-rrt")
+    p.add_argument("--time", type=positive_float, default=5.0, help="time limit in seconds (default 5)")
+    p.add_argument("--samples", type=positive_int, default=None, help="sample / iteration cap")
+    p.add_argument("--seed", type=int, default=1)
+    p.add_argument("--queries", default="planning_necessary", help="query set name or JSON file")
+    p.add_argument("--query-index", type=int, default=0, help="which query of that pair (default 0)")
+    p.add_argument("--start", type=finite, nargs=4, default=None, metavar="Q", help="start DOF1..DOF4 (rad)")
+    p.add_argument("--goal", type=finite, nargs=4, default=None, metavar="Q", help="goal DOF1..DOF4 (rad)")
+    add_model_args(p)
+
+
+# ---------------------------------------------------------------------------------------- aim / track
+def cmd_aim(args: argparse.Namespace) -> int:
+    """Closed-form aiming IK for one target (eqs. 1-11) with the collision and line-of-sight verdict."""
+    from ..model.pointing import aim_errors, check_target
+    from ..model.sectors import select_sector
+
+    robot = load_robot(args)
+    target = check_target(np.array(args.target), robot)
+    sector_ = args.sector if args.sector is not None else select_sector(target)
+    q = aim(target, sector_, pan_reference=args.pan_reference)
+    perp, _, ang = aim_errors(robot, q, target)
+    result = {"target": target.tolist(), "sector": sector_, "q_rad": q.round(9).tolist(),
+              "q_deg": np.degrees(q).round(4).tolist(), "collision_free": robot.is_valid(q),
+              "line_of_sight_clear": robot.line_of_sight_clear(q, target), "aim_error_m": perp, "aim_error_rad": ang}
+    if args.json:
+        print(json.dumps(result))
+    else:
+        print(f"sector {sector_}: DOF1..DOF4 = {' '.join(f'{v:+.6f}' for v in q)} rad "
+              f"({' '.join(f'{v:+.2f}' for v in np.degrees(q))} deg)")
+        print(f"collision-free: {result['collision_free']}, line of sight clear: {result['line_of_sight_clear']}, "
+              f"aim error {perp:.1e} m")
+    return 0 if result["collision_free"] and result["line_of_sight_clear"] else 1
+
+
+def _scripted_targets(name: str, duration: float, rate: float) -> list[tuple]:
+    """Target streams for `track`: a circle around the wearer, boundary jitter, sector jumps."""
+    t = np.arange(0.0, duration, 1.0 / rate)
+    if name == "circle":
+        az = 2 * np.pi * t / duration
+        pts = np.c_[5 * np.cos(az), 5 * np.sin(az), 1.5 + 1.0 * np.sin(3 * az)]
+        return [(ti, p) for ti, p in zip(t, pts)]
+    if name == "jitter":
+        rng = np.random.default_rng(0)
+        az = np.radians(90.0 + rng.uniform(-4.0, 4.0, size=t.size))  # the 2/3 posture boundary, to the left
+        pts = np.c_[6 * np.cos(az) - 0.3, 6 * np.sin(az), np.full(t.size, 2.0)]
+        return [(ti, p) for ti, p in zip(t, pts)]
+    if name == "jump":
+        spots = [np.array(v) for v in ((6.0, 3.0, 2.0), (-2.0, -6.0, 1.0), (-5.0, 4.0, 2.5), (6.0, -3.0, 1.5))]
+        spot = [int(k * len(spots) / t.size) for k in range(t.size)]
+        return [(ti, spots[spot[k]], k > 0 and spot[k] != spot[k - 1]) for k, ti in enumerate(t)]
+    raise CliError(f"unknown script {name!r}")
+
+
+def cmd_track(args: argparse.Namespace) -> int:
+    """Run the Fig. 10 tracking strategy on a scripted target stream and report its events."""
+    from ..library.tracker import Tracker, make_default_planner
+
+    robot = load_robot(args)
+    if args.planner == "dimension-rrt":
+        plan = dimension_rrt_planner(robot, max_samples=args.samples, seed=args.seed)
+
+        def planner(start: np.ndarray, goal: np.ndarray, i: int, j: int) -> np.ndarray:
+            path = plan(start, goal, i, j) if i != j else None
+            if path is None:
+                raise RuntimeError(f"dimension-RRT found no path {i}->{j}")
+            return path
+    elif args.planner == "library":
+        from ..library.path_library import PathLibrary
+
+        lib = PathLibrary.load(args.library, robot, plan=dimension_rrt_planner(robot, max_samples=args.samples))
+        planner = lib.as_planner()
+    else:
+        planner = make_default_planner(robot, seed=args.seed)
+    stream = _scripted_targets(args.script, args.duration, args.rate)
+    result = Tracker(robot, planner).run(stream)
+    kinds = ("aim", "cross-sector", "blind-area", "unreachable")
+    summary = {k: result.count(k) for k in kinds}
+    if args.output:
+        header = "t,dof1,dof2,dof3,dof4,sector"
+        np.savetxt(args.output, np.c_[result.times, result.configurations, result.sectors], delimiter=",",
+                   header=header, comments="")
+    if args.json:
+        print(json.dumps({"script": args.script, "samples": len(stream), "trajectory_points": len(result.times),
+                          "events": summary}))
+    else:
+        print(f"{args.script}: {len(stream)} target samples -> {len(result.times)} trajectory points; "
+              + ", ".join(f"{k} {v}" for k, v in summary.items()))
+        if args.output:
+            print(f"wrote {args.output}")
+    return 0
+
+
+# ---------------------------------------------------------------------------------------- parsers
+def register(sub: argparse._SubParsersAction, fmt: type) -> None:
+    """Add the ``plan``, ``aim`` and ``track`` subcommands."""
+    p = sub.add_parser("plan", help="plan one cross-sector motion", formatter_class=fmt,
+                       description="Plan a cross-sector motion between the first stored query of a sector pair "
+                                   "(or --start/--goal).\n\nexample:\n"
+                                   "  tpee-ompl plan --from 1 --to 4 --planner dimension-rrt\n"
+                                   "  tpee-ompl plan --from 2 --to 3 --planner rrtstar --samples 1000 --json")
+    add_plan_args(p, required=True)
+    p.add_argument("--json", action="store_true", help="machine-readable output")
+    p.set_defaults(func=cmd_plan)
+
+    p = sub.add_parser("aim", help="aiming IK for a target", formatter_class=fmt,
+                       description="Closed-form aiming IK (paper eqs. 1-11).\n\nexample:\n"
+                                   "  tpee-ompl aim --target 5 2 1.5\n  tpee-ompl aim --target -4 -3 1 --sector 1 --json")
+    p.add_argument("--target", type=finite, nargs=3, required=True, metavar=("X", "Y", "Z"), help="metres, world frame")
+    p.add_argument("--sector", type=sector, default=None, help="posture sector (default: chosen from the target)")
+    p.add_argument("--pan-reference", type=finite, default=default_of(aim, "pan_reference"),
+                   help="pan angle the smaller rotation is measured from")
+    p.add_argument("--json", action="store_true")
+    add_model_args(p)
+    p.set_defaults(func=cmd_aim)
+
+    p = sub.add_parser("track", help="run the tracking strategy (Fig. 10) on a scripted target", formatter_class=fmt,
+                       description="Track a scripted target: re-aim inside a pointing sector, plan cross-sector motions "
+                                   "when it leaves.\n\nexample:\n  tpee-ompl track --script circle\n"
+                                   "  tpee-ompl track --script jump --planner dimension-rrt -o traj.csv")
+    p.add_argument("--script", choices=("circle", "jitter", "jump"), default="circle")
+    p.add_argument("--planner", choices=("default", "dimension-rrt", "library"), default="default",
+                   help="cross-sector planner: default (Table 3 straight motion, else RRTConnect), dimension-rrt, library")
+    p.add_argument("--library", default=str(default_library_path()),
+                   help="path library file (with --planner library; default: the packaged one)")
+    p.add_argument("--samples", type=positive_int, default=default_of(dimension_rrt_planner, "max_samples"),
+                   help="dimension-RRT sample cap")
+    p.add_argument("--duration", type=positive_float, default=20.0, help="seconds of target motion")
+    p.add_argument("--rate", type=positive_float, default=10.0, help="target samples per second")
+    p.add_argument("--seed", type=int, default=1, help="OMPL / planner seed (>= 1)")
+    p.add_argument("--json", action="store_true")
+    p.add_argument("-o", "--output", help="write the trajectory as CSV")
+    add_model_args(p)
+    p.set_defaults(func=cmd_track)

@@ -1,0 +1,100 @@
+"""Helpers shared by the figure modules: 3D axes set-up, argument checks, writing files.
+
+matplotlib is imported inside the functions, so importing the package stays cheap.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
+    from ..model.wearer_arm import WearerArm
+
+log = logging.getLogger(__name__)
+
+
+# ---------------------------------------------------------------------------- axes
+def new_axes(figsize: tuple[float, float] = (7.0, 7.0), dpi: int = 110) -> Axes:
+    """3D axes on a new headless Figure (not pyplot: no global state, no display needed)."""
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=figsize, dpi=dpi)
+    return fig.add_subplot(projection="3d")
+
+
+def set_view(ax: Axes, lo: np.ndarray, hi: np.ndarray, elev: float, azim: float) -> None:
+    """Limits [lo, hi] with equal metres per unit on all three axes, the camera, axis labels."""
+    ax.set_xlim(lo[0], hi[0])
+    ax.set_ylim(lo[1], hi[1])
+    ax.set_zlim(lo[2], hi[2])
+    ax.set_box_aspect(tuple(hi - lo))
+    ax.view_init(elev=elev, azim=azim)
+    ax.set_xlabel("x (m, forward)")
+    ax.set_ylabel("y (m, left)")
+    ax.set_zlabel("z (m)")
+    ax.tick_params(labelsize=7)
+
+
+def draw_floor(ax: Axes, lo: np.ndarray, hi: np.ndarray) -> None:
+    """A faint grey floor quad at z = lo[2]."""
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    z = lo[2]
+    quad = [[(lo[0], lo[1], z), (hi[0], lo[1], z), (hi[0], hi[1], z), (lo[0], hi[1], z)]]
+    ax.add_collection3d(Poly3DCollection(quad, facecolors=(0.85, 0.85, 0.85, 0.35), edgecolors="none"))
+
+
+def clip_segment(a: np.ndarray, b: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """End point of segment a->b clipped to the box [lo, hi] (a is inside)."""
+    d = b - a
+    t = 1.0
+    for k in range(3):
+        if d[k] > 1e-12:
+            t = min(t, (hi[k] - a[k]) / d[k])
+        elif d[k] < -1e-12:
+            t = min(t, (lo[k] - a[k]) / d[k])
+    return a + max(t, 0.0) * d
+
+
+# ---------------------------------------------------------------------------- argument checks
+def check_target(target: Any) -> np.ndarray | None:
+    """None, or the target as 3 finite floats (metres); ValueError otherwise."""
+    if target is None:
+        return None
+    t = np.asarray(target, dtype=float)
+    if t.shape != (3,) or not np.all(np.isfinite(t)):
+        raise ValueError(f"target must be 3 finite numbers (x, y, z in metres), got {target!r}")
+    return t
+
+
+def check_waypoints(robot: WearerArm, waypoints: Any) -> np.ndarray:
+    """The waypoints as a finite (K >= 1, robot.nq) float array; ValueError otherwise."""
+    W = np.asarray(waypoints, dtype=float)
+    if W.ndim != 2 or W.shape[1] != robot.nq or len(W) < 1:
+        raise ValueError(f"waypoints must have shape (K, {robot.nq}) with K >= 1; got {W.shape}")
+    if not np.all(np.isfinite(W)):
+        raise ValueError("waypoints contain NaN or inf")
+    return W
+
+
+# ---------------------------------------------------------------------------- files
+def output_path(out_path: str | os.PathLike) -> Path:
+    """``out_path`` as a Path, its parent folders created."""
+    out = Path(out_path)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    return out
+
+
+def write_figure(fig: Figure, out: Path, dpi: int, **savefig_kwargs: Any) -> Path:
+    """Save ``fig`` to ``out`` (format from the suffix), log it, and return ``out``."""
+    fig.savefig(out, dpi=dpi, **savefig_kwargs)
+    log.info("wrote %s", out)
+    return out
