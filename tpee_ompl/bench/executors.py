@@ -1,6 +1,6 @@
 """Where the tasks of a benchmark campaign run: this process, a local process pool, or Dask.
 
-A campaign is a list of plain-data tasks (one per query, see ``benchmark.run_query_task``), each run
+A campaign is a list of plain-data tasks (one per query, see :func:`tpee_ompl.bench.experiment.run_query_task`), each run
 in a **fresh process** so that ``ompl.util.RNG.setSeed`` (which works once per process) gives every
 task the same seed whichever machine runs it.  The executors differ only in who starts that process:
 
@@ -122,7 +122,7 @@ def _die_with_parent() -> None:
             ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
 
 
-def run_task_in_subprocess(task: dict, fn_path: str = "tpee_ompl.bench.campaign:run_query_task") -> dict:
+def run_task_in_subprocess(task: dict, fn_path: str = "tpee_ompl.bench.experiment:run_query_task") -> dict:
     """Run ``fn(task)`` in a fresh Python process and return its (JSON) result.
 
     ``task["sys_path"]`` entries that exist here are put on the child's ``sys.path`` (so planner

@@ -31,7 +31,7 @@ def _pyplot():
 def make_plots(db_path: str | Path, directory: str | Path, planner: str | None = None,
                reference: str | None = None) -> list[Path]:
     """Write the PNGs into ``directory`` and return their paths (only the plots the data allow)."""
-    from .report import PAPER_TABLE4, RATIO_METRICS, _resolve, load_runs, ratio_table
+    from .report import PAPER_TABLE4, RATIO_METRICS, load_runs, ratio_table, resolve_planner_name
 
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
@@ -40,8 +40,8 @@ def make_plots(db_path: str | Path, directory: str | Path, planner: str | None =
     out: list[Path] = []
     it = [r for r in runs if r["comparison"] == "iterations"]
     seen = sorted({r["planner"] for r in it})
-    planner = planner or _resolve("DimensionRRT", seen)
-    reference = reference or _resolve("RRTstar", seen)
+    planner = planner or resolve_planner_name("DimensionRRT", seen)
+    reference = reference or resolve_planner_name("RRTstar", seen)
     if it:
         ratios = ratio_table(runs, planner, reference)
         for chk in sorted({r["checker"] for r in ratios}):

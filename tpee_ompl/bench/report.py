@@ -1,7 +1,7 @@
 """Campaign report: the paper's Table-4 ratios and honest length figures, as Markdown and CSV.
 
 Everything is read back from the campaign's SQLite database (Planner Arena format, see
-:mod:`tpee_ompl.bench.campaign`).  A run *succeeds* when its status is an exact solution,
+:mod:`tpee_ompl.bench.database`).  A run *succeeds* when its status is an exact solution,
 OMPL's ``correct_solution`` is 1, the raw path starts at the start and ends at the goal
 (``reaches_goal``; OMPL 2.0.1's AORRTC sometimes returns a zero-length path with status "Invalid
 goal" that Benchmark still marks solved) and every raw-path segment passes ``si.checkMotion``
@@ -27,6 +27,7 @@ __all__ = [
     "length_quality_table",
     "load_runs",
     "ratio_table",
+    "resolve_planner_name",
     "success_table",
     "summarize",
     "write_report",
@@ -275,8 +276,8 @@ def write_report(db_path: str | Path, directory: str | Path, expected: dict | No
     cfg = (expected or {}).get("config", {})
     names = list(cfg.get("iteration_planners") or ["DimensionRRT", "RRTstar"])
     seen = sorted({r["planner"] for r in runs if r["comparison"] == "iterations"})
-    planner = planner or _resolve(names[0], seen)
-    reference = reference or _resolve(names[1] if len(names) > 1 else "RRTstar", seen)
+    planner = planner or resolve_planner_name(names[0], seen)
+    reference = reference or resolve_planner_name(names[1] if len(names) > 1 else "RRTstar", seen)
     headline = (cfg.get("checkers") or ["batched"])[0]
     ratios = ratio_table(runs, planner, reference)
     succ = success_table(runs, expected)
@@ -292,7 +293,7 @@ def write_report(db_path: str | Path, directory: str | Path, expected: dict | No
     return {**paths, "markdown_text": text, "planner": planner, "reference": reference}
 
 
-def _resolve(name: str, seen: Sequence[str]) -> str:
+def resolve_planner_name(name: str, seen: Sequence[str]) -> str:
     """Planner names in the DB come from getName(); map a factory key (or module:function) onto them."""
     if name in seen:
         return name

@@ -3,37 +3,17 @@
 from __future__ import annotations
 
 import json
-import os
-import signal
 import sqlite3
-import time
 from pathlib import Path
 
 import pytest
 
 pytest.importorskip("distributed")
 
-from test_benchmark import StandInPlanner, tiny_config, write_query_file  # noqa: E402
+from helpers.bench_standins import KILL_MARKER_ENV, STANDIN, tiny_config, write_query_file  # noqa: E402
 
-from tpee_ompl.bench.campaign import PlannerContext, run_campaign
-from tpee_ompl.bench.executors import DaskExecutor, ProcessPoolExecutor
-
-KILL_MARKER_ENV = "TPEE_TEST_KILL_MARKER"
-
-
-def make_worker_killer(si, ctx: PlannerContext):
-    """First call anywhere: kill the Dask worker running this task (our parent process); then a stand-in."""
-    marker = Path(os.environ[KILL_MARKER_ENV])
-    try:
-        fd = os.open(marker, os.O_CREAT | os.O_EXCL | os.O_WRONLY)
-    except FileExistsError:
-        return StandInPlanner(si, max_samples=ctx.max_samples, seed=ctx.seed)
-    os.write(fd, str(os.getppid()).encode())
-    os.close(fd)
-    os.kill(os.getppid(), signal.SIGKILL)
-    time.sleep(30)  # PR_SET_PDEATHSIG ends this process with its worker
-    raise RuntimeError("worker was not killed")
-
+from tpee_ompl.bench.campaign import run_campaign  # noqa: E402
+from tpee_ompl.bench.executors import DaskExecutor, ProcessPoolExecutor  # noqa: E402
 
 ROWS_SQL = (
     "SELECT experiments.query_id, experiments.sample_cap, experiments.motion_validator, plannerConfigs.name, "
@@ -66,11 +46,12 @@ def dask_executor():
 
 def _iteration_config(query_file: Path, out: Path, **kw):
     base = dict(sample_caps=(30, 60), anytime_budgets=(), workers=2, seed=11,
-                iteration_planners=("test_benchmark:make_standin", "RRTstar"))
+                iteration_planners=(STANDIN, "RRTstar"))
     base.update(kw)
     return tiny_config(query_file, out, **base)
 
 
+@pytest.mark.slow
 def test_dask_campaign_gives_the_same_rows_as_the_local_pool(query_file, tmp_path, dask_executor):
     cfg = _iteration_config(query_file, tmp_path)
     local = run_campaign(cfg, executor=ProcessPoolExecutor(2), report=False, progress_bar=False)
@@ -83,6 +64,7 @@ def test_dask_campaign_gives_the_same_rows_as_the_local_pool(query_file, tmp_pat
     assert meta["executor"].startswith("Dask") and meta["finished_experiments"] == 6
 
 
+@pytest.mark.slow
 def test_killed_dask_worker_has_its_task_retried_and_nothing_is_lost_or_doubled(query_file, tmp_path, dask_executor,
                                                                                 monkeypatch):
     marker = tmp_path / "killed"
@@ -90,7 +72,7 @@ def test_killed_dask_worker_has_its_task_retried_and_nothing_is_lost_or_doubled(
     ex = DaskExecutor("local", n_workers=2, retries=0)
     try:
         cfg = _iteration_config(query_file, tmp_path, sample_caps=(30,),
-                                iteration_planners=("test_dask:make_worker_killer", "RRTstar"))
+                                iteration_planners=("helpers.bench_standins:make_worker_killer", "RRTstar"))
         res = run_campaign(cfg, executor=ex, report=False, progress_bar=False)
     finally:
         ex.shutdown()

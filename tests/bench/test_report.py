@@ -6,7 +6,6 @@ import math
 
 import pytest
 
-from tpee_ompl.bench.campaign import stratified_subset
 from tpee_ompl.bench.report import PAPER_TABLE4, length_quality_table, ratio_table, success_table, summarize
 
 
@@ -54,10 +53,3 @@ def test_summarize_ignores_non_finite_values_and_handles_empty_input():
     s = summarize([1.0, 2.0, 3.0, math.inf, None])
     assert s["n"] == 3 and s["median"] == 2.0 and s["q1"] == 1.5
     assert summarize([])["n"] == 0 and math.isnan(summarize([])["mean"])
-
-
-def test_stratified_subset_covers_every_sector_pair():
-    qs = [{"id": 10 * p + k, "from_sector": p, "to_sector": p + 1} for p in range(1, 4) for k in range(3)]
-    sub = stratified_subset(qs, 3)
-    assert {q["from_sector"] for q in sub} == {1, 2, 3}
-    assert len(stratified_subset(qs, None)) == 9

@@ -1,9 +1,8 @@
-"""Campaign faults: callback exceptions, corrupt logs, SIGINT/SIGTERM at random moments, resume, no Dask."""
+"""Campaign faults: callback exceptions, corrupt logs, SIGINT/SIGTERM at random moments, resume."""
 
 from __future__ import annotations
 
 import json
-import os
 import signal
 import sqlite3
 import subprocess
@@ -12,72 +11,19 @@ import time
 from pathlib import Path
 
 import pytest
+from helpers.bench_standins import STANDIN, tiny_config, write_query_file
 from ompl import base as ob
 from ompl import util as ou
-from test_benchmark import StandInPlanner, tiny_config, write_query_file
 
-from tpee_ompl.bench.campaign import (
-    PlannerContext,
-    build_database,
-    main,
-    resume_campaign,
-    run_campaign,
-    write_new_file,
-)
+from tpee_ompl.bench.campaign import resume_campaign, run_campaign
+from tpee_ompl.cli.bench import main
 
-TESTS = Path(__file__).resolve().parent
-
-
-class SolveRaises(StandInPlanner):
-    """Raises inside ``solve`` (called by OMPL's Benchmark from C++)."""
-
-    def __init__(self, si, max_samples=None, seed=None):
-        super().__init__(si, max_samples, seed)
-        self.setName("SolveRaises")
-
-    def solve(self, ptc):
-        raise ValueError("solve exploded")
-
-
-class SetupRaises(StandInPlanner):
-    """Raises inside ``setup``."""
-
-    def __init__(self, si, max_samples=None, seed=None):
-        super().__init__(si, max_samples, seed)
-        self.setName("SetupRaises")
-
-    def setup(self):
-        raise ValueError("setup exploded")
-
-
-class _RaisingMotionValidator(ob.MotionValidator):
-    def __init__(self, si):
-        super().__init__(si)
-
-    def checkMotion(self, s1, s2):  # noqa: N802 (OMPL override)
-        raise RuntimeError("motion validator exploded")
-
-
-class AbortsBenchmark(StandInPlanner):
-    """Solves, then leaves a raising Python motion validator: OMPL's own path check aborts ``benchmark()``."""
-
-    def solve(self, ptc):
-        status = super().solve(ptc)
-        si = self.getSpaceInformation()
-        si.setMotionValidator(_RaisingMotionValidator(si))
-        return status
-
-
-def make_solve_raises(si, ctx: PlannerContext):
-    return SolveRaises(si, max_samples=ctx.max_samples, seed=ctx.seed)
-
-
-def make_setup_raises(si, ctx: PlannerContext):
-    return SetupRaises(si, max_samples=ctx.max_samples, seed=ctx.seed)
-
-
-def make_aborts_benchmark(si, ctx: PlannerContext):
-    return AbortsBenchmark(si, max_samples=ctx.max_samples, seed=ctx.seed)
+TESTS = Path(__file__).resolve().parents[1]
+"""``tests/``: put on the campaign subprocess's ``sys.path`` so it imports ``helpers.bench_standins``."""
+FAULTS = "helpers.bench_standins:"
+CRASH = int(ob.PlannerStatus.CRASH.value)
+UNSOLVED_OR_SOLVED = {int(s.value) for s in (ob.PlannerStatus.TIMEOUT, ob.PlannerStatus.APPROXIMATE_SOLUTION,
+                                             ob.PlannerStatus.EXACT_SOLUTION)}
 
 
 @pytest.fixture(scope="module")
@@ -97,25 +43,24 @@ def _runs(db: Path) -> list[tuple]:
 
 def test_exceptions_in_planner_callbacks_are_failed_runs_and_ompl_logging_stays_on(query_file, tmp_path):
     cfg = tiny_config(query_file, tmp_path, sample_caps=(20,), anytime_budgets=(), max_queries=1,
-                      iteration_planners=("test_campaign_faults:make_solve_raises",
-                                          "test_campaign_faults:make_setup_raises", "RRTstar"))
+                      iteration_planners=(FAULTS + "make_solve_raises", FAULTS + "make_setup_raises", "RRTstar"))
     res = run_campaign(cfg, report=False, progress_bar=False)
     rows = {name: (status, solved, err) for name, status, solved, err in _runs(res.database)}
-    assert rows["geometric_SolveRaises"] == (7, 0, 1) and rows["geometric_SetupRaises"] == (7, 0, 1)
+    assert rows["geometric_SolveRaises"] == (CRASH, 0, 1) and rows["geometric_SetupRaises"] == (CRASH, 0, 1)
     status, _, err = rows["geometric_RRTstar"]
-    assert status in (4, 5, 6) and err == 0  # the rest of the experiment ran (20 iterations may not solve)
+    assert status in UNSOLVED_OR_SOLVED and err == 0  # the rest of the experiment ran (20 iterations may not solve)
     assert len(_runs(res.database)) == 3
     assert ou.getOutputHandler() is not None
 
 
 def test_benchmark_aborted_by_a_python_callback_records_failed_runs_and_restores_logging(query_file, tmp_path):
     cfg = tiny_config(query_file, tmp_path, sample_caps=(20,), anytime_budgets=(), max_queries=2,
-                      iteration_planners=("test_campaign_faults:make_aborts_benchmark", "RRTstar"))
+                      iteration_planners=(FAULTS + "make_aborts_benchmark", "RRTstar"))
     res = run_campaign(cfg, report=False, progress_bar=False)
     assert ou.getOutputHandler() is not None  # Benchmark had switched it off when it was aborted
     runs = _runs(res.database)
     assert len(runs) == 2 * 2  # every planner of both experiments has its run, recorded as failed
-    assert all(status == 7 and solved == 0 and err == 1 for _, status, solved, err in runs)
+    assert all(status == CRASH and solved == 0 and err == 1 for _, status, solved, err in runs)
     tasks = [json.loads(line) for line in (res.directory / "tasks.jsonl").read_text().splitlines()]
     assert all("motion validator exploded" in next(iter(t["errors"].values())) for t in tasks)
 
@@ -138,27 +83,12 @@ def test_corrupt_log_is_reported_by_name_and_skipped(query_file, tmp_path, caplo
     assert bad.read_text() == text[: len(text) // 3]  # reported, not deleted or rewritten
 
 
-def test_write_new_file_never_overwrites(tmp_path):
-    target = tmp_path / "a.log"
-    assert write_new_file(target, "first")
-    assert not write_new_file(target, "second")
-    assert target.read_text() == "first" and [p.name for p in tmp_path.iterdir()] == ["a.log"]
-
-
-def test_missing_dask_gives_a_clear_error(monkeypatch, capsys, tmp_path):
-    monkeypatch.setitem(sys.modules, "distributed", None)  # import distributed -> ImportError
-    code = main(["--dask", "local", "--samples", "10", "--anytime", "--out", str(tmp_path), "--no-progress"])
-    err = capsys.readouterr().err
-    assert code == 2 and "pip install" in err and "dask" in err
-    assert not list(tmp_path.iterdir())  # nothing started
-
-
 def _launch(query_file: Path, out: Path) -> subprocess.Popen:
-    code = ("import sys; sys.path.insert(0, sys.argv[1]); from tpee_ompl.bench.campaign import main; "
+    code = ("import sys; sys.path.insert(0, sys.argv[1]); from tpee_ompl.cli.bench import main; "
             "sys.exit(main(sys.argv[2:]))")
     args = ["--queries", str(query_file), "--name", "sig", "--samples", "30", "60", "--anytime", "0.05",
-            "--planners", "test_benchmark:make_standin", "RRTstar",
-            "--anytime-planners", "test_benchmark:make_standin", "RRTConnect",
+            "--planners", STANDIN, "RRTstar",
+            "--anytime-planners", STANDIN, "RRTConnect",
             "--checkers", "batched", "--workers", "1", "--seed", "5", "--out", str(out), "--no-progress"]
     return subprocess.Popen([sys.executable, "-c", code, str(TESTS), *args], cwd=str(TESTS.parent),
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
@@ -172,6 +102,7 @@ def _wait_for(pred, timeout: float = 60.0) -> None:
         time.sleep(0.02)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("sig", "moment"), [(signal.SIGINT, "first_log"), (signal.SIGTERM, "start")])
 def test_signal_keeps_finished_runs_never_half_writes_the_db_and_resume_completes(query_file, tmp_path, sig, moment):
     proc = _launch(query_file, tmp_path)

@@ -1,0 +1,120 @@
+"""Benchmark campaigns: smoke campaign, interruption, isolation of campaigns, configuration, query rows."""
+
+from __future__ import annotations
+
+import json
+import sqlite3
+from pathlib import Path
+
+import pytest
+from helpers.bench_standins import tiny_config, write_query_file
+
+from tpee_ompl.bench.campaign import query_rows, run_campaign, stratified_subset
+from tpee_ompl.bench.config import CampaignConfig, default_workers
+
+
+@pytest.fixture(scope="module")
+def query_file(tmp_path_factory, robot) -> Path:
+    return write_query_file(tmp_path_factory.mktemp("q") / "tiny.json", robot)
+
+
+def test_query_file_loads_as_plain_dicts(query_file):
+    name, qs = query_rows(str(query_file))
+    assert name == "tiny" and len(qs) == 2
+    assert qs[0]["from_sector"] == 1 and len(qs[0]["start"]) == 4
+    assert json.loads(json.dumps(qs)) == qs  # plain data: goes to worker processes and campaign.json
+
+
+def test_packaged_query_set_is_found_by_name():
+    name, qs = query_rows("planning_necessary")
+    assert name == "planning_necessary" and len(qs) == 120
+
+
+def test_stratified_subset_covers_every_sector_pair():
+    qs = [{"id": 10 * p + k, "from_sector": p, "to_sector": p + 1} for p in range(1, 4) for k in range(3)]
+    sub = stratified_subset(qs, 3)
+    assert {q["from_sector"] for q in sub} == {1, 2, 3}
+    assert len(stratified_subset(qs, None)) == 9
+
+
+@pytest.mark.slow
+def test_smoke_campaign_fills_the_database(query_file, tmp_path):
+    res = run_campaign(tiny_config(query_file, tmp_path), progress_bar=False)
+    assert not res.interrupted
+    assert res.directory.parent == tmp_path and res.directory.name.endswith("_smoke")
+    assert len(res.logs) == 2 * 3 and all(p.suffix == ".log" for p in res.logs)
+    con = sqlite3.connect(res.database)
+    rows = con.execute(
+        "SELECT plannerConfigs.name, runs.correct_solution, runs.best_cost, runs.iterations, runs.collision_checks, "
+        "runs.length_dof12, runs.length_dof34, runs.path_valid_dense, runs.solution_length "
+        "FROM runs JOIN plannerConfigs ON runs.plannerid = plannerConfigs.id "
+        "JOIN experiments ON runs.experimentid = experiments.id WHERE experiments.comparison = 'iterations'").fetchall()
+    planners = {r[0] for r in rows}
+    assert planners == {"geometric_StandIn", "geometric_RRTstar"}
+    for name, correct, best, iters, checks, l12, l34, dense, length in rows:
+        assert correct is not None and iters is not None and checks > 0  # filled for every run
+        if length is not None:  # solved: every column of the raw path is there
+            assert correct == 1 and dense == 1 and best == pytest.approx(length, rel=1e-4)
+            assert l12 + l34 >= length - 1e-6  # triangle inequality per segment
+    assert {r[0] for r in rows if r[8] is not None} == planners  # each planner solved something
+    caps = dict(con.execute("SELECT sample_cap, COUNT(*) FROM experiments WHERE comparison='iterations' "
+                            "GROUP BY sample_cap").fetchall())
+    assert caps == {30: 2, 60: 2}
+    rrt_iters = {r[0] for r in con.execute(
+        "SELECT runs.iterations FROM runs JOIN plannerConfigs ON runs.plannerid = plannerConfigs.id "
+        "JOIN experiments ON runs.experimentid = experiments.id "
+        "WHERE plannerConfigs.name='geometric_RRTstar' AND experiments.comparison='iterations'")}
+    assert rrt_iters <= {30, 60}
+    n_prog = con.execute(
+        "SELECT COUNT(*) FROM progress JOIN runs ON progress.runid = runs.id "
+        "JOIN plannerConfigs ON runs.plannerid = plannerConfigs.id WHERE plannerConfigs.name='geometric_StandIn'"
+    ).fetchone()[0]
+    assert n_prog > 0
+    settings = con.execute("SELECT settings FROM plannerConfigs WHERE name='geometric_StandIn'").fetchone()[0]
+    assert "planner.kind" in settings and "iteration_cap" in settings
+    params = con.execute("SELECT query_id, from_sector, to_sector, query_set FROM experiments").fetchall()
+    assert ("0", 1, 2, "tiny") in params
+    con.close()
+    table = (res.directory / "table4.csv").read_text()
+    assert table.splitlines()[0].endswith(",paper") and "length_dof12" in table
+    assert "StandIn / RRTstar" in (res.directory / "report.md").read_text()
+    assert res.plots and all(p.suffix == ".png" and p.stat().st_size > 0 for p in res.plots)
+    meta = json.loads((res.directory / "campaign.json").read_text())
+    assert meta["seed"] == 3 and "ompl" in meta["versions"]
+
+
+def test_interrupted_campaign_keeps_finished_logs_and_builds_the_db(query_file, tmp_path):
+    def stop_after_first(logs):
+        raise KeyboardInterrupt
+
+    cfg = tiny_config(query_file, tmp_path, sample_caps=(30,), anytime_budgets=())
+    res = run_campaign(cfg, on_task_done=stop_after_first, progress_bar=False)
+    assert res.interrupted
+    assert len(res.logs) == 1 and res.logs[0].is_file()
+    assert not list((res.directory / "logs").glob("*.part"))
+    con = sqlite3.connect(res.database)
+    assert con.execute("SELECT COUNT(*) FROM experiments").fetchone()[0] == 1
+    con.close()
+    success = (res.directory / "success.csv").read_text()
+    assert "missing" in success.splitlines()[0]
+
+
+def test_second_campaign_leaves_the_first_untouched(query_file, tmp_path):
+    cfg = tiny_config(query_file, tmp_path, sample_caps=(20,), anytime_budgets=(), max_queries=1)
+    first = run_campaign(cfg, progress_bar=False, report=False)
+    before = {p: (p.stat().st_mtime_ns, p.read_bytes()) for p in first.directory.rglob("*") if p.is_file()}
+    second = run_campaign(cfg, progress_bar=False, report=False)
+    assert second.directory != first.directory
+    after = {p: (p.stat().st_mtime_ns, p.read_bytes()) for p in first.directory.rglob("*") if p.is_file()}
+    assert before == after
+
+
+def test_bad_config_is_rejected():
+    with pytest.raises(ValueError, match="motion validator"):
+        CampaignConfig(checkers=("fast",))
+    with pytest.raises(ValueError, match="caps"):
+        CampaignConfig(sample_caps=(0,))
+
+
+def test_default_workers_is_at_most_two():
+    assert CampaignConfig().workers == default_workers() and 1 <= default_workers() <= 2

@@ -1,0 +1,31 @@
+"""One query's experiments: path metrics, the experiment list and log names."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from tpee_ompl.bench.config import CampaignConfig
+from tpee_ompl.bench.experiment import experiment_specs, group_lengths, log_name
+
+
+def test_group_lengths_split_the_joint_space_path():
+    W = np.array([[0, 0, 0, 0], [3, 4, 0, 0], [3, 4, 1, 0]], dtype=float)
+    assert group_lengths(W) == pytest.approx((6.0, 5.0, 1.0))
+    with pytest.raises(ValueError, match="shape"):
+        group_lengths(np.zeros((3, 2)))
+
+
+def test_alternative_checkers_and_anytime_run_on_the_first_queries_only():
+    cfg = dataclasses.asdict(CampaignConfig(sample_caps=(10, 20), alt_checker_queries=1, alt_checker_caps=(10,),
+                                            anytime_budgets=(0.5,), anytime_queries=1))
+    first, second = experiment_specs(cfg, 0), experiment_specs(cfg, 1)
+    assert [(s["comparison"], s["checker"], s["cap"], s["budget"]) for s in first] == [
+        ("iterations", "batched", 10, None), ("iterations", "batched", 20, None),
+        ("iterations", "discrete", 10, None), ("anytime", "batched", None, 0.5)]
+    assert [(s["checker"], s["cap"]) for s in second] == [("batched", 10), ("batched", 20)]
+    names = [log_name({"id": 7}, 3, s) for s in first]
+    assert names[0] == "q003_iterations_batched_N10.log" and names[-1] == "q003_anytime_batched_T0.5s.log"
+    assert len(set(names)) == len(names)

@@ -1,0 +1,34 @@
+"""Result files are never overwritten: :mod:`tpee_ompl.bench.results`."""
+
+from __future__ import annotations
+
+from tpee_ompl.bench.results import format_value, make_results_dir, new_output_stem, write_new_file
+
+
+def test_existing_results_get_a_new_timestamped_stem(tmp_path) -> None:
+    stem = tmp_path / "sub" / "benchmark"
+    assert new_output_stem(stem) == stem and stem.parent.is_dir()
+    stem.with_suffix(".json").write_text("{}")
+    second = new_output_stem(stem)
+    assert second != stem and second.name.startswith("benchmark_") and second.parent == stem.parent
+    second.with_suffix(".csv").write_text("")
+    third = new_output_stem(stem)
+    assert third not in (stem, second)
+    assert stem.with_suffix(".json").read_text() == "{}"
+
+
+def test_write_new_file_never_overwrites(tmp_path):
+    target = tmp_path / "a.log"
+    assert write_new_file(target, "first")
+    assert not write_new_file(target, "second")
+    assert target.read_text() == "first" and [p.name for p in tmp_path.iterdir()] == ["a.log"]
+
+
+def test_results_dirs_are_always_new(tmp_path):
+    a, b = make_results_dir(tmp_path, "x y"), make_results_dir(tmp_path, "x y")
+    assert a != b and a.is_dir() and b.is_dir() and a.name.endswith("_x_y")
+
+
+def test_values_are_formatted_as_ompl_log_text():
+    assert [format_value(v) for v in (None, True, 3, 0.5, float("nan"), float("inf"), "s")] == [
+        "", "1", "3", "0.5", "nan", "inf", "s"]

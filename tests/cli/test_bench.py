@@ -1,0 +1,60 @@
+"""``tpee-ompl bench`` / ``experiments/run_benchmark.py``: parsing, defaults from one source, clear errors."""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import sys
+
+import pytest
+
+from tpee_ompl.bench.config import ANYTIME_PLANNERS, CLI_PLANNER_NAMES, CampaignConfig
+from tpee_ompl.bench.planners import PLANNER_FACTORIES
+from tpee_ompl.cli.bench import build_parser, config_from_args, main, register, run
+
+
+def test_command_line_defaults_are_the_config_defaults():
+    cfg = config_from_args(build_parser().parse_args([]))
+    default = CampaignConfig()
+    assert dataclasses.replace(cfg, name=default.name) == default
+    assert cfg.name == "planning_necessary"  # the results folder is named after the query set
+
+
+def test_options_reach_the_config():
+    args = build_parser().parse_args(["--queries", "some/set.json", "--samples", "10", "20", "--anytime",
+                                      "--checkers", "discrete", "--alt-checker-samples", "10", "--workers", "0",
+                                      "--seed", "9", "--planners", "RRTstar", "RRTConnect"])
+    cfg = config_from_args(args)
+    assert cfg.name == "set" and cfg.sample_caps == (10, 20) and cfg.anytime_budgets == ()
+    assert cfg.checkers == ("discrete",) and cfg.alt_checker_caps == (10,)
+    assert cfg.workers == 0 and cfg.seed == 9 and cfg.iteration_planners == ("RRTstar", "RRTConnect")
+
+
+def test_register_adds_the_bench_subcommand_with_an_example(capsys):
+    parser = argparse.ArgumentParser(prog="tpee-ompl")
+    sub = parser.add_subparsers(dest="command", required=True)
+    register(sub, argparse.RawDescriptionHelpFormatter)
+    args = parser.parse_args(["bench", "--samples", "30", "--workers", "0"])
+    assert args.func is run and args.samples == [30] and args.workers == 0
+    with pytest.raises(SystemExit) as exc:
+        parser.parse_args(["bench", "--help"])
+    assert exc.value.code == 0
+    assert "example:" in capsys.readouterr().out
+
+
+def test_cli_planner_names_are_the_anytime_planners():
+    assert tuple(CLI_PLANNER_NAMES.values()) == ANYTIME_PLANNERS
+    assert set(CLI_PLANNER_NAMES.values()) <= set(PLANNER_FACTORIES)
+
+
+def test_missing_dask_gives_a_clear_error(monkeypatch, capsys, tmp_path):
+    monkeypatch.setitem(sys.modules, "distributed", None)  # import distributed -> ImportError
+    code = main(["--dask", "local", "--samples", "10", "--anytime", "--out", str(tmp_path), "--no-progress"])
+    err = capsys.readouterr().err
+    assert code == 2 and "pip install" in err and "dask" in err
+    assert not list(tmp_path.iterdir())  # nothing started
+
+
+def test_resume_of_a_folder_without_campaign_is_a_clear_error(capsys, tmp_path):
+    assert main(["--resume", str(tmp_path), "--workers", "0", "--no-progress"]) == 2
+    assert "campaign.json" in capsys.readouterr().err

@@ -1,0 +1,172 @@
+"""OMPL's recorded experiment data, patched before saving; and the Planner-Arena database built from logs.
+
+After ``Benchmark.benchmark()`` and before ``saveResultsToFile``, :func:`patch_recorded_data` writes
+each run's post-run record (``best_cost``, ``iterations``, ``samples``, ``collision_checks``,
+``length_dof12``, ``length_dof34``, ``path_valid_dense``, ``first_solution_time``, ...) into the
+runs, the wrapped planner's settings into the planner's common properties and the recorded progress
+into the progress data; :func:`pad_aborted_runs` adds a failed run for each run an aborted
+``benchmark()`` never finished.
+
+:func:`build_database` turns the ``.log`` files into one SQLite database with
+``ompl.tools.readBenchmarkLog``/``computeViews`` (what ``ompl_benchmark_statistics`` runs),
+skipping corrupt logs by name.
+"""
+
+from __future__ import annotations
+
+import builtins
+import contextlib
+import io
+import logging
+import os
+import sys
+from collections.abc import Callable, Sequence
+from pathlib import Path
+
+from ompl import base as ob
+from ompl import tools as ot
+
+from .config import PROGRESS_PROPERTIES
+from .planners import planner_settings
+from .results import format_value
+
+__all__ = ["build_database", "failed_run_properties", "pad_aborted_runs", "patch_recorded_data"]
+
+log = logging.getLogger(__name__)
+
+
+def failed_run_properties(error: str) -> dict:
+    """The extra run properties of a run that failed with ``error`` (a planner or callback exception)."""
+    return {"planner_error INTEGER": 1, "path_valid_dense INTEGER": 0, "reaches_goal INTEGER": 0,
+            "error_message TEXT": error[:200].replace("\n", " ").replace(";", ",")}
+
+
+def _planner_name(recorded_name: str) -> str:
+    """``geometric_RRTstar`` -> ``RRTstar`` (OMPL prefixes the planner's name in the recorded data)."""
+    return recorded_name.split("_", 1)[1] if "_" in recorded_name else recorded_name
+
+
+def pad_aborted_runs(bench, records: dict, run_count: int, error: str) -> None:
+    """After an aborted ``benchmark()``: add a failed run (status *crash*) for every run that never finished."""
+    crash = str(ob.PlannerStatus.CRASH.value)
+    for pl in bench.getRecordedExperimentData().planners:
+        recs = records.setdefault(_planner_name(pl.name), [])
+        runs = list(pl.runs)
+        del recs[len(runs):]  # a record whose run was not stored (the abort came after the post-run event)
+        while len(runs) < run_count:
+            run = ot.RunProperties()
+            for k, v in {"status ENUM": crash, "solved BOOLEAN": "0", "approximate solution BOOLEAN": "0",
+                         "correct solution BOOLEAN": "0", "time REAL": "0", "memory REAL": "0"}.items():
+                run[k] = v
+            runs.append(run)
+            recs.append({"props": failed_run_properties(error), "progress": []})
+        pl.runs = runs
+
+
+def patch_recorded_data(bench, wrappers: dict, records: dict, cap: int | None) -> None:
+    """Write the post-run records into the recorded experiment data (in place, before saving).
+
+    ``wrappers``: planner name -> its :class:`~tpee_ompl.bench.planners.RecordingPlanner`;
+    ``records``: planner name -> one ``{"props": {column: value}, "progress": [(t, cost, n)]}`` per run.
+    """
+    for pl in bench.getRecordedExperimentData().planners:
+        name = _planner_name(pl.name)
+        recs = records.get(name, [])
+        for run, rec in zip(pl.runs, recs):
+            for k, v in rec["props"].items():
+                run[k] = format_value(v)
+        for k, v in planner_settings(wrappers[name].inner).items():
+            pl.common[f"planner.{k}"] = v
+        pl.common["iteration_cap"] = str(cap) if cap is not None else "none"
+        pl.common["wrapper"] = "RecordingPlanner"
+        pl.progressPropertyNames = list(PROGRESS_PROPERTIES)
+        pl.runsProgressData = [
+            [
+                {"best cost REAL": format_value(c), "iterations INTEGER": format_value(n), "time REAL": format_value(t)}
+                for t, c, n in _dedupe_times(rec["progress"])
+            ]
+            for rec in recs
+        ]
+
+
+def _dedupe_times(progress: Sequence[tuple[float, float, int]]) -> list[tuple[float, float, int]]:
+    """Keep the last entry per printed time (the progress table's key is (runid, time))."""
+    out: dict[str, tuple[float, float, int]] = {}
+    for t, c, n in progress:
+        out[format_value(float(t))] = (float(t), float(c), None if n is None else int(n))
+    return sorted(out.values())
+
+
+def build_database(logs: Sequence[os.PathLike], db_path: os.PathLike) -> tuple[Path | None, list[Path]]:
+    """Build a Planner Arena SQLite database from OMPL ``.log`` files (ompl_benchmark_statistics).
+
+    Each log is first parsed on its own (into an in-memory database); a log that fails is reported
+    by name and skipped.  The database is written to ``<db>.part`` and renamed over ``db_path``
+    only when complete, so an interruption never leaves a half-written database.  Returns the
+    database (None when no log was readable) and the skipped logs.
+    """
+    db_path = Path(db_path)
+    good, bad = [], []
+    buf = io.StringIO()
+    with contextlib.redirect_stdout(buf), _eof_guard(ot.readBenchmarkLog):  # it prints a line per file and planner
+        for p in logs:
+            try:
+                if not Path(p).read_text().rstrip().endswith("\n."):  # every planner block ends with "."
+                    raise ValueError("truncated (no final '.')")
+                ot.readBenchmarkLog(":memory:", [str(p)], False)
+                good.append(Path(p))
+            except Exception as exc:  # noqa: BLE001 (any parse error: the file is corrupt)
+                log.error("skipping corrupt log %s: %r", Path(p).name, exc)
+                bad.append(Path(p))
+    if not good:
+        return None, bad
+    tmp = db_path.with_name(db_path.name + ".part")
+    tmp.unlink(missing_ok=True)
+    try:
+        with contextlib.redirect_stdout(buf):
+            ot.readBenchmarkLog(str(tmp), [str(p) for p in good], False)
+            ot.computeViews(str(tmp), False)
+        os.replace(tmp, db_path)
+    finally:
+        tmp.unlink(missing_ok=True)
+    return db_path, bad
+
+
+class _EofGuardedFile:
+    """A text file whose ``readline`` raises after many reads at end of file.
+
+    OMPL's ``readBenchmarkLog`` loops forever on some truncated logs (it keeps reading ``''``).
+    """
+
+    def __init__(self, f, limit: int = 1000) -> None:
+        self._f, self._limit, self._eof_reads = f, limit, 0
+
+    def readline(self, *args) -> str:
+        line = self._f.readline(*args)
+        if line == "":
+            self._eof_reads += 1
+            if self._eof_reads > self._limit:
+                raise ValueError(f"unexpected end of file in {self._f.name}")
+        return line
+
+    def __getattr__(self, name: str):
+        return getattr(self._f, name)
+
+    def __iter__(self):
+        return iter(self._f)
+
+
+@contextlib.contextmanager
+def _eof_guard(reader: Callable):
+    """Within the block, files opened by ``reader``'s module are :class:`_EofGuardedFile`."""
+    mod = sys.modules[reader.__module__]
+    had = "open" in vars(mod)
+    previous = vars(mod).get("open")
+    mod.open = lambda *a, **k: _EofGuardedFile(builtins.open(*a, **k))
+    try:
+        yield
+    finally:
+        if had:
+            mod.open = previous
+        else:
+            del mod.open

@@ -1,0 +1,217 @@
+"""The planners a campaign runs: factories by name, their settings, and :class:`RecordingPlanner`.
+
+A factory is ``(si, PlannerContext) -> ob.Planner``.  :data:`PLANNER_FACTORIES` holds the built-in
+ones (dimension-RRT and OMPL's planners with their default settings); a name ``module:function``
+is imported instead, so worker processes can build planners defined elsewhere (e.g. test stand-ins).
+
+Every planner runs inside :class:`RecordingPlanner`, which keeps the planner's *raw* output path
+(OMPL simplifies the solution in place before the benchmark's post-run event, so the event can only
+see the simplified path), caps native planners' iterations and records progress.
+
+This module imports OMPL; :mod:`tpee_ompl.bench.config` (the names) does not, so the command-line
+parser is built without it.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import importlib
+import logging
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from ompl import base as ob
+from ompl import geometric as og
+
+from ..planning.paths import path_to_array
+
+__all__ = [
+    "PLANNER_FACTORIES",
+    "PlannerContext",
+    "PlannerFactory",
+    "RecordingPlanner",
+    "planner_factory",
+    "planner_settings",
+]
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class PlannerContext:
+    """What a planner factory may use: the query (plain dict), the cap and a seed."""
+
+    query: dict
+    max_samples: int | None
+    seed: int
+
+
+PlannerFactory = Callable[[ob.SpaceInformation, PlannerContext], ob.Planner]
+
+
+def _native(cls_name: str) -> PlannerFactory:
+    def make(si, ctx: PlannerContext):
+        return getattr(og, cls_name)(si)  # OMPL's defaults, never changed
+
+    make.__name__ = f"make_{cls_name}"
+    return make
+
+
+def _dimension_rrt(si, ctx: PlannerContext):
+    from ..planning.tpee import tpee_dimension_rrt
+
+    q = ctx.query
+    return tpee_dimension_rrt(si, int(q["from_sector"]), int(q["to_sector"]), max_samples=ctx.max_samples, seed=ctx.seed)
+
+
+PLANNER_FACTORIES: dict[str, PlannerFactory] = {
+    "DimensionRRT": _dimension_rrt,
+    **{n: _native(n) for n in ("RRTstar", "InformedRRTstar", "RRTConnect", "AORRTC", "BITstar", "RRT", "PRMstar")},
+}
+"""Planner name -> factory ``(si, PlannerContext) -> ob.Planner``.  A name ``module:function`` is
+imported instead (so worker processes can build planners defined elsewhere, e.g. test stand-ins)."""
+
+
+def planner_factory(name: str) -> PlannerFactory:
+    """The factory of a planner name of :data:`PLANNER_FACTORIES`, or of a ``module:function`` name."""
+    if name in PLANNER_FACTORIES:
+        return PLANNER_FACTORIES[name]
+    if ":" in name:
+        mod, _, attr = name.partition(":")
+        return getattr(importlib.import_module(mod), attr)
+    raise ValueError(f"unknown planner {name!r}: choose from {sorted(PLANNER_FACTORIES)} or give module:function")
+
+
+def _parse_settings(text: str) -> dict[str, str]:
+    out = {}
+    for line in text.splitlines():
+        k, sep, v = line.partition(" = ")
+        if sep and k.strip() and " " not in k.strip():
+            out[k.strip()] = v.strip()
+    return out
+
+
+def planner_settings(p) -> dict[str, str]:
+    """A planner's settings as text: its ``settings()`` (Python planners) or parsed ``printSettings()``."""
+    if hasattr(p, "settings"):
+        return {str(k): str(v) for k, v in p.settings().items()}
+    try:
+        return _parse_settings(p.printSettings())
+    except Exception:  # noqa: BLE001 (bindings differ per planner)
+        return {}
+
+
+class RecordingPlanner(ob.Planner):
+    """Runs an inner planner, caps its iterations, keeps its raw path and records progress.
+
+    Parameters
+    ----------
+    si : ob.SpaceInformation
+    inner : ob.Planner
+        Native OMPL planner or Python planner (``last_run_stats()`` is used when present).
+    max_iterations : int or None
+        Stop after this many ``inner.numIterations()`` (native planners only; Python planners
+        get their cap through their factory).
+    progress_period : float, seconds
+        Progress sampling period for native planners exposing ``bestCost``/``numIterations``.
+
+    After each ``solve``, :attr:`last` holds the run's record: ``waypoints`` (raw path, (K, 4), or
+    None), ``iterations``, ``samples``, ``best_cost``, ``first_solution_time``, ``progress``
+    (list of (time, best cost, iterations)) and ``error`` (None, or the exception's repr).
+    Exceptions never escape to OMPL (they would abort the whole benchmark): a failing ``solve``
+    returns status *crash*.
+    """
+
+    def __init__(self, si, inner, max_iterations: int | None = None, progress_period: float = 0.05) -> None:
+        super().__init__(si, inner.getName())
+        self.inner = inner
+        self.max_iterations = max_iterations
+        self.progress_period = float(progress_period)
+        self._native_stats = hasattr(inner, "numIterations") and not hasattr(inner, "last_run_stats")
+        if max_iterations is not None and not hasattr(inner, "last_run_stats") and not hasattr(inner, "numIterations"):
+            raise ValueError(f"{inner.getName()} has no numIterations(): it cannot be iteration-capped")
+        self._setup_error: str | None = None
+        self.last: dict = {}
+
+    def setup(self) -> None:  # noqa: D102 (OMPL override)
+        super().setup()
+        self._setup_error = None
+        try:  # an exception escaping to C++ would abort the whole benchmark
+            self.inner.setProblemDefinition(self.getProblemDefinition())
+            self.inner.setup()
+        except Exception as exc:  # noqa: BLE001
+            log.exception("planner %s: setup failed", self.inner.getName())
+            self._setup_error = repr(exc)
+
+    def clear(self) -> None:  # noqa: D102 (OMPL override)
+        super().clear()
+        try:
+            self.inner.clear()
+        except Exception:  # noqa: BLE001
+            log.exception("planner %s: clear failed", self.inner.getName())
+
+    def solve(self, ptc):  # noqa: D102 (OMPL override)
+        inner, cap = self.inner, self.max_iterations
+        t0 = time.perf_counter()
+        progress: list[tuple[float, float, int]] = []
+        state = {"next": 0.0}
+        has_cost = hasattr(inner, "bestCost")
+
+        def stop() -> bool:
+            it = inner.numIterations()
+            now = time.perf_counter() - t0
+            if has_cost and now >= state["next"]:
+                progress.append((now, inner.bestCost().value(), it))
+                state["next"] = now + self.progress_period
+            return cap is not None and it >= cap
+
+        error = self._setup_error
+        try:
+            if error is not None:
+                raise RuntimeError(f"setup failed: {error}")
+            if self._native_stats:
+                cond = ob.plannerOrTerminationCondition(ptc, ob.PlannerTerminationCondition(stop))
+                status = inner.solve(cond)
+            else:
+                status = inner.solve(ptc)
+        except Exception as exc:  # noqa: BLE001 (an exception would abort the whole benchmark)
+            log.exception("planner %s failed", inner.getName())
+            error = repr(exc)
+            status = ob.PlannerStatus(ob.PlannerStatus.CRASH)
+        elapsed = time.perf_counter() - t0
+        pdef = self.getProblemDefinition()
+        waypoints = None
+        if error is None and pdef.hasSolution():
+            waypoints = path_to_array(pdef.getSolutionPath(), 4)
+        self.last = {"waypoints": waypoints, "error": error, **self._run_stats(elapsed, progress, has_cost)}
+        return status
+
+    def _run_stats(self, elapsed: float, progress: list, has_cost: bool) -> dict:
+        """Iterations, samples, best cost, first-solution time and progress of the run that just ended."""
+        inner = self.inner
+        if hasattr(inner, "last_run_stats"):
+            stats: dict = {}
+            with contextlib.suppress(Exception):
+                stats = dict(inner.last_run_stats() or {})
+            iterations = stats.get("iterations")
+            return {
+                "iterations": iterations,
+                "samples": stats.get("samples", iterations),
+                "best_cost": stats.get("best_cost"),
+                "first_solution_time": stats.get("first_solution_time"),
+                "progress": [(float(t), float(c), int(n)) for t, c, n in stats.get("progress", [])],
+            }
+        iterations = inner.numIterations() if hasattr(inner, "numIterations") else None
+        best = inner.bestCost().value() if has_cost else None
+        if has_cost:
+            progress.append((elapsed, best, iterations))
+        finite = [t for t, c, _ in progress if math.isfinite(c)]
+        return {
+            "iterations": iterations,
+            "samples": iterations,
+            "best_cost": best,
+            "first_solution_time": finite[0] if finite else None,
+            "progress": progress,
+        }

@@ -1,0 +1,129 @@
+"""Result files that never overwrite anything: new folders, new names, atomic writes; and what goes in them.
+
+* :func:`make_results_dir`: a new ``<out>/<UTC timestamp>_<name>/`` campaign folder.
+* :func:`new_output_stem`: a free file stem for scripts writing ``<stem>.csv`` / ``<stem>.json``.
+* :func:`write_new_file`: atomic, never over an existing file (concurrent writers race safely).
+* :func:`write_json`: atomic replace (a campaign's own ``campaign.json``).
+* :func:`package_versions`, :func:`format_value`: what the logs and metadata record, as text.
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import json
+import math
+import os
+import platform
+import time
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+
+__all__ = [
+    "format_value",
+    "make_results_dir",
+    "new_output_stem",
+    "package_versions",
+    "utc_now",
+    "write_json",
+    "write_new_file",
+]
+
+
+def utc_now() -> str:
+    """The current UTC time, ISO 8601."""
+    return _dt.datetime.now(_dt.timezone.utc).isoformat()
+
+
+def _utc_stamp() -> str:
+    return _dt.datetime.now(_dt.timezone.utc).strftime("%Y%m%dT%H%M%SZ")
+
+
+def make_results_dir(out: str | os.PathLike, name: str) -> Path:
+    """A new ``<out>/<UTC timestamp>_<name>/`` folder; never an existing one."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    stamp = _utc_stamp()
+    safe = "".join(c if c.isalnum() or c in "-_." else "_" for c in name)
+    for k in range(1000):
+        d = out / (f"{stamp}_{safe}" if k == 0 else f"{stamp}_{safe}_{k}")
+        try:
+            d.mkdir()
+            return d
+        except FileExistsError:
+            continue
+    raise RuntimeError(f"could not create a new results folder under {out}")
+
+
+def new_output_stem(stem: str | os.PathLike, suffixes: Sequence[str] = (".csv", ".json")) -> Path:
+    """``stem`` if none of ``stem + suffix`` exists, else ``<stem>_<UTC timestamp>[_k]``: results are never overwritten."""
+    stem = Path(stem)
+    stem.parent.mkdir(parents=True, exist_ok=True)
+    if not any(stem.with_name(stem.name + s).exists() for s in suffixes):
+        return stem
+    stamp = _utc_stamp()
+    for k in range(1000):
+        cand = stem.with_name(f"{stem.name}_{stamp}" if k == 0 else f"{stem.name}_{stamp}_{k}")
+        if not any(cand.with_name(cand.name + s).exists() for s in suffixes):
+            return cand
+    raise RuntimeError(f"no free output name for {stem}")
+
+
+def write_new_file(target: Path, text: str) -> bool:
+    """Write ``text`` to ``target`` atomically and never over an existing file.
+
+    The text goes to a unique ``.part`` file first, then is hard-linked to ``target`` (which fails
+    if ``target`` exists, even when two processes race).  Returns False when ``target`` existed.
+    """
+    target = Path(target)
+    tmp = target.with_name(f"{target.name}.{os.getpid()}.{time.monotonic_ns()}.part")
+    with open(tmp, "w") as f:
+        f.write(text)
+        f.flush()
+        os.fsync(f.fileno())
+    try:
+        os.link(tmp, target)
+        return True
+    except FileExistsError:
+        return False
+    finally:
+        tmp.unlink()
+
+
+def write_json(path: Path, data: dict) -> None:
+    """Write ``data`` as indented JSON, replacing ``path`` atomically (through ``<path>.part``)."""
+    tmp = path.with_name(path.name + ".part")
+    tmp.write_text(json.dumps(data, indent=2))
+    os.replace(tmp, path)
+
+
+def package_versions() -> dict[str, str]:
+    """Versions of Python and the packages the results depend on."""
+    from importlib import metadata
+
+    out = {"python": platform.python_version(), "platform": platform.platform()}
+    for dist in ("tpee_ompl", "ompl", "pin", "coal", "numpy", "matplotlib"):
+        try:
+            out[dist] = metadata.version(dist)
+        except metadata.PackageNotFoundError:
+            out[dist] = "not installed"
+    return out
+
+
+def format_value(v) -> str:
+    """A value as OMPL log text: '' for None, 0/1 for booleans, ``repr`` for floats, 'nan'/'inf'."""
+    if v is None:
+        return ""
+    if isinstance(v, str):
+        return v
+    if isinstance(v, (bool, np.bool_)):
+        return str(int(v))
+    if isinstance(v, (int, np.integer)):
+        return str(int(v))
+    v = float(v)
+    if math.isnan(v):
+        return "nan"
+    if math.isinf(v):
+        return "inf"
+    return repr(v)
