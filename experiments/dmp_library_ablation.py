@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from tpee_ompl.bench.campaign import new_output_stem
+from tpee_ompl.bench.results import new_output_stem
 from tpee_ompl.library.dmp import DMPOptions
 from tpee_ompl.library.path_library import DEMO_MARGINS, PathLibrary
 from tpee_ompl.planning.paths import motion_is_valid, path_length

@@ -34,7 +34,7 @@ from pathlib import Path
 
 import numpy as np
 
-from tpee_ompl.bench.campaign import new_output_stem
+from tpee_ompl.bench.results import new_output_stem
 from tpee_ompl.library.path_library import PathLibrary, benchmark_queries, dimension_rrt_planner
 from tpee_ompl.planning.paths import path_length
 

@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 from ompl import util as ou
 
-from tpee_ompl.bench.campaign import new_output_stem
+from tpee_ompl.bench.results import new_output_stem
 from tpee_ompl.planning.tpee import tpee_dimension_rrt
 from tpee_ompl.planning.setup import make_simple_setup
 from tpee_ompl.library.path_library import N_FAKE_TIME_STEPS, PathLibrary

@@ -25,8 +25,6 @@ __all__ = [
 
 ITERATION_PLANNERS = ("DimensionRRT", "RRTstar")
 """Planners of the iteration-matched (Table 4) comparison: dimension-RRT first, the reference second."""
-ANYTIME_PLANNERS = ("DimensionRRT", "RRTstar", "InformedRRTstar", "RRTConnect", "AORRTC", "BITstar")
-"""Planners of the time-matched comparison."""
 CLI_PLANNER_NAMES: dict[str, str] = {
     "dimension-rrt": "DimensionRRT",
     "rrtstar": "RRTstar",
@@ -37,6 +35,8 @@ CLI_PLANNER_NAMES: dict[str, str] = {
 }
 """``tpee-ompl plan --planner`` name -> benchmark planner name (= OMPL class name; dimension-RRT is ours).
 The planners of :data:`ANYTIME_PLANNERS`, in the same order."""
+ANYTIME_PLANNERS: tuple[str, ...] = tuple(CLI_PLANNER_NAMES.values())
+"""Planners of the time-matched comparison (every planner the command line knows)."""
 CHECKERS = ("batched", "discrete")
 """Motion validators: one batched Pinocchio call per motion, or OMPL's DiscreteMotionValidator."""
 PROGRESS_PROPERTIES = ["best cost REAL", "iterations INTEGER", "time REAL"]  # sorted, as OMPL's map

@@ -15,34 +15,12 @@ import sys
 from collections.abc import Sequence
 
 from ._common import CliError
+from .bench import register as register_bench
 from .library import register as register_library
 from .pictures import register as register_pictures
 from .plan import register as register_plan
 
 __all__ = ["get_argument_parser", "main"]
-
-
-# ---------------------------------------------------------------------------------------- bench (until merge)
-# Stand-in for ``from .bench import register as register_bench`` (tpee_ompl/cli/bench.py, written on
-# another branch).  When that module is merged, delete this block and import its ``register`` instead.
-def register_bench(sub: argparse._SubParsersAction, fmt: type) -> None:
-    from ..bench.campaign import build_parser
-
-    template = build_parser("tpee-ompl bench")
-    p = sub.add_parser("bench", help="head-to-head benchmark campaign (OMPL Benchmark, SQLite, Table 4)",
-                       formatter_class=fmt, description=(template.description or "") +
-                       "\n\nexample:\n  tpee-ompl bench --max-queries 24 --samples 500 2500 --anytime 0.1 0.5 --workers 2",
-                       parents=[template], add_help=False, conflict_handler="resolve")
-    p.set_defaults(func=_cmd_bench)
-
-
-def _cmd_bench(args: argparse.Namespace) -> int:
-    """Run a benchmark campaign (delegates to :mod:`tpee_ompl.bench.campaign`)."""
-    from ..bench import campaign as benchmark
-
-    argv = args._argv
-    return int(benchmark.main(argv[argv.index("bench") + 1 :]) or 0)
-# ---------------------------------------------------------------------------------------- end of bench block
 
 
 def get_argument_parser() -> argparse.ArgumentParser:
@@ -60,7 +38,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``tpee-ompl``; returns the exit code."""
     parser = get_argument_parser()
     args = parser.parse_args(argv)
-    args._argv = list(sys.argv[1:] if argv is None else argv)
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
                         format="%(levelname)s %(name)s: %(message)s")
     try:

@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..bench.config import CLI_PLANNER_NAMES
 from ..library.path_library import dimension_rrt_planner
 from ..model.pointing import aim
 from ..resources import default_library_path
@@ -18,14 +19,7 @@ if TYPE_CHECKING:
 
 __all__ = ["PLANNERS", "add_plan_args", "cmd_aim", "cmd_plan", "cmd_track", "plan_motion", "register"]
 
-PLANNERS = {
-    "dimension-rrt": "DimensionRRT",
-    "rrtstar": "RRTstar",
-    "informedrrtstar": "InformedRRTstar",
-    "rrtconnect": "RRTConnect",
-    "aorrtc": "AORRTC",
-    "bitstar": "BITstar",
-}
+PLANNERS = CLI_PLANNER_NAMES
 """``--planner`` choices: CLI name -> planner class name (``ompl.geometric.<name>``; DimensionRRT is this package's)."""
 
 
