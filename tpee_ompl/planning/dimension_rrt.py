@@ -32,7 +32,10 @@ checker's batched ``are_valid(Q)`` when it has one (two calls per sample at most
 every 8th interior motion state, then the remaining interior states of the survivors); otherwise
 per-state ``si.isValid`` and per-motion ``si.checkMotion``.  Motion states are those OMPL's
 discrete motion validator checks.  An exact solution is reported only after every segment of the
-final path passed ``si.checkMotion``.
+final path passed ``si.checkMotion`` (:func:`~tpee_ompl.planning.paths.path_passes_motion_checks`).
+
+This module holds the settings (:class:`DimensionRRTOptions`) and the OMPL planner; the search
+itself (checker, iteration, layered trees) is :mod:`tpee_ompl.planning.dimension_search`.
 """
 
 from __future__ import annotations
