@@ -66,7 +66,8 @@ def make_planar_arm_setup(
     """SimpleSetup over ``RealVectorStateSpace(4)`` in [-pi, pi]^4 with path-length objective.
 
     The default query sweeps the stretched arm from 0.3 rad to 2.6 rad past an obstacle above the
-    base, so the arm must fold to pass.
+    base, so the arm must fold to pass.  ``ss.getStateValidityChecker()`` returns the
+    :class:`PlanarArm` checker itself (its ``are_valid``, ``points`` and ``collision_checks``).
     """
     space = ob.RealVectorStateSpace(4)
     space.setBounds(-np.pi, np.pi)

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..planning.grouped_space import interpolate_waypoints
-from ..planning.paths import motion_states
+from ..planning.paths import motion_is_valid
 from ..model.wearer_arm import WearerArm
 from ..model.sectors import cross_sector_trajectory, posture_preset
 
@@ -30,10 +30,7 @@ def straight_motion_waypoints(i: int, j: int, start: np.ndarray, goal: np.ndarra
 
 def straight_motion_valid(robot: WearerArm, i: int, j: int, start: np.ndarray, goal: np.ndarray) -> bool:
     """True if the un-planned motion (Table 3 + linear DOF3/DOF4) is collision-free at the guarantee step."""
-    W = straight_motion_waypoints(i, j, start, goal)
-    step = robot.max_joint_step()
-    Q = np.concatenate([W[:1]] + [motion_states(a, b, step) for a, b in zip(W[:-1], W[1:])])
-    return bool(robot.are_valid(Q).all())
+    return motion_is_valid(robot, straight_motion_waypoints(i, j, start, goal), robot.max_joint_step())
 
 
 def cross_sector_query(

@@ -32,7 +32,10 @@ checker's batched ``are_valid(Q)`` when it has one (two calls per sample at most
 every 8th interior motion state, then the remaining interior states of the survivors); otherwise
 per-state ``si.isValid`` and per-motion ``si.checkMotion``.  Motion states are those OMPL's
 discrete motion validator checks.  An exact solution is reported only after every segment of the
-final path passed ``si.checkMotion``.
+final path passed ``si.checkMotion`` (:func:`~tpee_ompl.planning.paths.path_passes_motion_checks`).
+
+This module holds the settings (:class:`DimensionRRTOptions`) and the OMPL planner; the search
+itself (checker, iteration, layered trees) is :mod:`tpee_ompl.planning.dimension_search`.
 """
 
 from __future__ import annotations
@@ -49,402 +52,20 @@ import numpy as np
 from ompl import base as ob
 
 from ..validation import check_bool, check_int, check_name, check_number
-from .grouped_space import GroupedSpace, RealVectorLayout
+from .dimension_search import Checker, Search
+from .grouped_space import GroupedSpace
+from .paths import path_passes_motion_checks
 
 __all__ = ["DimensionRRT", "DimensionRRTOptions"]
 
 log = logging.getLogger(__name__)
 
-_COARSE_STRIDE = 8
-"""First pass over a motion checks every 8th interior state (collisions span many states)."""
-_UNIFORM_FRACTION = 0.1
-"""Share of samples drawn uniformly over the bounds once the sampling region has narrowed."""
-_NARROWING_UNIT = 100
-"""The narrowing factor applies per this many samples."""
-_GROUP_BLOCK = 100
-"""With several planned groups, each gets this many consecutive samples in turn."""
-_REPAIR_FRACTION = 0.5
-"""Share of repair samples while no valid path exists."""
-_REPAIR_SIGMA = (0.01, 0.1)
-"""Repair samples: Gaussian around a waypoint, sigma log-uniform in this range times the bound widths."""
 _PROGRESS_PERIOD = 0.01
 """Seconds between progress-trace entries (OMPL's benchmark records progress about as often)."""
 
 
 def _status(code: Any) -> ob.PlannerStatus:
     return ob.PlannerStatus(code)
-
-
-class _Checker:
-    """Validity of states and motions for one SpaceInformation, batched when the setup allows it."""
-
-    def __init__(self, si: ob.SpaceInformation, layout: RealVectorLayout, batch: bool) -> None:
-        self.si = si
-        self.layout = layout
-        svc = si.getStateValidityChecker()
-        mv = si.getMotionValidator()
-        are_valid = getattr(svc, "are_valid", None)
-        self.step: float | None = None
-        self.euclid = True
-        if batch and callable(are_valid):
-            factor = max(1, int(si.getStateSpace().getValidSegmentCountFactor()))
-            if isinstance(getattr(mv, "step", None), float) and callable(getattr(mv, "check_motions", None)):
-                # BatchedMotionValidator: Euclidean, ceil(|b-a| / step) segments (step / factor)
-                self.step = float(mv.effective_step()) if callable(getattr(mv, "effective_step", None)) else mv.step
-            elif type(mv) is ob.MotionValidator:  # the C++ default, DiscreteMotionValidator
-                self.step = float(si.getStateSpace().getLongestValidSegmentLength()) / factor
-                self.euclid = layout.is_plain
-        self.batched = self.step is not None
-        self._are_valid = are_valid if self.batched else None
-        counter_owner = getattr(svc, "robot", svc)
-        self._counter_owner = counter_owner if isinstance(getattr(counter_owner, "collision_checks", None), int) else None
-        self.own_checks = 0
-        self._longest = float(si.getStateSpace().getLongestValidSegmentLength())
-        self._s1, self._s2 = si.allocState(), si.allocState()
-
-    def counter(self) -> int:
-        """Configurations checked so far (the robot's counter when available, else our own count)."""
-        return self._counter_owner.collision_checks if self._counter_owner is not None else self.own_checks
-
-    def states(self, Q: np.ndarray) -> np.ndarray:
-        """Validity of configurations Q (m, n)."""
-        if len(Q) == 0:
-            return np.zeros(0, dtype=bool)
-        self.own_checks += len(Q)
-        if self._are_valid is not None:
-            return np.asarray(self._are_valid(Q), dtype=bool)
-        s = self._s1
-        out = np.empty(len(Q), dtype=bool)
-        for k, q in enumerate(Q):
-            self.layout.write(s, q)
-            out[k] = self.si.isValid(s)
-        return out
-
-    def interior(self, A: np.ndarray, B: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Interior states of motions A[k] -> B[k]: (states (M, n), motion index (M,), step index j >= 1)."""
-        d = np.sqrt(((B - A) ** 2).sum(-1)) if self.euclid else self.layout.distance(A, B)
-        nd = np.maximum(1, np.ceil(d / self.step)).astype(int)
-        cnt = nd - 1
-        total = int(cnt.sum())
-        idx = np.repeat(np.arange(len(A)), cnt)
-        j = np.arange(total) - np.repeat(np.cumsum(cnt) - cnt, cnt) + 1
-        frac = j / nd[idx]
-        return A[idx] + frac[:, None] * (B[idx] - A[idx]), idx, j
-
-    def motions(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
-        """Validity of the interiors of motions A[k] -> B[k] (ends not checked), one call when batched."""
-        K = len(A)
-        if K == 0:
-            return np.zeros(0, dtype=bool)
-        if self.batched:
-            S, idx, _ = self.interior(A, B)
-            ok = self.states(S)
-            return np.bincount(idx[~ok], minlength=K) == 0
-        out = np.empty(K, dtype=bool)
-        for k in range(K):
-            out[k] = self._check_motion(A[k], B[k])
-        return out
-
-    def _check_motion(self, a: np.ndarray, b: np.ndarray) -> bool:
-        self.layout.write(self._s1, a)
-        self.layout.write(self._s2, b)
-        self.own_checks += max(1, math.ceil(float(self.layout.distance(a, b)) / self._longest))
-        return bool(self.si.checkMotion(self._s1, self._s2))
-
-    def candidates(
-        self, C: np.ndarray, A: np.ndarray, B: np.ndarray, left_known: np.ndarray, right_known: np.ndarray, strict: np.ndarray
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Evaluate candidate waypoints C (m, n) between neighbours A and B (m, n).
-
-        ``left_known[k]`` / ``right_known[k]`` false means that neighbour is invalid, so that motion is
-        invalid without a check.  For ``strict[k]`` candidates only all-valid matters, so the second
-        motion is not finished once one fails.  Returns validity of C, of A->C and of C->B (ends incl.).
-        """
-        m = len(C)
-        vc = self.states(C) if not self.batched else None
-        if self.batched:
-            # pass 1: candidate states + every 8th interior state of motions whose other end is valid
-            SL, iL, jL = self.interior(A, C)
-            SR, iR, jR = self.interior(C, B)
-            cL, cR = (jL % _COARSE_STRIDE == 0) & left_known[iL], (jR % _COARSE_STRIDE == 0) & right_known[iR]
-            ok = self.states(np.concatenate([C, SL[cL], SR[cR]]))
-            vc = ok[:m]
-            nl = int(cL.sum())
-            badL = np.bincount(iL[cL][~ok[m : m + nl]], minlength=m) > 0
-            badR = np.bincount(iR[cR][~ok[m + nl :]], minlength=m) > 0
-            goL = vc & left_known & ~badL
-            goR = vc & right_known & ~badR
-            both = goL & goR
-            goL &= both | ~strict
-            goR &= both | ~strict
-            # pass 2: the remaining interior states of motions still in question
-            fL, fR = ~cL & goL[iL], ~cR & goR[iR]
-            ok2 = self.states(np.concatenate([SL[fL], SR[fR]]))
-            nl2 = int(fL.sum())
-            left = goL & (np.bincount(iL[fL][~ok2[:nl2]], minlength=m) == 0)
-            right = goR & (np.bincount(iR[fR][~ok2[nl2:]], minlength=m) == 0)
-            return vc, left, right
-        left = np.zeros(m, dtype=bool)
-        right = np.zeros(m, dtype=bool)
-        for k in range(m):
-            if not vc[k]:
-                continue
-            if left_known[k]:
-                left[k] = self._check_motion(A[k], C[k])
-            if right_known[k] and (left[k] or not strict[k]):
-                right[k] = self._check_motion(C[k], B[k])
-        return vc, left, right
-
-
-class _Search:
-    """The dimension-RRT iteration on a waypoint array; OMPL-free apart from the checker."""
-
-    def __init__(
-        self,
-        grouped: GroupedSpace,
-        checker: _Checker,
-        rng: np.random.Generator,
-        start: np.ndarray,
-        goal: np.ndarray,
-        narrow_after: int,
-        narrowing: float,
-        range_: np.ndarray,
-        initial: np.ndarray | None = None,
-    ) -> None:
-        self.g = grouped
-        self.checker = checker
-        self.rng = rng
-        self.narrow_after = narrow_after
-        self.narrowing = narrowing
-        self.range_ = range_
-        self.dist = grouped.layout.distance
-        W = grouped.initial_waypoints(start, goal)
-        if initial is not None:
-            for gi in grouped.planned:
-                d = grouped.group_dims(gi)
-                W[1:-1, d] = initial[1:-1, d]
-        self.W = W
-        V = np.ones(len(W), dtype=bool)
-        V[1:-1] = checker.states(W[1:-1])
-        self.V = V
-        self.E = V[:-1] & V[1:]
-        self.E[self.E] = checker.motions(W[:-1][self.E], W[1:][self.E])
-        self.L = self.dist(W[:-1], W[1:])
-        self.samples = 0
-        self.group_samples = {gi: 0 for gi in grouped.planned}
-        self.narrow_start: dict[int, int | None] = {gi: None for gi in grouped.planned}
-        self._dims = {gi: grouped.group_dims(gi) for gi in grouped.planned}
-        self._bounds = {gi: grouped.group_bounds(gi) for gi in grouped.planned}
-        self._tree: _LayeredTrees | None = None
-        self._uniform = np.empty((0, 0))
-        self._normal = np.empty((0, 0))
-        self._ui = 0
-
-    @property
-    def valid(self) -> bool:
-        return bool(self.V.all() and self.E.all())
-
-    @property
-    def cost(self) -> float:
-        return float(self.L.sum())
-
-    def _next_random(self, k: int) -> tuple[np.ndarray, np.ndarray]:
-        """Buffered randomness for one sample: 3 + k uniforms and k standard normals."""
-        if self._ui >= len(self._uniform) or self._uniform.shape[1] != k + 3:
-            self._uniform = self.rng.random((1024, k + 3))
-            self._normal = self.rng.standard_normal((1024, k))
-            self._ui = 0
-        i = self._ui
-        self._ui += 1
-        return self._uniform[i], self._normal[i]
-
-    def current_group(self) -> int:
-        planned = self.g.planned
-        return planned[(self.samples // _GROUP_BLOCK) % len(planned)]
-
-    def draw(self, gi: int) -> np.ndarray:
-        """One k_i-dimensional sample for group gi: repair, narrowed or uniform (module docstring)."""
-        d = self._dims[gi]
-        lo, hi = self._bounds[gi]
-        u, z = self._next_random(len(d))
-        span = hi - lo
-        valid = self.valid
-        if not valid and u[0] < _REPAIR_FRACTION and self._tree is not None:
-            anchor = self._tree.anchor(u[1])
-            sigma = span * _REPAIR_SIGMA[0] * (_REPAIR_SIGMA[1] / _REPAIR_SIGMA[0]) ** u[2]
-            return np.clip(anchor + sigma * z, lo, hi)
-        n0 = self.narrow_start[gi]
-        if n0 is None and valid and self.group_samples[gi] >= self.narrow_after:
-            n0 = self.narrow_start[gi] = self.group_samples[gi]
-        if n0 is not None and u[0] >= _UNIFORM_FRACTION:
-            m = self.group_samples[gi] - n0
-            pad = np.maximum(self.range_[gi], span * self.narrowing ** (m / _NARROWING_UNIT))
-            vals = self.W[:, d]
-            lo = np.maximum(lo, vals.min(axis=0) - pad)
-            hi = np.minimum(hi, vals.max(axis=0) + pad)
-        return lo + u[3:] * (hi - lo)
-
-    def iterate(self) -> int:
-        """Draw one sample for the current group and try it at every intermediate step.
-
-        Returns the number of waypoints changed (feasibility phase: 1 when the layered trees
-        connected, 0 otherwise).
-        """
-        gi = self.current_group()
-        valid = self.valid
-        if not valid and (self._tree is None or self._tree.group != gi):
-            self._tree = _LayeredTrees(self, gi)
-        c = self.draw(gi)
-        self.samples += 1
-        self.group_samples[gi] += 1
-        return self._improve(gi, c) if valid else self._grow(c)
-
-    def _grow(self, c: np.ndarray) -> int:
-        """Feasibility phase: extend the forward/backward layered trees with the sample c."""
-        tree = self._tree
-        d = tree.dims
-        h = self.g.h
-        ts, fi, bi = [], [], []
-        for t in range(1, h - 1):
-            f = tree.fwd[t - 1].nearest(c)
-            b = tree.bwd[t + 1].nearest(c)
-            if f >= 0 or b >= 0:
-                ts.append(t)
-                fi.append(f)
-                bi.append(b)
-        if not ts:
-            return 0
-        ts_a = np.array(ts)
-        C = self.W[ts_a].copy()
-        C[:, d] = c
-        A = self.W[ts_a - 1].copy()
-        B = self.W[ts_a + 1].copy()
-        for k, t in enumerate(ts):
-            if fi[k] >= 0:
-                A[k, d] = tree.fwd[t - 1].values[fi[k]]
-            if bi[k] >= 0:
-                B[k, d] = tree.bwd[t + 1].values[bi[k]]
-        has_f, has_b = np.array(fi) >= 0, np.array(bi) >= 0
-        vc, left, right = self.checker.candidates(C, A, B, has_f, has_b, np.zeros(len(ts), dtype=bool))
-        for k, t in enumerate(ts):
-            if not vc[k]:
-                continue
-            if left[k] and right[k]:
-                self._adopt(tree.path(t, c, fi[k], bi[k]))
-                self._tree = None
-                return 1
-            if left[k]:
-                tree.fwd[t].add(c, fi[k])
-            if right[k]:
-                tree.bwd[t].add(c, bi[k])
-        return 0
-
-    def _adopt(self, W: np.ndarray) -> None:
-        """Take W (h, n), checked by the trees, as the current (valid) path."""
-        self.W[:] = W
-        self.V[:] = True
-        self.E[:] = True
-        self.L[:] = self.dist(W[:-1], W[1:])
-
-    def _improve(self, gi: int, c: np.ndarray) -> int:
-        """Paper's rule on a valid path: replace W[t] when valid, connected and shorter."""
-        d = self._dims[gi]
-        W, V, E, L = self.W, self.V, self.E, self.L
-        C = W[1:-1].copy()
-        C[:, d] = c
-        A, B = W[:-2], W[2:]
-        dl, dr = self.dist(A, C), self.dist(C, B)
-        shorter = dl + dr < L[:-1] + L[1:] - 1e-12
-        if not shorter.any():
-            return 0
-        ts = np.flatnonzero(shorter)
-        yes = np.ones(len(ts), dtype=bool)
-        vc, left, right = self.checker.candidates(C[ts], A[ts], B[ts], yes, yes, yes)
-        ok = vc & left & right
-        accepted = 0
-        last = -2
-        for k in np.flatnonzero(ok):
-            t = int(ts[k]) + 1
-            if t == last + 1:
-                continue
-            W[t] = C[t - 1]
-            L[t - 1], L[t] = dl[t - 1], dr[t - 1]
-            accepted += 1
-            last = t
-        return accepted
-
-
-class _Layer:
-    """Nodes of one fake-time layer of a layered tree: group values and parent indices."""
-
-    def __init__(self, k: int) -> None:
-        self.values = np.empty((16, k))
-        self.parents: list[int] = []
-
-    def __len__(self) -> int:
-        return len(self.parents)
-
-    def add(self, x: np.ndarray, parent: int) -> None:
-        n = len(self.parents)
-        if n == len(self.values):
-            self.values = np.concatenate([self.values, np.empty_like(self.values)])
-        self.values[n] = x
-        self.parents.append(parent)
-
-    def nearest(self, x: np.ndarray) -> int:
-        """Index of the node closest to x (group values, Euclidean), -1 if empty."""
-        n = len(self.parents)
-        if n == 0:
-            return -1
-        D = self.values[:n] - x
-        return int(np.argmin(np.einsum("ij,ij->i", D, D)))
-
-
-class _LayeredTrees:
-    """Feasibility phase: a forward tree from the start and a backward tree from the goal whose
-    depth-t nodes are waypoints of fake-time step t (only the current group varies; the other DOFs
-    are those of the current path at that step).  Every node is valid and connected to its parent
-    by a valid motion, so there is no deadlock between neighbouring invalid waypoints.  Seeded with
-    the valid prefix and suffix of the current path."""
-
-    def __init__(self, search: _Search, gi: int) -> None:
-        self.group = gi
-        self.dims = d = search._dims[gi]
-        self.base = search.W.copy()
-        h = len(self.base)
-        self.fwd = [_Layer(len(d)) for _ in range(h)]
-        self.bwd = [_Layer(len(d)) for _ in range(h)]
-        V, E, W = search.V, search.E, search.W
-        self.fwd[0].add(W[0, d], -1)
-        t = 1
-        while t < h - 1 and V[t] and E[t - 1]:
-            self.fwd[t].add(W[t, d], 0)
-            t += 1
-        self.bwd[h - 1].add(W[h - 1, d], -1)
-        t = h - 2
-        while t > 0 and V[t] and E[t]:
-            self.bwd[t].add(W[t, d], 0)
-            t -= 1
-
-    def anchor(self, u: float) -> np.ndarray:
-        """Group values of a tree node picked by u in [0, 1): a uniform layer, then a uniform node."""
-        layers = [layer for layer in (*self.fwd, *self.bwd) if len(layer)]
-        x = u * len(layers)
-        layer = layers[int(x)]
-        return layer.values[int((x - int(x)) * len(layer))]
-
-    def path(self, t: int, c: np.ndarray, f: int, b: int) -> np.ndarray:
-        """The waypoints (h, n) through forward node f at t-1, c at t, backward node b at t+1."""
-        W = self.base.copy()
-        d = self.dims
-        W[t, d] = c
-        for s in range(t - 1, -1, -1):
-            W[s, d] = self.fwd[s].values[f]
-            f = self.fwd[s].parents[f]
-        for s in range(t + 1, len(W)):
-            W[s, d] = self.bwd[s].values[b]
-            b = self.bwd[s].parents[b]
-        return W
 
 
 @dataclass(frozen=True)
@@ -689,9 +310,9 @@ class DimensionRRT(ob.Planner):
         if mismatch is not None:
             log.error("the %s state is not on the prescribed trajectory", mismatch)
             return _status(ob.PlannerStatus.INVALID_START if mismatch == "start" else ob.PlannerStatus.INVALID_GOAL)
-        checker = _Checker(si, layout, self.batch)
+        checker = Checker(si, layout, self.batch)
         checks0 = checker.counter()
-        search = _Search(self.grouped, checker, self._rng, q0, q1, self.narrow_after, self.narrowing, self._ranges,
+        search = Search(self.grouped, checker, self._rng, q0, q1, self.narrow_after, self.narrowing, self._ranges,
                          self._initial)
         stats = self._stats
         progress = stats["progress"]
@@ -724,8 +345,8 @@ class DimensionRRT(ob.Planner):
         status = _status(ob.PlannerStatus.TIMEOUT)
         if best_W is not None:
             path = self.grouped.to_path(si, best_W)
-            states = path.getStates()
-            if all(si.checkMotion(states[i], states[i + 1]) for i in range(len(states) - 1)):
+            # the start state was checked by _endpoints: only the motions are checked again here
+            if path_passes_motion_checks(si, path, check_first=False):
                 pdef.addSolutionPath(path, False, 0.0, self.getName())
                 status = _status(ob.PlannerStatus.EXACT_SOLUTION)
             else:

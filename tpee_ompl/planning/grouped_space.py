@@ -28,6 +28,8 @@ import numpy as np
 from ompl import base as ob
 from ompl import geometric as og
 
+from .paths import array_to_path, path_to_array
+
 __all__ = [
     "RealVectorLayout",
     "GroupedSpace",
@@ -198,16 +200,11 @@ class RealVectorLayout:
 
     def to_path(self, si: ob.SpaceInformation, W: np.ndarray) -> og.PathGeometric:
         """An ``og.PathGeometric`` through the waypoints W (K, n)."""
-        path = og.PathGeometric(si)
-        for w in np.asarray(W, dtype=float):
-            s = si.allocState()
-            self.write(s, w)
-            path.append(s)
-        return path
+        return array_to_path(si, W, write=self.write)
 
     def from_path(self, path: og.PathGeometric) -> np.ndarray:
         """Waypoints of a geometric path, shape (K, n)."""
-        return np.array([self.read(s) for s in path.getStates()], dtype=float).reshape(-1, self.n)
+        return path_to_array(path, self.n, read=self.read)
 
 
 class GroupedSpace:

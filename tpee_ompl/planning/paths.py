@@ -1,13 +1,16 @@
-"""Paths as OMPL sees them, in numpy: states <-> arrays, the states a motion check visits, lengths, resampling.
+"""Paths as OMPL sees them, in numpy: states <-> arrays, the states a motion check visits, the
+whole-path check, lengths, resampling.
 
-The one home of these conversions and of OMPL's subdivision rule (what ``DiscreteMotionValidator``
-checks along a motion), so every planner, checker and experiment agrees on them.
+The one home of these conversions, of OMPL's subdivision rule (what ``DiscreteMotionValidator``
+checks along a motion) and of the whole-path check (:func:`path_passes_motion_checks`, what
+``og.PathGeometric.check`` does), so every planner, checker and experiment agrees on them.
 """
 
 from __future__ import annotations
 
+import itertools
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -20,9 +23,11 @@ if TYPE_CHECKING:
 __all__ = [
     "MIN_JOINT_STEP",
     "array_to_path",
+    "motion_interior_states",
     "motion_is_valid",
     "motion_states",
     "path_length",
+    "path_passes_motion_checks",
     "path_to_array",
     "polyline_motion_states",
     "resample_waypoints",
@@ -42,19 +47,89 @@ def set_state(state: ob.State, values: Sequence[float]) -> ob.State:
     return state
 
 
-def path_to_array(path: og.PathGeometric, n: int) -> np.ndarray:
-    """Waypoints of a geometric path as an array (K, n)."""
-    return np.array([[s[i] for i in range(n)] for s in path.getStates()], dtype=float)
+def path_to_array(
+    path: og.PathGeometric, n: int, *, read: Callable[[ob.State], np.ndarray] | None = None
+) -> np.ndarray:
+    """Waypoints of a geometric path as an array (K, n).
+
+    ``read(state) -> (n,)`` reads other state types (e.g. :meth:`RealVectorLayout.read` for a compound
+    space); the default reads the first n values of a RealVector state.
+    """
+    states = path.getStates()
+    if read is None:
+        return np.array([[s[i] for i in range(n)] for s in states], dtype=float)
+    return np.array([read(s) for s in states], dtype=float).reshape(-1, n)
 
 
-def array_to_path(si: ob.SpaceInformation, waypoints: np.ndarray) -> og.PathGeometric:
-    """An ``og.PathGeometric`` through the given (K, n) waypoints."""
+def array_to_path(
+    si: ob.SpaceInformation, waypoints: np.ndarray, *, write: Callable[[ob.State, np.ndarray], object] | None = None
+) -> og.PathGeometric:
+    """An ``og.PathGeometric`` through the given (K, n) waypoints.
+
+    ``write(state, values)`` writes other state types (e.g. :meth:`RealVectorLayout.write`); the
+    default is :func:`set_state` (RealVector states).
+    """
+    write = set_state if write is None else write
     path = og.PathGeometric(si)
     for w in np.asarray(waypoints, dtype=float):
         s = si.allocState()
-        set_state(s, w)
+        write(s, w)
         path.append(s)
     return path
+
+
+def path_passes_motion_checks(
+    si: ob.SpaceInformation, waypoints: og.PathGeometric | Sequence[ob.State] | np.ndarray, *, check_first: bool = True
+) -> bool:
+    """OMPL's whole-path check: the first state is valid and every segment passes ``si.checkMotion``.
+
+    Makes the calls ``og.PathGeometric.check()`` makes, in the same order: ``si.isValid`` of the
+    first state, then ``si.checkMotion(w[k], w[k + 1])`` for k = 0 .. K-2, stopping at the first
+    failure (so it agrees with ``check()`` and costs the same).  An empty path passes; the
+    SpaceInformation is set up first if it is not (as ``check()`` does).  Neither checks the
+    bounds (``si.satisfiesBounds``) nor where the path starts or ends.
+
+    Parameters
+    ----------
+    si : ob.SpaceInformation
+    waypoints : og.PathGeometric, sequence of ob.State, or array (K, n)
+        An array is written into states of a ``RealVectorStateSpace`` of dimension n (for other
+        spaces pass states or a path).
+    check_first : bool
+        False skips ``si.isValid`` of the first state, for a caller that has just checked it
+        (the motion checks never check a motion's first state).
+
+    Raises
+    ------
+    ValueError
+        An array that is not (K, n) with n the space's dimension, not finite, or given for a space
+        that is not a ``RealVectorStateSpace``.
+    """
+    if isinstance(waypoints, og.PathGeometric):
+        states = list(waypoints.getStates())
+    elif not isinstance(waypoints, np.ndarray) and all(isinstance(w, ob.State) for w in waypoints):
+        states = list(waypoints)
+    else:
+        space = si.getStateSpace()
+        if not isinstance(space, ob.RealVectorStateSpace):
+            raise ValueError(f"waypoints as an array need a RealVectorStateSpace, got {type(space).__name__}")
+        try:
+            W = np.asarray(waypoints, dtype=float)
+        except (TypeError, ValueError):
+            raise ValueError("waypoints must be a PathGeometric, a sequence of states or an array (K, n)") from None
+        n = int(space.getDimension())
+        if W.ndim != 2 or W.shape[1] != n:
+            raise ValueError(f"waypoints must have shape (K, {n}), got {W.shape}")
+        if not np.all(np.isfinite(W)):
+            raise ValueError("waypoints contain NaN or inf")
+        states = [set_state(si.allocState(), w) for w in W]
+    if not si.isSetup():
+        si.setup()
+    if not states:
+        return True
+    if check_first and not si.isValid(states[0]):
+        return False
+    return all(si.checkMotion(a, b) for a, b in itertools.pairwise(states))
 
 
 MIN_JOINT_STEP = 1e-4
@@ -81,6 +156,27 @@ def motion_states(a: np.ndarray, b: np.ndarray, step: float, include_start: bool
     n = max(1, math.ceil(float(np.linalg.norm(b - a)) / step))
     t = np.arange(0 if include_start else 1, n + 1) / n
     return a + t[:, None] * (b - a)
+
+
+def motion_interior_states(
+    A: np.ndarray, B: np.ndarray, step: float, lengths: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Interior states of the motions A[k] -> B[k] (K, n), as OMPL's discrete motion validator picks them.
+
+    Motion k has ``n_k = max(1, ceil(d_k / step))`` segments, ``d_k`` being ``lengths[k]`` (the
+    space's metric; default Euclidean ``|B[k] - A[k]|``).  Returns its interior states
+    ``A[k] + (j / n_k)(B[k] - A[k])``, j = 1 .. n_k - 1, for all motions at once, in motion order:
+    ``(states (M, n), motion index k (M,), step index j (M,))``.  Neither end is included (unlike
+    :func:`motion_states`).  Not validated: it runs in planners' inner loops.
+    """
+    d = np.sqrt(((B - A) ** 2).sum(-1)) if lengths is None else lengths
+    nd = np.maximum(1, np.ceil(d / step)).astype(int)
+    cnt = nd - 1
+    total = int(cnt.sum())
+    idx = np.repeat(np.arange(len(A)), cnt)
+    j = np.arange(total) - np.repeat(np.cumsum(cnt) - cnt, cnt) + 1
+    frac = j / nd[idx]
+    return A[idx] + frac[:, None] * (B[idx] - A[idx]), idx, j
 
 
 def polyline_motion_states(path: np.ndarray, step: float) -> np.ndarray:
@@ -133,5 +229,8 @@ def motion_is_valid(robot: WearerArm, path: np.ndarray, step: float | None = Non
 
 
 def path_length(path: np.ndarray) -> float:
-    """Euclidean joint-space length of a polyline (K, n), radians (the setups' path-length objective)."""
+    """Euclidean joint-space length of a polyline (K, n), radians (the setups' path-length objective).
+
+    For a compound space's weighted metric see :meth:`~tpee_ompl.planning.grouped_space.RealVectorLayout.path_length`.
+    """
     return float(np.linalg.norm(np.diff(np.asarray(path, dtype=float), axis=0), axis=1).sum())

@@ -22,13 +22,14 @@ from ompl import base as ob
 from ompl import geometric as og
 
 from ..model.wearer_arm import WearerArm
-from .paths import MIN_JOINT_STEP, motion_states, set_state
+from .paths import MIN_JOINT_STEP, motion_states, set_state, state_to_array
 
 __all__ = [
     "WearerValidityChecker",
     "BatchedMotionValidator",
     "make_space",
     "make_simple_setup",
+    "motion_check_step",
 ]
 
 
@@ -76,9 +77,7 @@ class BatchedMotionValidator(ob.MotionValidator):
 
     def checkMotion(self, s1: ob.State, s2: ob.State) -> bool:  # noqa: N802 (OMPL override)
         """True if every state along s1 -> s2 (excluding s1) is valid."""
-        n = self._n
-        a = np.array([s1[i] for i in range(n)])
-        b = np.array([s2[i] for i in range(n)])
+        a, b = state_to_array(s1, self._n), state_to_array(s2, self._n)
         self.motions_checked += 1
         return bool(self.robot.are_valid(motion_states(a, b, self.effective_step())).all())
 
@@ -131,7 +130,8 @@ def make_simple_setup(
         Raise ValueError when start or goal is out of limits or in collision.
 
     The objective is path length in the joint-space Euclidean metric.  The setup's
-    ``getSpaceInformation()`` is fully set up on return.
+    ``getSpaceInformation()`` is fully set up on return; :func:`motion_check_step` gives back the
+    joint step it checks motions at.
     """
     if joint_step is None:
         step = robot.max_joint_step()
@@ -173,3 +173,22 @@ def make_simple_setup(
         ss.setStartAndGoalStates(s0, s1, 1e-9)
     si.setup()
     return ss
+
+
+def motion_check_step(setup: og.SimpleSetup | ob.SpaceInformation) -> float:
+    """Joint-space step (radians) between the states a motion check visits, at ``validSegmentCountFactor`` 1.
+
+    For a :func:`make_simple_setup` setup this is its ``joint_step`` exactly (default
+    ``robot.max_joint_step()``), read from its :class:`BatchedMotionValidator`; for any other motion
+    validator (OMPL's ``DiscreteMotionValidator``) it is the space's longest valid segment length,
+    ``si.getStateValidityCheckingResolution() * space.getMaximumExtent()`` (equal up to rounding).
+    While the space's ``validSegmentCountFactor`` is f > 1 (``ot.Benchmark``'s strict check), motions
+    are checked at ``step / f``.
+    """
+    si = setup.getSpaceInformation() if isinstance(setup, og.SimpleSetup) else setup
+    if not isinstance(si, ob.SpaceInformation):
+        raise ValueError(f"expected an og.SimpleSetup or ob.SpaceInformation, got {type(setup).__name__}")
+    mv = si.getMotionValidator()
+    if isinstance(mv, BatchedMotionValidator):
+        return mv.step
+    return float(si.getStateSpace().getLongestValidSegmentLength())

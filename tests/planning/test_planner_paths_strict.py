@@ -18,8 +18,8 @@ from ompl import geometric as og
 from ompl import util as ou
 
 from tpee_ompl.planning.tpee import tpee_dimension_rrt
-from tpee_ompl.planning.setup import make_simple_setup
-from tpee_ompl.planning.paths import motion_states, path_to_array
+from tpee_ompl.planning.setup import make_simple_setup, motion_check_step
+from tpee_ompl.planning.paths import motion_states, path_passes_motion_checks, path_to_array
 from tpee_ompl.model.queries import Query, load_queries
 from tpee_ompl.model.wearer_arm import WearerArm
 
@@ -46,19 +46,17 @@ def _strict_failures(robot: WearerArm, ss: og.SimpleSetup, q: Query) -> list[str
         return problems
     if not robot.are_valid(W).all():
         problems.append("a waypoint is invalid")
-    states = path.getStates()
-    segments = list(zip(states[:-1], states[1:]))
-    if not all(si.checkMotion(a, b) for a, b in segments):
+    if not path_passes_motion_checks(si, path):
         problems.append("si.checkMotion rejects a segment at the setup resolution")
     space = si.getStateSpace()
     factor = space.getValidSegmentCountFactor()
     space.setValidSegmentCountFactor(4 * factor)  # as ompl::tools::Benchmark for correct_solution_strict
     try:
-        if not all(si.checkMotion(a, b) for a, b in segments) or not path.check():
+        if not path_passes_motion_checks(si, path) or not path.check():
             problems.append("si.checkMotion rejects a segment at 4x the resolution")
     finally:
         space.setValidSegmentCountFactor(factor)
-    step = ss._tpee_refs[2].step / 4  # the setup's joint step, quartered
+    step = motion_check_step(ss) / 4  # the setup's joint step, quartered
     dense = np.concatenate([motion_states(a, b, step) for a, b in zip(W[:-1], W[1:])])
     if not robot.are_valid(dense).all():
         problems.append("a state at a quarter of the joint step collides")
@@ -96,9 +94,11 @@ NATIVE = {
     "InformedRRTstar": (og.InformedRRTstar, 1.5, 2),
     "BITstar": (og.BITstar, 1.5, 3),
 }
+SLOW = {"RRTstar", "InformedRRTstar", "BITstar"}
+"""These use their whole time budget (3 x 1.5 s)."""
 
 
-@pytest.mark.parametrize("name", sorted(NATIVE))
+@pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.slow) if n in SLOW else n for n in sorted(NATIVE)])
 def test_native_planner_exact_paths_pass_strict_check(robot: WearerArm, queries: list[Query], name: str) -> None:
     cls, seconds, offset = NATIVE[name]
     ou.RNG.setSeed(17)
@@ -151,11 +151,11 @@ def test_strict_check_really_is_denser_than_the_setup_resolution(robot: WearerAr
     """The 4x factor reaches our batched motion validator (it would silently ignore it otherwise)."""
     ss = make_simple_setup(robot)
     si = ss.getSpaceInformation()
-    mv = ss._tpee_refs[2]
+    step = motion_check_step(ss)
     a, b = si.allocState(), si.allocState()
     for i in range(4):
         a[i], b[i] = 0.3, 0.3
-    b[2] = 0.3 + 10 * mv.step
+    b[2] = 0.3 + 10 * step
     checks0 = robot.collision_checks
     si.checkMotion(a, b)
     coarse = robot.collision_checks - checks0

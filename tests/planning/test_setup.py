@@ -1,4 +1,4 @@
-"""OMPL set-up: bounds, resolution, motion-check guarantee, RRT* end to end."""
+"""OMPL set-up (tpee_ompl.planning.setup): bounds, resolution, motion-check guarantee, motion_check_step, RRT* end to end."""
 
 from __future__ import annotations
 
@@ -8,8 +8,8 @@ from ompl import base as ob
 from ompl import geometric as og
 from ompl import util as ou
 
-from tpee_ompl.planning.setup import BatchedMotionValidator, make_simple_setup
-from tpee_ompl.planning.paths import motion_states, path_to_array, set_state
+from tpee_ompl.planning.setup import BatchedMotionValidator, make_simple_setup, motion_check_step
+from tpee_ompl.planning.paths import motion_states, path_passes_motion_checks, path_to_array, set_state
 from tpee_ompl.model.wearer_arm import WearerArm
 from tpee_ompl.model.sectors import posture_preset
 
@@ -90,8 +90,7 @@ def test_rrtstar_between_two_presets_returns_an_exact_path_whose_every_segment_p
     assert status == ob.PlannerStatus.EXACT_SOLUTION
     assert ss.haveExactSolutionPath()
     path = ss.getSolutionPath()
-    states = path.getStates()
-    assert all(si.checkMotion(s0, s1) for s0, s1 in zip(states[:-1], states[1:]))
+    assert path_passes_motion_checks(si, path)
     W = path_to_array(path, 4)
     np.testing.assert_allclose(W[0], preset(1))
     np.testing.assert_allclose(W[-1], preset(4))
@@ -113,14 +112,26 @@ def test_bad_joint_step_raises(robot, step):
         make_simple_setup(robot, joint_step=step)
 
 
-def test_motion_states_match_ompl_subdivision():
-    s = motion_states(np.zeros(4), np.array([1.0, 0, 0, 0]), 0.3)
-    np.testing.assert_allclose(s[:, 0], [0.25, 0.5, 0.75, 1.0])
-
-
 def test_ompl_state_checker_agrees_with_the_model_inside_and_outside_the_limits(robot, rng):
     si = make_simple_setup(robot).getSpaceInformation()
     s = si.allocState()
     for q in rng.uniform(robot.lower - 0.2, robot.upper + 0.2, size=(2000, 4)):
         assert si.isValid(set_state(s, q)) == robot.is_valid(q)
     assert not robot.is_valid_values([float("nan"), 0.0, 0.0, 0.0])
+
+
+@pytest.mark.parametrize("joint_step", [None, 0.01, 0.05])
+def test_motion_check_step_is_the_setups_joint_step(robot, joint_step):
+    ss = make_simple_setup(robot, joint_step=joint_step)
+    want = robot.max_joint_step() if joint_step is None else joint_step
+    assert motion_check_step(ss) == want  # exactly: read from the batched motion validator
+    assert motion_check_step(ss.getSpaceInformation()) == want
+    si = ss.getSpaceInformation()
+    assert want == pytest.approx(si.getStateValidityCheckingResolution() * si.getStateSpace().getMaximumExtent())
+    discrete = make_simple_setup(robot, joint_step=joint_step, batched_motion_validator=False)
+    assert motion_check_step(discrete) == pytest.approx(want)
+
+
+def test_motion_check_step_refuses_other_objects():
+    with pytest.raises(ValueError, match="SimpleSetup or ob.SpaceInformation"):
+        motion_check_step(0.01)

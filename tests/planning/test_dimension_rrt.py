@@ -17,7 +17,7 @@ from tpee_ompl.planning.tpee import tpee_dimension_rrt
 from tpee_ompl.examples.planar_arm import make_planar_arm_setup
 from tpee_ompl.examples.tpee_queries import PAIR_TYPES, cross_sector_query
 from tpee_ompl.planning.setup import make_simple_setup
-from tpee_ompl.planning.paths import path_to_array, set_state
+from tpee_ompl.planning.paths import path_passes_motion_checks, path_to_array, set_state
 from tpee_ompl.model.wearer_arm import WearerArm
 
 SAMPLES = 300
@@ -38,9 +38,7 @@ def test_valid_paths_on_all_12_pair_types(robot: WearerArm) -> None:
         ss, planner, status = _solve(robot, i, j, q0, q1, max_samples=SAMPLES, seed=3)
         assert status == ob.PlannerStatus.EXACT_SOLUTION, (i, j)
         path = ss.getSolutionPath()
-        si = ss.getSpaceInformation()
-        states = path.getStates()
-        assert all(si.checkMotion(a, b) for a, b in zip(states[:-1], states[1:])), (i, j)
+        assert path_passes_motion_checks(ss.getSpaceInformation(), path), (i, j)
         W = path_to_array(path, 4)
         assert W.shape == (7, 4)
         np.testing.assert_allclose(W[0], q0)
@@ -92,9 +90,7 @@ def test_invalid_initial_waypoints_are_checked_not_trusted(robot: WearerArm) -> 
     planner.set_initial_waypoints(W)
     ss.setPlanner(planner)
     assert ss.solve(30.0) == ob.PlannerStatus.EXACT_SOLUTION
-    si = ss.getSpaceInformation()
-    states = ss.getSolutionPath().getStates()
-    assert all(si.checkMotion(a, b) for a, b in zip(states[:-1], states[1:]))
+    assert path_passes_motion_checks(ss.getSpaceInformation(), ss.getSolutionPath())
     np.testing.assert_allclose(path_to_array(ss.getSolutionPath(), 4)[:, :2], planner.prescribed[0])
     planner.set_initial_waypoints(None)
     assert planner.settings()["initial_waypoints"] == "none"

@@ -6,7 +6,8 @@ import numpy as np
 from ompl import base as ob
 
 from tpee_ompl.planning.dimension_rrt import DimensionRRT
-from tpee_ompl.examples.planar_arm import make_planar_arm_setup
+from tpee_ompl.examples.planar_arm import PlanarArm, make_planar_arm_setup
+from tpee_ompl.planning.paths import path_passes_motion_checks, path_to_array
 
 
 def test_finds_valid_paths_in_a_plain_ompl_setup() -> None:
@@ -19,8 +20,7 @@ def test_finds_valid_paths_in_a_plain_ompl_setup() -> None:
         ss.setPlanner(planner)
         assert ss.solve(10.0) == ob.PlannerStatus.EXACT_SOLUTION
         path = ss.getSolutionPath()
-        states = path.getStates()
-        assert all(si.checkMotion(s, t) for s, t in zip(states[:-1], states[1:]))
+        assert path_passes_motion_checks(si, path)
         assert path.getStateCount() == 7
         stats = planner.last_run_stats()
         assert stats["collision_checks"] > 0 and stats["best_cost"] == path.length()
@@ -28,7 +28,8 @@ def test_finds_valid_paths_in_a_plain_ompl_setup() -> None:
 
 def test_straight_motion_is_blocked_so_planning_is_needed() -> None:
     ss = make_planar_arm_setup()
-    checker = ss._planar_arm
+    checker = ss.getStateValidityChecker()
+    assert isinstance(checker, PlanarArm)
     Q = np.linspace([0.3, 0, 0, 0], [2.6, 0, 0, 0], 200)
     assert not checker.are_valid(Q).all()
 
@@ -40,7 +41,7 @@ def test_per_state_fallback_gives_the_same_path() -> None:
         planner = DimensionRRT(ss.getSpaceInformation(), seed=4, max_samples=300, batch=batch)
         ss.setPlanner(planner)
         assert ss.solve(10.0) == ob.PlannerStatus.EXACT_SOLUTION
-        paths.append(np.array([[s[i] for i in range(4)] for s in ss.getSolutionPath().getStates()]))
+        paths.append(path_to_array(ss.getSolutionPath(), 4))
     np.testing.assert_array_equal(paths[0], paths[1])
 
 

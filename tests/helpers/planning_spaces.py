@@ -1,0 +1,36 @@
+"""Small OMPL problems for the planning tests: a unit box with a counted, batched box-obstacle checker."""
+
+from __future__ import annotations
+
+import numpy as np
+from ompl import base as ob
+
+
+class BoxObstacle(ob.StateValidityChecker):
+    """Valid unless inside the axis-aligned box [lo, hi]; counts per-state and batched checks."""
+
+    def __init__(self, si: ob.SpaceInformation, lo, hi) -> None:
+        super().__init__(si)
+        self.lo, self.hi = np.asarray(lo, dtype=float), np.asarray(hi, dtype=float)
+        self.n = len(self.lo)
+        self.calls = 0
+
+    def are_valid(self, Q: np.ndarray) -> np.ndarray:
+        Q = np.atleast_2d(Q)
+        self.calls += len(Q)
+        return ~np.all((Q >= self.lo) & (Q <= self.hi), axis=1)
+
+    def isValid(self, state: ob.State) -> bool:  # noqa: N802 (OMPL override)
+        return bool(self.are_valid(np.array([[state[i] for i in range(self.n)]]))[0])
+
+
+def box_problem(lo=(0.4, -0.2), hi=(0.6, 0.2), resolution: float = 0.01) -> tuple[ob.SpaceInformation, BoxObstacle]:
+    """A set-up SpaceInformation over [-1, 1]^n (n = len(lo)) with one box obstacle; keep both alive."""
+    space = ob.RealVectorStateSpace(len(lo))
+    space.setBounds(-1.0, 1.0)
+    si = ob.SpaceInformation(space)
+    checker = BoxObstacle(si, lo, hi)
+    si.setStateValidityChecker(checker)
+    si.setStateValidityCheckingResolution(resolution)
+    si.setup()
+    return si, checker

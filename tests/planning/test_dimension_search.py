@@ -1,0 +1,59 @@
+"""tpee_ompl.planning.dimension_search without a planner: the batched checker and the search on a waypoint array."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from helpers.planning_spaces import box_problem
+
+from tpee_ompl.planning.dimension_search import Checker, Search
+from tpee_ompl.planning.grouped_space import GroupedSpace
+from tpee_ompl.planning.paths import path_passes_motion_checks, set_state
+
+
+def _valid_pairs(si, rng: np.random.Generator, m: int) -> tuple[np.ndarray, np.ndarray]:
+    """m motions whose two ends are valid (the checker's motions() leave the ends to the caller)."""
+    s = si.allocState()
+    Q = [q for q in rng.uniform(-1, 1, (8 * m, 2)) if si.isValid(set_state(s, q))]
+    return np.array(Q[:m]), np.array(Q[m : 2 * m])
+
+
+def test_batched_and_per_state_checkers_agree_with_check_motion(rng: np.random.Generator) -> None:
+    si, _ = box_problem()
+    grouped = GroupedSpace(si, [[0, 1]], 5)
+    A, B = _valid_pairs(si, rng, 60)
+    batched, plain = Checker(si, grouped.layout, batch=True), Checker(si, grouped.layout, batch=False)
+    assert batched.batched and not plain.batched
+    a, b = si.allocState(), si.allocState()
+    want = np.array([si.checkMotion(set_state(a, p), set_state(b, q)) for p, q in zip(A, B)])
+    assert want.any() and not want.all()
+    np.testing.assert_array_equal(batched.motions(A, B), want)
+    np.testing.assert_array_equal(plain.motions(A, B), want)
+    C = rng.uniform(-1, 1, (60, 2))
+    yes = np.ones(60, dtype=bool)
+    for strict in (yes, ~yes):
+        vb, lb, rb = batched.candidates(C, A, B, yes, yes, strict)
+        vp, lp, rp = plain.candidates(C, A, B, yes, yes, strict)
+        np.testing.assert_array_equal(vb, vp)
+        np.testing.assert_array_equal(lb & rb, lp & rp)  # strict: the second motion may be skipped
+
+
+@pytest.mark.parametrize("batch", [True, False])
+def test_search_finds_a_valid_path_around_the_box_and_only_shortens_it(batch: bool) -> None:
+    si, _ = box_problem(lo=(-0.2, -1.0), hi=(0.2, 0.6))  # a wall with a gap at the top
+    grouped = GroupedSpace(si, [[0, 1]], 7)
+    start, goal = np.array([-0.8, 0.0]), np.array([0.8, 0.0])
+    search = Search(grouped, Checker(si, grouped.layout, batch), np.random.default_rng(3), start, goal,
+                    narrow_after=200, narrowing=0.5, range_={0: np.full(2, 0.04)})
+    assert not search.valid and search.cost == pytest.approx(1.6)
+    while not search.valid and search.samples < 3000:
+        search.iterate()
+    assert search.valid
+    costs = [search.cost]
+    for _ in range(400):
+        search.iterate()
+        costs.append(search.cost)
+    assert all(b <= a + 1e-12 for a, b in zip(costs, costs[1:])) and costs[-1] < costs[0]
+    assert path_passes_motion_checks(si, search.W)
+    assert search.cost == pytest.approx(grouped.path_length(search.W))
+    np.testing.assert_array_equal(search.W[[0, -1]], [start, goal])

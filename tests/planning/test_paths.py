@@ -1,0 +1,174 @@
+"""tpee_ompl.planning.paths: states <-> arrays, motion states, the whole-path check, lengths, resampling."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from helpers.planning_spaces import box_problem
+from ompl import base as ob
+from ompl import geometric as og
+
+from tpee_ompl.model.wearer_arm import WearerArm
+from tpee_ompl.planning.grouped_space import RealVectorLayout
+from tpee_ompl.planning.paths import (
+    array_to_path,
+    motion_interior_states,
+    motion_is_valid,
+    motion_states,
+    path_length,
+    path_passes_motion_checks,
+    path_to_array,
+    polyline_motion_states,
+    resample_waypoints,
+    set_state,
+    state_to_array,
+)
+from tpee_ompl.planning.setup import make_simple_setup, motion_check_step
+
+
+# ------------------------------------------------------------------------------- states <-> arrays
+def test_state_and_path_round_trips() -> None:
+    si, _ = box_problem()
+    s = set_state(si.allocState(), [0.25, -0.5])
+    np.testing.assert_array_equal(state_to_array(s, 2), [0.25, -0.5])
+    W = np.array([[0.0, 0.0], [0.1, 0.2], [-0.3, 0.9]])
+    path = array_to_path(si, W)
+    assert isinstance(path, og.PathGeometric) and path.getStateCount() == 3
+    np.testing.assert_array_equal(path_to_array(path, 2), W)
+    assert path.length() == pytest.approx(path_length(W))
+
+
+def test_read_and_write_hooks_handle_a_compound_space() -> None:
+    cs = ob.CompoundStateSpace()
+    for dim, weight in ((2, 1.0), (1, 0.5)):
+        sub = ob.RealVectorStateSpace(dim)
+        sub.setBounds(-1.0, 1.0)
+        cs.addSubspace(sub, weight)
+    si = ob.SpaceInformation(cs)
+    si.setStateValidityChecker(ob.AllValidStateValidityChecker(si))
+    si.setup()
+    layout = RealVectorLayout(cs)
+    W = np.array([[0.0, 0.1, 0.2], [0.3, -0.4, 0.5]])
+    path = array_to_path(si, W, write=layout.write)
+    np.testing.assert_array_equal(path_to_array(path, 3, read=layout.read), W)
+    assert path.length() == pytest.approx(layout.path_length(W))  # the weighted metric, not path_length's
+
+
+# ------------------------------------------------------------------------------- motion states
+def test_motion_states_match_ompl_subdivision() -> None:
+    s = motion_states(np.zeros(4), np.array([1.0, 0, 0, 0]), 0.3)
+    np.testing.assert_allclose(s[:, 0], [0.25, 0.5, 0.75, 1.0])
+    s0 = motion_states(np.zeros(4), np.array([1.0, 0, 0, 0]), 0.3, include_start=True)
+    np.testing.assert_allclose(s0[:, 0], [0.0, 0.25, 0.5, 0.75, 1.0])
+
+
+def test_interior_and_polyline_states_are_motion_states(rng: np.random.Generator) -> None:
+    A, B = rng.uniform(-1, 1, (20, 3)), rng.uniform(-1, 1, (20, 3))
+    B[3] = A[3]  # a zero-length motion: one segment, no interior state
+    S, k, j = motion_interior_states(A, B, 0.07)
+    for m in range(len(A)):
+        want = motion_states(A[m], B[m], 0.07)[:-1]  # without the end state
+        np.testing.assert_array_equal(S[k == m], want)
+        np.testing.assert_array_equal(j[k == m], np.arange(1, len(want) + 1))
+    S2, k2, _ = motion_interior_states(A, B, 0.07, lengths=2 * np.sqrt(((B - A) ** 2).sum(-1)))
+    assert len(S2) > len(S)  # another metric, other segment counts
+    P = rng.uniform(-1, 1, (6, 3))
+    want = np.vstack([P[:1]] + [motion_states(a, b, 0.05) for a, b in zip(P[:-1], P[1:])])
+    np.testing.assert_allclose(polyline_motion_states(P, 0.05), want, rtol=0, atol=1e-15)
+
+
+@pytest.mark.parametrize("step", [0.0, -1.0, float("nan"), "0.1"])
+def test_motion_states_refuse_a_bad_step(step) -> None:
+    with pytest.raises(ValueError, match="step"):
+        motion_states(np.zeros(2), np.ones(2), step)
+
+
+# ------------------------------------------------------------------------------- whole-path check
+def test_valid_path_passes_and_a_segment_through_the_obstacle_fails() -> None:
+    si, _ = box_problem()
+    around = np.array([[0.0, 0.0], [0.5, 0.5], [1.0, 0.0]])
+    through = np.array([[0.0, 0.0], [1.0, 0.0]])  # both ends valid, the middle in the box
+    assert path_passes_motion_checks(si, around)
+    assert not path_passes_motion_checks(si, through)
+    assert si.isValid(set_state(si.allocState(), through[0])) and si.isValid(set_state(si.allocState(), through[1]))
+    for form in (array_to_path(si, through), array_to_path(si, through).getStates()):
+        assert not path_passes_motion_checks(si, form)
+
+
+def test_first_state_is_checked_unless_told_otherwise() -> None:
+    si, _ = box_problem(lo=(0.95, -1.0), hi=(1.0, 1.0))
+    out_of_the_box = np.array([[0.97, 0.0], [0.5, 0.0]])  # starts invalid; the motion's checked states are valid
+    assert not path_passes_motion_checks(si, out_of_the_box)
+    assert path_passes_motion_checks(si, out_of_the_box, check_first=False)
+    assert not array_to_path(si, out_of_the_box).check()
+
+
+def test_agrees_with_path_geometric_check_and_makes_the_same_checks(rng: np.random.Generator) -> None:
+    si, checker = box_problem()
+    verdicts = set()
+    for _ in range(200):
+        path = array_to_path(si, rng.uniform(-1, 1, (int(rng.integers(1, 5)), 2)))
+        checker.calls = 0
+        want = path.check()
+        calls = checker.calls
+        checker.calls = 0
+        assert path_passes_motion_checks(si, path) == want
+        assert checker.calls == calls
+        verdicts.add(want)
+    assert verdicts == {True, False}
+    empty = og.PathGeometric(si)
+    assert empty.check() and path_passes_motion_checks(si, empty) and path_passes_motion_checks(si, np.zeros((0, 2)))
+
+
+def test_sets_up_the_space_information_like_check_does() -> None:
+    space = ob.RealVectorStateSpace(2)
+    space.setBounds(-1.0, 1.0)
+    si = ob.SpaceInformation(space)
+    si.setStateValidityChecker(ob.AllValidStateValidityChecker(si))
+    assert not si.isSetup()
+    assert path_passes_motion_checks(si, np.array([[0.0, 0.0], [0.5, 0.5]]))
+    assert si.isSetup()
+
+
+@pytest.mark.parametrize("bad", [np.zeros((2, 3)), np.zeros(2), np.full((2, 2), np.nan), [["a", "b"]]])
+def test_bad_waypoint_arrays_raise(bad) -> None:
+    si, _ = box_problem()
+    with pytest.raises(ValueError, match="waypoints"):
+        path_passes_motion_checks(si, bad)
+
+
+def test_arrays_need_a_real_vector_space() -> None:
+    cs = ob.CompoundStateSpace()
+    sub = ob.RealVectorStateSpace(2)
+    sub.setBounds(-1.0, 1.0)
+    cs.addSubspace(sub, 1.0)
+    si = ob.SpaceInformation(cs)
+    si.setStateValidityChecker(ob.AllValidStateValidityChecker(si))
+    si.setup()
+    with pytest.raises(ValueError, match="RealVectorStateSpace"):
+        path_passes_motion_checks(si, np.zeros((2, 2)))
+
+
+def test_batched_motion_is_valid_agrees_with_the_setups_motion_checks(robot: WearerArm, rng: np.random.Generator) -> None:
+    ss = make_simple_setup(robot)
+    si = ss.getSpaceInformation()
+    verdicts = []
+    for _ in range(40):
+        W = rng.uniform(robot.lower, robot.upper, (3, 4))
+        W[1:] = np.clip(W[0] + rng.normal(scale=0.15, size=(2, 4)), robot.lower, robot.upper)
+        got = motion_is_valid(robot, W, motion_check_step(ss))
+        assert got == path_passes_motion_checks(si, W)
+        verdicts.append(got)
+    assert any(verdicts) and not all(verdicts)
+
+
+# ------------------------------------------------------------------------------- lengths, resampling
+def test_path_length_and_resampling_keep_the_geometry() -> None:
+    W = np.array([[0.0, 0.0], [3.0, 4.0], [3.0, 0.0]])
+    assert path_length(W) == pytest.approx(9.0)
+    R = resample_waypoints(W, per_step=10)
+    assert R.shape == (21, 2)
+    np.testing.assert_array_equal(R[[0, 10, 20]], W)
+    assert path_length(R) == pytest.approx(9.0)
+    with pytest.raises(ValueError, match="per_step"):
+        resample_waypoints(W, per_step=0)
