@@ -17,7 +17,7 @@ from tpee_ompl.model.sectors import (
 )
 from tpee_ompl.model.wearer_arm import WearerArm
 from tpee_ompl.planning.paths import MIN_JOINT_STEP
-from tpee_ompl.planning.setup import make_simple_setup
+from tpee_ompl.planning.setup import make_simple_setup, motion_check_step
 
 
 @SETTINGS
@@ -29,7 +29,7 @@ def test_make_simple_setup_joint_step_is_validated(robot: WearerArm, step) -> No
         assert "joint_step" in str(exc)
         assert step is not None
         return
-    got = ss._tpee_refs[2].step
+    got = motion_check_step(ss)
     assert got == (robot.max_joint_step() if step is None else float(step)) and got >= MIN_JOINT_STEP
 
 

@@ -29,7 +29,7 @@ import numpy as np
 from ompl import tools as ot
 from ompl import util as ou
 
-from ..planning.paths import path_length, set_state
+from ..planning.paths import path_length, path_passes_motion_checks
 from .database import failed_run_properties, pad_aborted_runs, patch_recorded_data
 from .planners import PlannerContext, RecordingPlanner, planner_factory
 from .results import format_value, write_new_file
@@ -49,16 +49,6 @@ def group_lengths(waypoints: np.ndarray) -> tuple[float, float, float]:
     if W.ndim != 2 or W.shape[1] != 4:
         raise ValueError(f"waypoints must have shape (K, 4), got {W.shape}")
     return path_length(W), path_length(W[:, :2]), path_length(W[:, 2:])
-
-
-def _segments_pass_check_motion(si, waypoints: np.ndarray) -> bool:
-    """True if every segment of ``waypoints`` (K, n) passes ``si.checkMotion``.
-
-    TODO(layout): the one home of this check is ``tpee_ompl.planning.paths.path_passes_motion_checks``
-    (being added); call it here once merged.
-    """
-    states = [set_state(si.allocState(), w) for w in waypoints]
-    return all(si.checkMotion(a, b) for a, b in zip(states[:-1], states[1:]))
 
 
 # --------------------------------------------------------------------------- seeds, experiment list
@@ -183,8 +173,7 @@ def _path_properties(si, rec: dict, start: np.ndarray, goal: np.ndarray) -> dict
     if W is None or len(W) < 1:
         return {}
     l4, l12, l34 = group_lengths(W) if len(W) >= 2 else (0.0, 0.0, 0.0)
-    ok = _segments_pass_check_motion(si, W)
-    ok = ok and si.isValid(set_state(si.allocState(), W[0]))
+    ok = path_passes_motion_checks(si, W)
     best = rec["best_cost"]
     if best is None or not math.isfinite(float(best)):
         best = l4

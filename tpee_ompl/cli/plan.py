@@ -65,7 +65,7 @@ def plan_motion(args: argparse.Namespace) -> tuple[dict, WearerArm]:
     from ompl import base as ob
     from ompl import util as ou
 
-    from ..planning.paths import path_to_array
+    from ..planning.paths import path_passes_motion_checks, path_to_array
     from ..planning.setup import make_simple_setup
 
     ou.setLogLevel(ou.LOG_WARN)
@@ -87,8 +87,7 @@ def plan_motion(args: argparse.Namespace) -> tuple[dict, WearerArm]:
                     "time_s": ss.getLastPlanComputationTime(), "collision_checks": robot.collision_checks - checks0}
     if ss.haveSolutionPath():
         path = ss.getSolutionPath()
-        states = path.getStates()
-        result["valid"] = bool(all(si.checkMotion(a, b) for a, b in zip(states[:-1], states[1:])))
+        result["valid"] = path_passes_motion_checks(si, path)
         result["length_rad"] = float(path.length())
         result["path"] = path_to_array(path, robot.nq).round(6).tolist()
     return result, robot
