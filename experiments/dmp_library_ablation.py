@@ -20,11 +20,10 @@ from pathlib import Path
 import numpy as np
 
 from tpee_ompl.bench.campaign import new_output_stem
-from tpee_ompl.library.dmp import DMPOptions
-from tpee_ompl.library.path_library import DEMO_MARGINS, PathLibrary
-from tpee_ompl.planning.paths import motion_is_valid, path_length
+from tpee_ompl.library import DEMO_MARGINS, DMPOptions, PathLibrary
 from tpee_ompl.model.queries import load_queries
 from tpee_ompl.model.wearer_arm import default_robot
+from tpee_ompl.planning.paths import motion_is_valid, path_length
 
 LADDERS = ((), (0.03,), (0.04, 0.03, 0.025), (0.05, 0.04, 0.03, 0.025))
 """Demo margins (m) around links 3-4, widest first; () = the robot's own 2 cm."""
