@@ -32,7 +32,7 @@ _BUILD_DEFAULTS = LibraryBuildOptions()
 """The ``library build`` defaults: those of :class:`~tpee_ompl.library.build.LibraryBuildOptions`."""
 
 _BUILD_EXAMPLE = """example:
-  tpee-ompl library build --per-pair 20 --seed 0 --workers 2 --library /tmp/default.npz
+  tpee-ompl library build --workers 2 --library /tmp/default.npz      # the packaged library's settings
   tpee-ompl library build --pairs 1-2 3-4 --per-pair 3 --max-samples 500 --library /tmp/small.npz
 """
 _QUERY_EXAMPLE = """example:
