@@ -15,14 +15,12 @@ from tpee_ompl.library.dmp import (
     integrate,
     learn_dmp,
 )
+from tpee_ompl.planning.paths import resample_waypoints
 
 
 def _demo(rng: np.random.Generator, steps: int = 7, per_step: int = 100, scale: float = 0.6) -> np.ndarray:
     """A 2-D demo like the library's: random waypoints, straight segments, quintic in fake time."""
-    W = np.cumsum(rng.uniform(-scale, scale, (steps, 2)), axis=0)
-    u = np.arange(per_step) / per_step
-    s = u**3 * (10 - 15 * u + 6 * u**2)
-    return np.vstack([W[k] + s[:, None] * (W[k + 1] - W[k]) for k in range(steps - 1)] + [W[-1:]])
+    return resample_waypoints(np.cumsum(rng.uniform(-scale, scale, (steps, 2)), axis=0), per_step)
 
 
 @pytest.mark.parametrize("seed", range(5))
