@@ -38,7 +38,7 @@ bench-full: $(STAMP)
 
 # Default cross-sector DMP path library (12 pairs x <= 20 dimension-RRT demos, ~3.5 min on 2 cores).
 library: $(STAMP)
-	$(PY) experiments/build_library.py --per-pair 20 --seed 0 --workers 2 --library tpee_ompl/data/library/default.npz
+	$(PY) experiments/build_library.py --workers 2 --library tpee_ompl/data/library/default.npz
 
 clean-env:
 	rm -rf $(VENV)

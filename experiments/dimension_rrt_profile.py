@@ -21,7 +21,8 @@ from ompl import geometric as og
 from ompl import util as ou
 
 from tpee_ompl.planning.tpee import tpee_dimension_rrt
-from tpee_ompl.examples.tpee_queries import PAIR_TYPES, cross_sector_query
+from tpee_ompl.examples.tpee_queries import cross_sector_query
+from tpee_ompl.model.sectors import SECTOR_PAIRS
 from tpee_ompl.planning.setup import make_simple_setup
 from tpee_ompl.model.wearer_arm import WearerArm
 
@@ -70,10 +71,10 @@ def run(args: argparse.Namespace) -> list[dict]:
         from tpee_ompl.model.queries import load_queries
 
         stored = load_queries(args.queries, robot if args.margin == 0.02 else None)
-        queries = [(q.from_sector, q.to_sector, np.asarray(q.start), np.asarray(q.goal)) for i, j in PAIR_TYPES
+        queries = [(q.from_sector, q.to_sector, np.asarray(q.start), np.asarray(q.goal)) for i, j in SECTOR_PAIRS
                    for q in [q for q in stored if (q.from_sector, q.to_sector) == (i, j)][: args.reps]]
     else:
-        queries = [(i, j, *cross_sector_query(robot, i, j, rng)) for _ in range(args.reps) for i, j in PAIR_TYPES]
+        queries = [(i, j, *cross_sector_query(robot, i, j, rng)) for _ in range(args.reps) for i, j in SECTOR_PAIRS]
     rows = []
     for n in args.samples:
         for batch in (True, False):

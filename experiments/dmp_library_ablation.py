@@ -20,8 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from tpee_ompl.bench.results import new_output_stem
-from tpee_ompl.library.dmp import DMPOptions
-from tpee_ompl.library.path_library import DEMO_MARGINS, PathLibrary
+from tpee_ompl.library import DEMO_MARGINS, DMPOptions, PathLibrary
 from tpee_ompl.planning.paths import motion_is_valid, path_length
 from tpee_ompl.model.queries import load_queries
 from tpee_ompl.model.wearer_arm import default_robot

@@ -4,7 +4,7 @@
    (planning-necessary regions; seeds differ from the library's build seed), drawn in
    ``--workers`` processes.
 2. Every query through :meth:`PathLibrary.query` (validation, repair, dimension-RRT fallback) in this
-   process alone, so the timings are not disturbed: :func:`tpee_ompl.library.path_library.benchmark_queries`.
+   process alone, so the timings are not disturbed: :func:`tpee_ompl.library.evaluation.benchmark_queries`.
 3. The same queries planned by dimension-RRT at ``--reference-samples`` samples (workers), for the
    path-length ratio.
 
@@ -35,15 +35,16 @@ from pathlib import Path
 import numpy as np
 
 from tpee_ompl.bench.results import new_output_stem
-from tpee_ompl.library.path_library import PathLibrary, benchmark_queries, dimension_rrt_planner
+from tpee_ompl.library import PathLibrary, benchmark_queries, dimension_rrt_planner
 from tpee_ompl.planning.paths import path_length
+from tpee_ompl.resources import default_library_path
 
 log = logging.getLogger("dmp_library_benchmark")
 
 
 def _gen_queries(n_per_pair: int, seed: int) -> list[dict]:
-    from tpee_ompl.planning.query_generation import generate_queries
     from tpee_ompl.model.wearer_arm import default_robot
+    from tpee_ompl.planning.query_generation import generate_queries
 
     qs, _ = generate_queries(default_robot(), n_per_pair=n_per_pair, seed=seed)
     return [q.to_dict() for q in qs]
@@ -88,7 +89,7 @@ def _summary(rows: list[dict]) -> dict:
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--library", type=Path, default=Path("experiments/library/default.npz"))
+    ap.add_argument("--library", type=Path, default=default_library_path())
     ap.add_argument("--per-pair", type=int, default=50, help="queries per ordered sector pair (default 50)")
     ap.add_argument("--seed", type=int, default=1000, help="query seed (worker w uses seed + w; default 1000)")
     ap.add_argument("--reference-samples", type=int, default=2500, help="dimension-RRT samples of the reference")

@@ -20,12 +20,13 @@ import numpy as np
 from ompl import util as ou
 
 from tpee_ompl.bench.results import new_output_stem
-from tpee_ompl.planning.tpee import tpee_dimension_rrt
-from tpee_ompl.planning.setup import make_simple_setup
-from tpee_ompl.library.path_library import N_FAKE_TIME_STEPS, PathLibrary
-from tpee_ompl.planning.paths import motion_is_valid
+from tpee_ompl.library import N_FAKE_TIME_STEPS, PathLibrary
 from tpee_ompl.model.queries import load_queries
 from tpee_ompl.model.wearer_arm import default_robot
+from tpee_ompl.planning.paths import motion_is_valid
+from tpee_ompl.planning.setup import make_simple_setup
+from tpee_ompl.planning.tpee import tpee_dimension_rrt
+from tpee_ompl.resources import default_library_path
 
 
 def _run(robot, q, samples: int, seed: int, initial: np.ndarray | None) -> dict:
@@ -52,7 +53,7 @@ def _block(rows: list[dict], key: str) -> dict:
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--library", type=Path, default=Path("experiments/library/default.npz"))
+    ap.add_argument("--library", type=Path, default=default_library_path())
     ap.add_argument("--query-set", default="planning_necessary")
     ap.add_argument("--samples", type=int, default=500)
     ap.add_argument("--seed", type=int, default=1)

@@ -9,8 +9,7 @@ library, tracker) -> ``bench`` (campaigns) -> ``cli``.  What a user needs first 
 """
 
 from .library.dmp import DMP, DMPOptions, generate, generate_blended, learn_dmp
-from .library.path_library import LibraryFileError, PathLibrary, QueryResult
-from .library.tracker import Tracker, TrackerOptions, make_default_planner
+from .library import LibraryFileError, PathLibrary, QueryResult, Tracker, TrackerOptions, make_default_planner
 from .model.pointing import AimingError, BlindAreaError, UnreachableTargetError, aim, aim_batch, aim_checked
 from .model.queries import Query, QuerySetError, load_queries
 from .model.sectors import (

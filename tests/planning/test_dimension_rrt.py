@@ -15,7 +15,8 @@ from ompl import tools as ot
 from tpee_ompl.planning.dimension_rrt import DimensionRRT
 from tpee_ompl.planning.tpee import tpee_dimension_rrt
 from tpee_ompl.examples.planar_arm import make_planar_arm_setup
-from tpee_ompl.examples.tpee_queries import PAIR_TYPES, cross_sector_query
+from tpee_ompl.examples.tpee_queries import cross_sector_query
+from tpee_ompl.model.sectors import SECTOR_PAIRS
 from tpee_ompl.planning.setup import make_simple_setup
 from tpee_ompl.planning.paths import path_passes_motion_checks, path_to_array, set_state
 from tpee_ompl.model.wearer_arm import WearerArm
@@ -33,7 +34,7 @@ def _solve(robot: WearerArm, i: int, j: int, q0: np.ndarray, q1: np.ndarray, **k
 
 def test_valid_paths_on_all_12_pair_types(robot: WearerArm) -> None:
     rng = np.random.default_rng(7)
-    for i, j in PAIR_TYPES:
+    for i, j in SECTOR_PAIRS:
         q0, q1 = cross_sector_query(robot, i, j, rng)
         ss, planner, status = _solve(robot, i, j, q0, q1, max_samples=SAMPLES, seed=3)
         assert status == ob.PlannerStatus.EXACT_SOLUTION, (i, j)

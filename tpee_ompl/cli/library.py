@@ -15,8 +15,10 @@ from pathlib import Path
 
 import numpy as np
 
+from ..library.build import LibraryBuildOptions
+from ..library.demos import dimension_rrt_planner
 from ..library.dmp import DMPOptions
-from ..library.path_library import ALL_PAIRS, DEMO_MARGINS, LIBRARY_DMP_OPTIONS, PathLibrary, dimension_rrt_planner
+from ..library import PathLibrary
 from ..planning.paths import path_length
 from ..resources import default_library_path
 
@@ -26,9 +28,11 @@ log = logging.getLogger(__name__)
 
 DEFAULT_LIBRARY = default_library_path()
 """Default library file, shipped inside the package (``make library`` rebuilds it)."""
+_BUILD_DEFAULTS = LibraryBuildOptions()
+"""The ``library build`` defaults: those of :class:`~tpee_ompl.library.build.LibraryBuildOptions`."""
 
 _BUILD_EXAMPLE = """example:
-  tpee-ompl library build --per-pair 20 --seed 0 --workers 2 --library /tmp/default.npz
+  tpee-ompl library build --workers 2 --library /tmp/default.npz      # the packaged library's settings
   tpee-ompl library build --pairs 1-2 3-4 --per-pair 3 --max-samples 500 --library /tmp/small.npz
 """
 _QUERY_EXAMPLE = """example:
@@ -50,7 +54,7 @@ def _pair(text: str) -> tuple[int, int]:
     return i, j
 
 
-def _load(path: Path, fallback: bool = True, max_samples: int = 2500) -> PathLibrary:
+def _load(path: Path, fallback: bool = True, max_samples: int = _BUILD_DEFAULTS.max_samples) -> PathLibrary:
     from ..model.wearer_arm import default_robot
 
     if not path.exists():
@@ -60,26 +64,33 @@ def _load(path: Path, fallback: bool = True, max_samples: int = 2500) -> PathLib
     return PathLibrary.load(path, robot, plan=plan)
 
 
+def _build_options(args: argparse.Namespace) -> LibraryBuildOptions:
+    """The build settings of ``library build``'s arguments; a bad one raises ValueError naming its option."""
+    given = {"per_pair": args.per_pair, "seed": args.seed, "min_difference": args.min_difference,
+             "max_attempts": args.max_attempts, "max_samples": args.max_samples, "timeout": args.timeout,
+             "demo_margins": tuple(args.demo_margins), "workers": args.workers,
+             "dmp_options": DMPOptions(scaling=args.dmp_scaling)}
+    if args.pairs:
+        given["pairs"] = tuple(args.pairs)
+    try:
+        return LibraryBuildOptions(**given)
+    except ValueError as exc:
+        message = str(exc)
+        name = next((n for n in given if message.startswith((n, n.replace("_", " ")))), None)
+        if name is None:
+            raise
+        raise ValueError(f"--{name.replace('_', '-')}: {message}") from None
+
+
 def run_build(args: argparse.Namespace) -> int:
     """Build a library with the default sampler and dimension-RRT and save it."""
     from ..model.wearer_arm import default_robot
 
-    if args.per_pair < 1:
-        raise ValueError(f"--per-pair must be >= 1, got {args.per_pair}")
-    if args.max_samples < 1:
-        raise ValueError(f"--max-samples must be >= 1, got {args.max_samples}")
-    if args.workers < 1:
-        raise ValueError(f"--workers must be >= 1, got {args.workers}")
-    if any(not (np.isfinite(m) and 0 <= m <= 1.0) for m in args.demo_margins):
-        raise ValueError(f"--demo-margins must be numbers in [0, 1] metres, got {args.demo_margins}")
+    options = _build_options(args)
     out = Path(args.library)
     out.parent.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
-    lib = PathLibrary.build_default(default_robot(), per_pair=args.per_pair, seed=args.seed,
-                                    pairs=tuple(args.pairs or ALL_PAIRS), min_difference=args.min_difference,
-                                    max_samples=args.max_samples, timeout=args.timeout,
-                                    max_attempts=args.max_attempts, demo_margins=tuple(args.demo_margins),
-                                    workers=args.workers, options=DMPOptions(scaling=args.dmp_scaling))
+    lib = PathLibrary.build_default(default_robot(), options)
     lib.save(out)
     s = lib.stats()
     print(f"wrote {out}: {len(lib)} demonstrations in {len(lib.pairs)} pairs "
@@ -145,22 +156,29 @@ def register(subparsers: argparse._SubParsersAction, formatter_class: type = arg
     b = sub.add_parser("build", help="build a library (dimension-RRT demonstrations)", epilog=_BUILD_EXAMPLE,
                        formatter_class=formatter_class)
     common(b)
-    b.add_argument("--per-pair", type=int, default=20, help="demonstrations per ordered sector pair (default 20)")
-    b.add_argument("--seed", type=int, default=0, help="seed of the sampler and the planner (default 0)")
-    b.add_argument("--pairs", type=_pair, nargs="+", metavar="I-J", help="sector pairs (default all 12)")
-    b.add_argument("--min-difference", type=float, default=0.15,
-                   help="new demo kept only if its DOF3/DOF4 (start, goal) differs by this many rad (default 0.15)")
-    b.add_argument("--max-attempts", type=int, default=None,
+    d = _BUILD_DEFAULTS
+    b.add_argument("--per-pair", type=int, default=d.per_pair,
+                   help=f"demonstrations per ordered sector pair (default {d.per_pair})")
+    b.add_argument("--seed", type=int, default=d.seed, help=f"seed of the sampler and the planner (default {d.seed})")
+    b.add_argument("--pairs", type=_pair, nargs="+", metavar="I-J",
+                   help=f"sector pairs (default all {len(d.pairs)})")
+    b.add_argument("--min-difference", type=float, default=d.min_difference,
+                   help="new demo kept only if its DOF3/DOF4 (start, goal) differs by this many rad "
+                        f"(default {d.min_difference:g})")
+    b.add_argument("--max-attempts", type=int, default=d.max_attempts,
                    help="draws per pair before giving up on per-pair (default 3 x per-pair)")
-    b.add_argument("--max-samples", type=int, default=2500, help="dimension-RRT samples per demo (default 2500)")
-    b.add_argument("--timeout", type=float, default=10.0, help="dimension-RRT time limit per demo, s (default 10)")
-    b.add_argument("--demo-margins", type=float, nargs="*", default=list(DEMO_MARGINS), metavar="M",
+    b.add_argument("--max-samples", type=int, default=d.max_samples,
+                   help=f"dimension-RRT samples per demo (default {d.max_samples})")
+    b.add_argument("--timeout", type=float, default=d.timeout,
+                   help=f"dimension-RRT time limit per demo, s (default {d.timeout:g})")
+    b.add_argument("--demo-margins", type=float, nargs="*", default=list(d.demo_margins), metavar="M",
                    help="margins (m) around the pointing system tried, widest first, before the robot's own "
-                        f"when planning a demo (default {' '.join(map(str, DEMO_MARGINS))}; none: robot's margin only)")
-    b.add_argument("--workers", type=int, default=1, help="processes building the pairs in parallel (default 1)")
-    b.add_argument("--dmp-scaling", choices=("none", "amplitude"), default=LIBRARY_DMP_OPTIONS.scaling,
+                        f"when planning a demo (default {' '.join(map(str, d.demo_margins))}; none: robot's margin only)")
+    b.add_argument("--workers", type=int, default=d.workers,
+                   help=f"processes building the pairs in parallel (default {d.workers})")
+    b.add_argument("--dmp-scaling", choices=("none", "amplitude"), default=d.dmp_options.scaling,
                    help="DMP forcing: 'amplitude' = eq. 13's x(g - y0), 'none' = absolute "
-                        f"(default {LIBRARY_DMP_OPTIONS.scaling}; docs/dmp.md says why)")
+                        f"(default {d.dmp_options.scaling}; docs/dmp.md says why)")
     b.set_defaults(func=run_build)
 
     q = sub.add_parser("query", help="answer one query", epilog=_QUERY_EXAMPLE, formatter_class=formatter_class)

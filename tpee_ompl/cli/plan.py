@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..bench.config import CLI_PLANNER_NAMES
-from ..library.path_library import dimension_rrt_planner
+from ..library import dimension_rrt_planner
 from ..model.pointing import aim
 from ..resources import default_library_path
 from ._common import CliError, add_model_args, default_of, finite, load_robot, positive_float, positive_int, sector
@@ -182,7 +182,7 @@ def cmd_track(args: argparse.Namespace) -> int:
                 raise RuntimeError(f"dimension-RRT found no path {i}->{j}")
             return path
     elif args.planner == "library":
-        from ..library.path_library import PathLibrary
+        from ..library import PathLibrary
 
         lib = PathLibrary.load(args.library, robot, plan=dimension_rrt_planner(robot, max_samples=args.samples))
         planner = lib.as_planner()

@@ -15,10 +15,8 @@ from ..planning.paths import motion_is_valid
 from ..model.wearer_arm import WearerArm
 from ..model.sectors import cross_sector_trajectory, posture_preset
 
-__all__ = ["PAIR_TYPES", "straight_motion_valid", "cross_sector_query"]
+__all__ = ["straight_motion_valid", "cross_sector_query"]
 
-PAIR_TYPES: tuple[tuple[int, int], ...] = tuple((i, j) for i in range(1, 5) for j in range(1, 5) if i != j)
-"""The 12 cross-sector (from, to) pairs of Table 3."""
 
 
 def straight_motion_waypoints(i: int, j: int, start: np.ndarray, goal: np.ndarray) -> np.ndarray:

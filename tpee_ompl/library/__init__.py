@@ -1,4 +1,50 @@
-"""The real-time layer: DMP maths, the cross-sector path library (demos, storage, queries) and the tracker.
+"""The real-time layer: DMP maths, the cross-sector path library (demos, build, storage, queries,
+evaluation) and the tracker.
 
-Imports :mod:`tpee_ompl.model` and :mod:`tpee_ompl.planning` below it.
+Modules: :mod:`~tpee_ompl.library.dmp` (DMP maths), :mod:`~tpee_ompl.library.demos` (query sampler,
+demo planners, demos per pair), :mod:`~tpee_ompl.library.build` (build settings, DMP learning),
+:mod:`~tpee_ompl.library.path_library` (:class:`PathLibrary`, queries), :mod:`~tpee_ompl.library.storage`
+(library files), :mod:`~tpee_ompl.library.evaluation` (benchmark rows), :mod:`~tpee_ompl.library.tracker`
+(Fig. 10 target tracking).  Imports :mod:`tpee_ompl.model` and :mod:`tpee_ompl.planning` below it.
 """
+
+from .build import LIBRARY_DMP_OPTIONS, LibraryBuildOptions
+from .demos import (
+    DEMO_MARGINS,
+    N_FAKE_TIME_STEPS,
+    POINTING_LINKS,
+    DemoPlanner,
+    PairDemos,
+    dimension_rrt_planner,
+    query_sampler,
+)
+from .dmp import DMP, DMPOptions, generate, generate_blended, learn_dmp
+from .evaluation import benchmark_queries
+from .path_library import PathLibrary, QueryResult
+from .storage import FORMAT_VERSION, LibraryFileError
+from .tracker import Tracker, TrackerOptions, make_default_planner
+
+__all__ = [
+    "DEMO_MARGINS",
+    "DMP",
+    "DMPOptions",
+    "FORMAT_VERSION",
+    "LIBRARY_DMP_OPTIONS",
+    "LibraryBuildOptions",
+    "LibraryFileError",
+    "N_FAKE_TIME_STEPS",
+    "POINTING_LINKS",
+    "DemoPlanner",
+    "PairDemos",
+    "PathLibrary",
+    "QueryResult",
+    "Tracker",
+    "TrackerOptions",
+    "benchmark_queries",
+    "dimension_rrt_planner",
+    "generate",
+    "generate_blended",
+    "learn_dmp",
+    "make_default_planner",
+    "query_sampler",
+]

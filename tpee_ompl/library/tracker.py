@@ -22,11 +22,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..planning.paths import MIN_JOINT_STEP, motion_states, polyline_motion_states
 from ..model.pointing import AimingError, PointingGeometry, aim_batch, check_target
-from ..model.wearer_arm import WearerArm
-from ..validation import as_float_array
 from ..model.sectors import SECTORS, check_sector, in_pointing_sector, posture_preset, posture_sector
+from ..model.wearer_arm import WearerArm
+from ..planning.paths import MIN_JOINT_STEP, motion_is_valid, motion_states
+from ..validation import as_float_array, check_number
 
 __all__ = [
     "Planner",
@@ -59,14 +59,9 @@ class TrackerOptions:
     check_step: float = 0.01
 
     def __post_init__(self) -> None:
-        for name in ("joint_speed", "check_step"):
-            v = getattr(self, name)
-            if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)) or not (
-                math.isfinite(v) and v > 0
-            ):
-                raise ValueError(f"{name} must be a finite number > 0, got {v!r}")
-        if self.check_step < MIN_JOINT_STEP:
-            raise ValueError(f"check_step must be >= {MIN_JOINT_STEP} rad, got {self.check_step!r}")
+        set_ = lambda field_, value: object.__setattr__(self, field_, value)  # noqa: E731 (frozen dataclass)
+        set_("joint_speed", check_number("joint_speed", self.joint_speed, low=0.0, low_open=True))
+        set_("check_step", check_number("check_step", self.check_step, low=MIN_JOINT_STEP))
 
 
 @dataclass(frozen=True)
@@ -183,7 +178,7 @@ class Tracker:
         if not (np.allclose(waypoints[0], self.q, atol=1e-6) and np.allclose(waypoints[-1], goal, atol=1e-6)):
             raise ValueError("planner path does not start at the current configuration and end at the goal")
         waypoints[0], waypoints[-1] = self.q, goal
-        if not self.robot.are_valid(polyline_motion_states(waypoints, self.options.check_step)).all():
+        if not motion_is_valid(self.robot, waypoints, self.options.check_step):
             raise ValueError(f"planner path {self.sector}->{k} collides (checked every {self.options.check_step} rad)")
         self.events.append(TrackEvent(t, "cross-sector", k, f"{self.sector}->{k}: {why}, {len(waypoints)} waypoints"))
         clock = t
@@ -206,8 +201,7 @@ class Tracker:
         ValueError
             If t is not a finite number or target is not 3 numbers.
         """
-        if isinstance(t, bool) or not isinstance(t, (int, float, np.integer, np.floating)) or not math.isfinite(t):
-            raise ValueError(f"time t must be a finite number (seconds), got {t!r}")
+        t = check_number("time t (seconds)", t)
         raw = as_float_array(target, "target")
         if raw.shape != (3,):
             raise ValueError(f"target must have shape (3,); got {raw.shape}")
@@ -275,9 +269,9 @@ def make_default_planner(robot: WearerArm, *, timeout: float = 2.0, seed: int | 
     from ompl import geometric as og
     from ompl import util as ou
 
-    from ..planning.setup import make_simple_setup
-    from ..planning.paths import path_to_array
     from ..model.queries import straight_motion
+    from ..planning.paths import path_to_array
+    from ..planning.setup import make_simple_setup
 
     ou.setLogLevel(ou.LOG_WARN)
     if seed is not None:
@@ -286,7 +280,7 @@ def make_default_planner(robot: WearerArm, *, timeout: float = 2.0, seed: int | 
 
     def plan(start: np.ndarray, goal: np.ndarray, i: int, j: int) -> np.ndarray:
         w = straight_motion(start, goal, i, j) if i != j else np.array([start, goal], dtype=float)
-        if robot.are_valid(polyline_motion_states(w, step)).all():
+        if motion_is_valid(robot, w, step):
             return w
         ss = make_simple_setup(robot, start, goal)
         ss.setPlanner(og.RRTConnect(ss.getSpaceInformation()))

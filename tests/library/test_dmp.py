@@ -1,8 +1,6 @@
-"""Tests of the DMP maths (eqs. 12-17): reproduction, exact goal convergence, goal == start, speed."""
+"""Tests of the DMP maths (eqs. 12-17): reproduction, exact goal convergence, goal == start, closed-form generation."""
 
 from __future__ import annotations
-
-import time
 
 import numpy as np
 import pytest
@@ -17,14 +15,12 @@ from tpee_ompl.library.dmp import (
     integrate,
     learn_dmp,
 )
+from tpee_ompl.planning.paths import resample_waypoints
 
 
 def _demo(rng: np.random.Generator, steps: int = 7, per_step: int = 100, scale: float = 0.6) -> np.ndarray:
     """A 2-D demo like the library's: random waypoints, straight segments, quintic in fake time."""
-    W = np.cumsum(rng.uniform(-scale, scale, (steps, 2)), axis=0)
-    u = np.arange(per_step) / per_step
-    s = u**3 * (10 - 15 * u + 6 * u**2)
-    return np.vstack([W[k] + s[:, None] * (W[k + 1] - W[k]) for k in range(steps - 1)] + [W[-1:]])
+    return resample_waypoints(np.cumsum(rng.uniform(-scale, scale, (steps, 2)), axis=0), per_step)
 
 
 @pytest.mark.parametrize("seed", range(5))
@@ -119,12 +115,20 @@ def test_bad_inputs_raise_with_a_message() -> None:
         generate(dmp, np.zeros(2), np.zeros(2))
 
 
-def test_generating_one_600_point_path_takes_well_under_a_millisecond(rng: np.random.Generator) -> None:
+def test_generation_is_closed_form_and_batched(rng: np.random.Generator, monkeypatch) -> None:
+    """Generating a path never steps the dynamics (no call of integrate) and a batch equals one call per query."""
+    import tpee_ompl.library.dmp as dmp_module
+
     demo = _demo(rng)
     fwd, rev = learn_dmp(demo), learn_dmp(demo[::-1])
-    start, goal = demo[0] + 0.1, demo[-1] - 0.1
-    n = 200
-    t0 = time.perf_counter()
-    for _ in range(n):
-        generate_blended(fwd, rev, start, goal)
-    assert (time.perf_counter() - t0) / n < 0.5e-3
+    starts = demo[0] + rng.uniform(-0.2, 0.2, (200, 2))
+    goals = demo[-1] + rng.uniform(-0.2, 0.2, (200, 2))
+
+    def no_integration(*args, **kwargs):
+        raise AssertionError("generation must not integrate the dynamics")
+
+    monkeypatch.setattr(dmp_module, "integrate", no_integration)
+    batch = generate_blended(fwd, rev, starts, goals)
+    assert batch.shape == (200, fwd.n_steps, 2) and np.all(np.isfinite(batch))
+    for k in (0, 99, 199):
+        np.testing.assert_array_equal(batch[k], generate_blended(fwd, rev, starts[k], goals[k]))

@@ -7,11 +7,11 @@ import itertools
 import numpy as np
 import pytest
 
-from tpee_ompl.planning.paths import motion_states
+from tpee_ompl.library.tracker import Tracker, make_default_planner
 from tpee_ompl.model.pointing import aim_errors
 from tpee_ompl.model.queries import straight_motion
 from tpee_ompl.model.sectors import posture_sector, sector_origin
-from tpee_ompl.library.tracker import Tracker, make_default_planner
+from tpee_ompl.planning.paths import motion_states
 
 
 def _direction(az_deg: float, el_deg: float) -> np.ndarray:

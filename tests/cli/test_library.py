@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from tpee_ompl.cli.library import DEFAULT_LIBRARY, build_parser
-from tpee_ompl.library.path_library import PathLibrary
+from tpee_ompl.library import PathLibrary
 
 
 def _run(argv: list[str]) -> int:
@@ -38,8 +38,8 @@ def test_stats_describes_the_file(small_file: str, capsys) -> None:
 
 
 def test_query_from_a_named_set_prints_a_checked_path_as_json(robot, small_file: str, capsys) -> None:
-    from tpee_ompl.planning.paths import motion_is_valid
     from tpee_ompl.model.queries import load_queries
+    from tpee_ompl.planning.paths import motion_is_valid
 
     q = load_queries("planning_necessary")[0]
     assert (q.from_sector, q.to_sector) == (1, 2)

@@ -1,0 +1,69 @@
+"""Tests of the build settings and the default build: :class:`LibraryBuildOptions`, workers, determinism."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+from helpers.library_standins import RRT_PAIRS
+
+from tpee_ompl.library import DEMO_MARGINS, LIBRARY_DMP_OPTIONS, LibraryBuildOptions, PathLibrary
+from tpee_ompl.model.wearer_arm import WearerArm
+from tpee_ompl.planning.paths import motion_is_valid
+
+
+@pytest.mark.slow
+def test_seeded_default_build_is_deterministic_with_one_or_two_workers(robot: WearerArm, rrt_library: PathLibrary) -> None:
+    again = PathLibrary.build_default(robot, per_pair=2, seed=3, pairs=RRT_PAIRS, max_samples=300, timeout=5.0, workers=2)
+    for pair in RRT_PAIRS:
+        a, b = rrt_library.pairs[pair], again.pairs[pair]
+        assert np.array_equal(a.starts, b.starts) and np.array_equal(a.goals, b.goals)
+        assert np.array_equal(a.waypoints, b.waypoints) and np.array_equal(a.margins, b.margins, equal_nan=True)
+    assert again.build_stats == rrt_library.build_stats
+
+
+@pytest.mark.slow
+def test_worker_processes_plan_with_the_callers_robot_and_its_margins() -> None:
+    strict = WearerArm(link_margins={"link3": 0.03, "link4": 0.03})
+    kw = {"per_pair": 1, "seed": 5, "pairs": ((1, 2), (2, 1)), "max_samples": 200, "timeout": 5.0, "demo_margins": ()}
+    one, two = PathLibrary.build_default(strict, workers=1, **kw), PathLibrary.build_default(strict, workers=2, **kw)
+    for pair in kw["pairs"]:
+        assert np.array_equal(one.pairs[pair].waypoints, two.pairs[pair].waypoints)
+        for W in two.pairs[pair].waypoints:
+            assert motion_is_valid(strict, W)
+
+
+def test_default_options_are_the_packaged_librarys_settings() -> None:
+    opts = LibraryBuildOptions()
+    assert (opts.per_pair, opts.seed, len(opts.pairs), opts.min_difference) == (20, 0, 12, 0.15)
+    assert opts.max_attempts is None and opts.draws_per_pair == 60
+    assert opts.demo_margins == DEMO_MARGINS and opts.dmp_options == LIBRARY_DMP_OPTIONS
+    assert dataclasses.replace(opts, per_pair=4).draws_per_pair == 12
+    assert dataclasses.replace(opts, max_attempts=5).draws_per_pair == 5
+
+
+@pytest.mark.parametrize(
+    "field, value, match",
+    [("per_pair", 0, "per_pair"), ("per_pair", 2.0, "per_pair"), ("per_pair", True, "per_pair"),
+     ("seed", -1, "seed"), ("min_difference", float("nan"), "min_difference"), ("min_difference", -0.1, "min_difference"),
+     ("max_attempts", 0, "max_attempts"), ("per_step", 0, "per_step"), ("max_samples", 0, "max_samples"),
+     ("timeout", 0.0, "timeout"), ("require_planning", 1, "require_planning"), ("demo_margins", (2.0,), "demo margins"),
+     ("demo_margins", ("wide",), "demo margins"), ("workers", 0, "workers"), ("dmp_options", None, "dmp_options"),
+     ("pairs", ((2, 2),), "not a cross-sector motion"), ("pairs", ((1, 5),), "sector"), ("pairs", 3, "pairs")],
+)
+def test_bad_build_options_are_refused_naming_the_field(field: str, value, match: str) -> None:
+    with pytest.raises(ValueError, match=match):
+        LibraryBuildOptions(**{field: value})
+
+
+def test_options_are_normalised_once() -> None:
+    opts = LibraryBuildOptions(pairs=[[np.int64(1), 2]], demo_margins=[0.03], min_difference=1, timeout=5)
+    assert opts.pairs == ((1, 2),) and opts.demo_margins == (0.03,)
+    assert isinstance(opts.min_difference, float) and isinstance(opts.timeout, float)
+
+
+def test_build_default_refuses_options_of_another_type(robot: WearerArm) -> None:
+    with pytest.raises(ValueError, match="LibraryBuildOptions"):
+        PathLibrary.build_default(robot, LIBRARY_DMP_OPTIONS)  # type: ignore[arg-type]
+

@@ -1,0 +1,55 @@
+"""Tests of library files (:mod:`tpee_ompl.library.storage`): round trip, damaged files, other model or version."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from helpers.library_standins import RRT_PAIRS, necessary_queries
+
+from tpee_ompl.library import LibraryFileError, PathLibrary
+from tpee_ompl.model.wearer_arm import WearerArm
+
+
+def test_library_round_trips_through_disk(robot: WearerArm, library: PathLibrary, tmp_path) -> None:
+    f = library.save(tmp_path / "lib.npz")
+    loaded = PathLibrary.load(f, robot)
+    assert set(loaded.pairs) == set(library.pairs) and len(loaded) == len(library)
+    (i, j), pd = next(iter(library.pairs.items()))
+    rng = np.random.default_rng(0)
+    start = pd.starts[0] + np.r_[0, 0, rng.uniform(-0.1, 0.1, 2)]
+    goal = pd.goals[-1]
+    for k in range(len(pd.starts)):
+        assert np.array_equal(loaded.generate(start, goal, i, j, k), library.generate(start, goal, i, j, k))
+
+
+def test_truncated_library_file_is_refused(robot: WearerArm, library: PathLibrary, tmp_path) -> None:
+    f = library.save(tmp_path / "lib.npz")
+    data = f.read_bytes()
+    f.write_bytes(data[: len(data) // 2])
+    with pytest.raises(LibraryFileError, match="truncated"):
+        PathLibrary.load(f, robot)
+
+
+def test_library_from_another_model_or_version_is_refused(robot: WearerArm, library: PathLibrary, tmp_path, monkeypatch) -> None:
+    import tpee_ompl.library.storage as storage
+
+    f = library.save(tmp_path / "lib.npz")
+
+    class OtherModel:
+        model_hash = "0123456789abcdef"
+
+    with pytest.raises(LibraryFileError, match="built for model"):
+        PathLibrary.load(f, OtherModel())  # type: ignore[arg-type]
+    monkeypatch.setattr(storage, "FORMAT_VERSION", storage.FORMAT_VERSION + 1)
+    with pytest.raises(LibraryFileError, match="format version"):
+        PathLibrary.load(f, robot)
+
+
+@pytest.mark.slow
+def test_build_parameters_survive_the_round_trip(robot: WearerArm, rrt_library: PathLibrary, tmp_path) -> None:
+    loaded = PathLibrary.load(rrt_library.save(tmp_path / "lib.npz"), robot)
+    assert loaded.build_params == rrt_library.build_params and loaded.query_stride == rrt_library.query_stride
+    q = necessary_queries(RRT_PAIRS, 1)[0]
+    for k in range(2):
+        assert np.array_equal(loaded.generate(q.start, q.goal, q.from_sector, q.to_sector, k, stride=10),
+                              rrt_library.generate(q.start, q.goal, q.from_sector, q.to_sector, k, stride=10))
