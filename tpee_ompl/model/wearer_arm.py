@@ -18,7 +18,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..resources import model_file
-from ..validation import as_float_array
+from ..validation import as_float_array, check_int, check_number
 from .urdf_loading import ARM_JOINTS, MUZZLE_FRAME, ModelFiles, bounding_radius, load_wearer_model
 
 __all__ = [
@@ -98,18 +98,8 @@ class WearerArm:
         n_threads: int | None = None,
         link_margins: Mapping[str, float] | None = None,
     ) -> None:
-        if (
-            isinstance(security_margin, bool)
-            or not isinstance(security_margin, (int, float, np.integer, np.floating))
-            or not 0 <= float(security_margin) <= MAX_SECURITY_MARGIN
-        ):
-            raise ValueError(
-                f"security_margin must be a number in [0, {MAX_SECURITY_MARGIN}] metres, got {security_margin!r}"
-            )
-        if n_threads is not None and (
-            isinstance(n_threads, bool) or not isinstance(n_threads, (int, np.integer)) or not 1 <= n_threads <= 1024
-        ):
-            raise ValueError(f"n_threads must be None or an integer in [1, 1024], got {n_threads!r}")
+        security_margin = check_number("security_margin (metres)", security_margin, low=0.0, high=MAX_SECURITY_MARGIN)
+        n_threads = check_int("n_threads", n_threads, minimum=1, maximum=1024, optional=True)
         for what, value in (("urdf_path", urdf_path), ("srdf_path", srdf_path)):
             if value is not None and value is not False and not isinstance(value, (str, os.PathLike)):
                 raise ValueError(f"{what} must be a path, None or (srdf_path only) False, got {value!r}")
@@ -178,17 +168,10 @@ class WearerArm:
             raise ValueError(f"link_margins must be a mapping {{link name: metres}}, got {link_margins!r}")
         out = {}
         for name, m in link_margins.items():
-            if (
-                not isinstance(name, str)
-                or isinstance(m, bool)
-                or not isinstance(m, (int, float, np.integer, np.floating))
-                or not base <= float(m) <= MAX_SECURITY_MARGIN
-            ):
-                raise ValueError(
-                    f"link_margins[{name!r}] must be a number in [security_margin = {base}, {MAX_SECURITY_MARGIN}] "
-                    f"metres, got {m!r}"
-                )
-            out[name] = float(m)
+            if not isinstance(name, str):
+                raise ValueError(f"link_margins keys must be link names, got {name!r}")
+            out[name] = check_number(f"link_margins[{name!r}] (metres, >= security_margin = {base})", m,
+                                     low=base, high=MAX_SECURITY_MARGIN)
         return out
 
     def _margin_matrix(self) -> np.ndarray:

@@ -28,6 +28,7 @@ import numpy as np
 from ompl import base as ob
 from ompl import geometric as og
 
+from ..validation import check_int
 from .paths import array_to_path, path_to_array
 
 __all__ = [
@@ -238,9 +239,7 @@ class GroupedSpace:
             space = space.getStateSpace()
         self.layout = RealVectorLayout(space)
         n = self.layout.n
-        if isinstance(h, bool) or not isinstance(h, (int, np.integer)) or not 3 <= h <= MAX_H:
-            raise ValueError(f"h (fake-time steps incl. start and goal) must be an integer in [3, {MAX_H}], got {h!r}")
-        self.h = int(h)
+        self.h = check_int("h (fake-time steps incl. start and goal)", h, minimum=3, maximum=MAX_H)
         self.groups = validate_groups(default_groups(n) if groups is None else groups, n)
         self.prescribed = validate_prescribed(prescribed, self.groups, self.h)
         self.planned = [g for g in range(len(self.groups)) if g not in self.prescribed]

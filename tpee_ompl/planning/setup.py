@@ -14,7 +14,6 @@ least m/2 (1 cm by default) from the wearer and from the arm's own non-adjacent 
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 
 import numpy as np
@@ -22,6 +21,7 @@ from ompl import base as ob
 from ompl import geometric as og
 
 from ..model.wearer_arm import WearerArm
+from ..validation import check_number
 from .paths import MIN_JOINT_STEP, motion_states, set_state, state_to_array
 
 __all__ = [
@@ -133,19 +133,12 @@ def make_simple_setup(
     ``getSpaceInformation()`` is fully set up on return; :func:`motion_check_step` gives back the
     joint step it checks motions at.
     """
-    if joint_step is None:
-        step = robot.max_joint_step()
-    elif isinstance(joint_step, bool) or not isinstance(joint_step, (int, float, np.integer, np.floating)):
-        raise ValueError(f"joint_step must be a number (radians), got {joint_step!r}")
-    else:
-        step = float(joint_step)
     space = make_space(robot)
     extent = float(space.getMaximumExtent())
-    if not (math.isfinite(step) and MIN_JOINT_STEP <= step < extent):
-        raise ValueError(
-            f"joint_step must be a finite number in [{MIN_JOINT_STEP}, {extent:.4g}) rad "
-            f"(the space's extent), got {joint_step!r}"
-        )
+    step = check_number("joint_step (radians, below the space's extent)", joint_step, low=MIN_JOINT_STEP, high=extent,
+                        high_open=True, optional=True)
+    if step is None:
+        step = robot.max_joint_step()
     ss = og.SimpleSetup(space)
     si = ss.getSpaceInformation()
     checker = WearerValidityChecker(si, robot)
