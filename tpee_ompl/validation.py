@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["as_float_array", "check_bool", "check_int", "check_name", "check_number"]
+__all__ = ["MAX_SEED", "as_float_array", "check_bool", "check_int", "check_name", "check_number", "check_seed"]
 
 
 def check_int(name: str, value: Any, *, minimum: int | None = None, maximum: int | None = None,
@@ -65,3 +65,15 @@ def as_float_array(x: object, what: str) -> np.ndarray:
         return np.asarray(x, dtype=float)
     except (TypeError, ValueError) as exc:
         raise ValueError(f"{what} must be numbers, got {x!r} ({exc})") from exc
+
+
+MAX_SEED = 2**32 - 1
+"""Largest accepted seed (OMPL's ``RNG.setSeed`` takes an unsigned integer; numpy's generators accept it too)."""
+
+
+def check_seed(name: str, value: Any) -> int:
+    """A seed for OMPL's ``RNG.setSeed`` and numpy: an integer in [1, 2**32 - 1].
+
+    0 is refused: OMPL ignores it with a warning ("seed cannot be 0") and would run unseeded.
+    """
+    return check_int(name, value, minimum=1, maximum=MAX_SEED)

@@ -1,0 +1,55 @@
+"""Atomic writes: a failed write leaves the old file and no temporary behind; nothing is replaced without force."""
+
+from __future__ import annotations
+
+import pytest
+
+from tpee_ompl.files import OutputExistsError, atomic_path, atomic_write_text, check_output_path
+from tpee_ompl.validation import MAX_SEED, check_seed
+
+
+def test_atomic_write_replaces_the_file_in_one_step(tmp_path):
+    target = tmp_path / "a.txt"
+    atomic_write_text(target, "one")
+    atomic_write_text(target, "two")
+    assert target.read_text() == "two" and [p.name for p in tmp_path.iterdir()] == ["a.txt"]
+
+
+def test_failed_write_keeps_the_old_file_and_leaves_no_temporary(tmp_path):
+    target = tmp_path / "lib.npz"
+    target.write_bytes(b"old")
+    with pytest.raises(KeyboardInterrupt), atomic_path(target) as tmp:
+        tmp.write_bytes(b"half")
+        raise KeyboardInterrupt
+    assert target.read_bytes() == b"old" and [p.name for p in tmp_path.iterdir()] == ["lib.npz"]
+
+
+def test_existing_file_is_not_replaced_without_force(tmp_path):
+    target = tmp_path / "r.json"
+    target.write_text("keep")
+    with pytest.raises(OutputExistsError, match="--force"):
+        atomic_write_text(target, "new", force=False)
+    with pytest.raises(OutputExistsError, match="--force"):
+        check_output_path(target)
+    assert target.read_text() == "keep"
+    assert check_output_path(target, force=True) == target
+
+
+def test_output_path_that_is_a_folder_or_under_a_file_is_refused_naming_it(tmp_path):
+    with pytest.raises(ValueError, match="is a folder"):
+        check_output_path(tmp_path)
+    (tmp_path / "f").write_text("x")
+    with pytest.raises(ValueError, match="is a file"):
+        check_output_path(tmp_path / "f" / "out.png")
+    assert check_output_path(tmp_path / "new" / "out.png").name == "out.png"
+    assert not (tmp_path / "new").exists()  # checking creates nothing
+
+
+@pytest.mark.parametrize("seed", [0, -5, MAX_SEED + 1, 10**20, 1.5, True, "3", None])
+def test_bad_seeds_are_refused_naming_the_argument(seed):
+    with pytest.raises(ValueError, match="seed"):
+        check_seed("seed", seed)
+
+
+def test_seed_range_ends_are_accepted():
+    assert check_seed("seed", 1) == 1 and check_seed("seed", MAX_SEED) == MAX_SEED

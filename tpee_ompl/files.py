@@ -1,0 +1,91 @@
+"""Writing files safely: atomically (a crash never leaves half a file) and never over an existing one unless asked.
+
+Every file the project writes (libraries, databases, campaign files, figures) goes through
+:func:`atomic_write`: the data go to a temporary file in the target's folder, are flushed to disk, then
+``os.replace`` puts them in place in one step.  :func:`check_output_path` is called before any work
+starts, so a refused target costs nothing and leaves nothing behind.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import tempfile
+from collections.abc import Callable, Iterator
+from pathlib import Path
+
+__all__ = ["OutputExistsError", "atomic_path", "atomic_write", "atomic_write_bytes", "atomic_write_text",
+           "check_output_path"]
+
+
+class OutputExistsError(FileExistsError):
+    """The output file exists and overwriting was not asked for (``--force``)."""
+
+
+def check_output_path(path: str | os.PathLike, *, force: bool = False, what: str = "output file") -> Path:
+    """Check that ``path`` can be written: not a folder, its folder exists or can be made, no file there
+    unless ``force``.  Nothing is created.
+
+    Raises
+    ------
+    OutputExistsError
+        The file exists and ``force`` is False.
+    ValueError
+        ``path`` is a folder, or a parent is a file.
+    """
+    p = Path(path)
+    if p.is_dir():
+        raise ValueError(f"{what} {p} is a folder; give a file name")
+    for parent in p.parents:
+        if parent.exists():
+            if not parent.is_dir():
+                raise ValueError(f"{what} {p}: {parent} is a file, not a folder")
+            if not os.access(parent, os.W_OK):
+                raise ValueError(f"{what} {p}: folder {parent} is not writable")
+            break
+    if p.exists() and not force:
+        raise OutputExistsError(f"{what} {p} exists; pass --force to replace it")
+    return p
+
+
+@contextlib.contextmanager
+def atomic_path(path: str | os.PathLike, *, force: bool = True, suffix: str | None = None) -> Iterator[Path]:
+    """A temporary path beside ``path`` to write to; on success it replaces ``path`` in one step.
+
+    On an exception (or KeyboardInterrupt) the temporary file is removed and ``path`` is unchanged.
+    ``suffix`` (default: ``path``'s own) keeps writers that choose a format by file name happy.
+    With ``force=False`` an existing ``path`` raises :class:`OutputExistsError` before anything is written.
+    """
+    target = Path(path)
+    if target.exists() and not force:
+        raise OutputExistsError(f"{target} exists; pass --force to replace it")
+    target.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp_name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=(target.suffix if suffix is None else suffix) + ".part",
+                                    dir=target.parent)
+    os.close(fd)
+    tmp = Path(tmp_name)
+    try:
+        yield tmp
+        with open(tmp, "rb+") as f:
+            os.fsync(f.fileno())
+        os.replace(tmp, target)
+    finally:
+        with contextlib.suppress(FileNotFoundError):
+            tmp.unlink()
+
+
+def atomic_write(path: str | os.PathLike, write: Callable[[Path], object], *, force: bool = True) -> Path:
+    """Call ``write(tmp_path)`` and move the result to ``path`` atomically; returns ``path``."""
+    with atomic_path(path, force=force) as tmp:
+        write(tmp)
+    return Path(path)
+
+
+def atomic_write_bytes(path: str | os.PathLike, data: bytes, *, force: bool = True) -> Path:
+    """Write ``data`` to ``path`` atomically."""
+    return atomic_write(path, lambda tmp: tmp.write_bytes(data), force=force)
+
+
+def atomic_write_text(path: str | os.PathLike, text: str, *, force: bool = True) -> Path:
+    """Write ``text`` (UTF-8) to ``path`` atomically."""
+    return atomic_write(path, lambda tmp: tmp.write_text(text, encoding="utf-8"), force=force)
