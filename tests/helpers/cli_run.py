@@ -11,7 +11,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-CLI = [sys.executable, "-m", "tpee_ompl.cli.main"]
+CLI = [sys.executable, "-m", "tpee_ompl.cli"]
 
 
 def run_cli(args: list[str], cwd: Path, timeout: float = 120.0) -> subprocess.CompletedProcess:

@@ -10,13 +10,15 @@ import argparse
 import inspect
 import math
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, NoReturn
 
 if TYPE_CHECKING:
     from ..model.wearer_arm import WearerArm
 
 __all__ = [
     "CliError",
+    "Parser",
+    "seed",
     "add_model_args",
     "default_of",
     "finite",
@@ -29,6 +31,17 @@ __all__ = [
 
 class CliError(Exception):
     """A user-facing error: printed as one line, exit code 2."""
+
+
+class Parser(argparse.ArgumentParser):
+    """An ``ArgumentParser`` whose usage errors are ONE line on stderr (exit 2), naming the argument.
+
+    argparse's own ``error`` prints the whole usage block first; a user (or a script reading stderr)
+    should see only what was wrong.  Subparsers made from it are of this class too.
+    """
+
+    def error(self, message: str) -> NoReturn:  # noqa: D102 (argparse override)
+        self.exit(2, f"{self.prog}: error: {message} (see --help)\n")
 
 
 # ---------------------------------------------------------------------------------------- argument types
@@ -54,6 +67,16 @@ def positive_float(text: str) -> float:
     if v <= 0:
         raise argparse.ArgumentTypeError(f"must be > 0: {text}")
     return v
+
+
+def seed(text: str) -> int:
+    """argparse type: a seed for OMPL and numpy, an integer in [1, 2**32 - 1] (OMPL ignores 0)."""
+    from ..validation import check_seed
+
+    try:
+        return check_seed("seed", int(text))
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc).removeprefix("seed ")) from None
 
 
 def sector(text: str) -> int:

@@ -16,6 +16,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from ..bench.config import CHECKERS, CampaignConfig
+from ._common import Parser
 
 __all__ = ["DESCRIPTION", "EXAMPLE", "add_arguments", "build_parser", "config_from_args", "main", "register", "run"]
 
@@ -73,7 +74,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def build_parser(prog: str | None = None) -> argparse.ArgumentParser:
     """The stand-alone parser (``experiments/run_benchmark.py``)."""
-    p = argparse.ArgumentParser(prog=prog, description=DESCRIPTION)
+    p = Parser(prog=prog, description=DESCRIPTION)
     add_arguments(p)
     return p
 

@@ -21,6 +21,7 @@ from ..library.dmp import DMPOptions
 from ..library import PathLibrary
 from ..planning.paths import path_length
 from ..resources import default_library_path
+from ._common import Parser
 
 __all__ = ["DEFAULT_LIBRARY", "build_parser", "register", "run_build", "run_query", "run_stats"]
 
@@ -201,6 +202,6 @@ def register(subparsers: argparse._SubParsersAction, formatter_class: type = arg
 
 def build_parser() -> argparse.ArgumentParser:
     """A stand-alone parser with only the ``library`` subcommand (for scripts and tests)."""
-    parser = argparse.ArgumentParser(prog="tpee-ompl", formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = Parser(prog="tpee-ompl", formatter_class=argparse.RawDescriptionHelpFormatter)
     register(parser.add_subparsers(dest="command", required=True), argparse.RawDescriptionHelpFormatter)
     return parser

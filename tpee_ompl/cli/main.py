@@ -14,7 +14,7 @@ import logging
 import sys
 from collections.abc import Sequence
 
-from ._common import CliError
+from ._common import CliError, Parser
 from .bench import register as register_bench
 from .library import register as register_library
 from .pictures import register as register_pictures
@@ -25,7 +25,7 @@ __all__ = ["get_argument_parser", "main"]
 
 def get_argument_parser() -> argparse.ArgumentParser:
     """The full ``tpee-ompl`` argument parser."""
-    parser = argparse.ArgumentParser(prog="tpee-ompl", description=__doc__.split("\n")[0])
+    parser = Parser(prog="tpee-ompl", description=__doc__.split("\n")[0])
     parser.add_argument("-v", "--verbose", action="store_true", help="log at INFO level")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     fmt = argparse.RawDescriptionHelpFormatter
