@@ -79,6 +79,41 @@ def test_compound_layout_reads_writes_and_measures_like_ompl() -> None:
     assert float(lay.distance(lay.read(x), lay.read(y))) == pytest.approx(si.distance(x, y))
 
 
-def test_non_real_vector_space_is_rejected() -> None:
-    with pytest.raises(ValueError, match="RealVector"):
-        RealVectorLayout(ob.SO2StateSpace())
+@pytest.mark.parametrize("make", [ob.SE2StateSpace, ob.SO3StateSpace, lambda: ob.TimeStateSpace()])
+def test_other_space_types_are_refused_by_name(make) -> None:
+    space = make()
+    with pytest.raises(ValueError, match=type(space).__name__):
+        RealVectorLayout(space)
+    cs = ob.CompoundStateSpace()
+    cs.addSubspace(ob.SO2StateSpace(), 1.0)
+    cs.addSubspace(space, 1.0)
+    with pytest.raises(ValueError, match=rf"{type(space).__name__} \(subspace \[1\]\)"):
+        RealVectorLayout(cs)
+
+
+def test_real_vector_space_without_bounds_is_refused() -> None:
+    with pytest.raises(ValueError, match="bounds"):
+        RealVectorLayout(ob.RealVectorStateSpace(3))
+
+
+def test_so2_leaves_wrap_around_like_the_space() -> None:
+    cs = ob.CompoundStateSpace()
+    cs.addSubspace(ob.SO2StateSpace(), 1.0)
+    r = ob.RealVectorStateSpace(1)
+    r.setBounds(-1.0, 1.0)
+    cs.addSubspace(r, 0.5)
+    si = ob.SpaceInformation(cs)
+    si.setStateValidityChecker(lambda s: True)
+    si.setup()
+    lay = RealVectorLayout(cs)
+    assert lay.n == 2 and list(lay.circular) == [True, False]
+    a, b = np.array([3.0, 0.2]), np.array([-3.0, -0.4])
+    x, y = lay.write(si.allocState(), a), lay.write(si.allocState(), b)
+    np.testing.assert_allclose(lay.read(x), a)
+    assert float(lay.distance(a, b)) == pytest.approx(si.distance(x, y))
+    assert float(lay.distance(a, b)) < 0.3 + 0.5 * 0.6 + 1e-9  # across +-pi, not 6 rad
+    m = si.allocState()
+    cs.interpolate(x, y, 0.25, m)
+    np.testing.assert_allclose(lay.interpolate(a, b, 0.25), lay.read(m), atol=1e-12)
+    mid = lay.interpolate(a, b, 0.5)
+    assert abs(abs(mid[0]) - np.pi) < 1e-9

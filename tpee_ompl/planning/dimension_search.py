@@ -16,9 +16,10 @@ import numpy as np
 from ompl import base as ob
 
 from .grouped_space import GroupedSpace, RealVectorLayout
+from .layered_trees import LayeredTrees, spread_waypoints
 from .paths import motion_interior_states
 
-__all__ = ["Checker", "Layer", "LayeredTrees", "Search"]
+__all__ = ["Checker", "Search"]
 
 _COARSE_STRIDE = 8
 """First pass over a motion checks every 8th interior state (collisions span many states)."""
@@ -188,6 +189,11 @@ class Search:
         self._dims = {gi: grouped.group_dims(gi) for gi in grouped.planned}
         self._bounds = {gi: grouped.group_bounds(gi) for gi in grouped.planned}
         self._tree: LayeredTrees | None = None
+        # feasibility phase: all planned groups vary jointly (with one planned group: that group)
+        self._fdims = np.concatenate([self._dims[gi] for gi in grouped.planned]) if grouped.planned else np.zeros(0, int)
+        self._fbounds = (grouped.layout.lower[self._fdims], grouped.layout.upper[self._fdims])
+        self._hold = not grouped.prescribed
+        self.delta = grouped.layout.delta
         self._uniform = np.empty((0, 0))
         self._normal = np.empty((0, 0))
         self._ui = 0
@@ -214,19 +220,21 @@ class Search:
         planned = self.g.planned
         return planned[(self.samples // _GROUP_BLOCK) % len(planned)]
 
-    def draw(self, gi: int) -> np.ndarray:
-        """One k_i-dimensional sample for group gi: repair, narrowed or uniform (module docstring)."""
-        d = self._dims[gi]
-        lo, hi = self._bounds[gi]
+    def draw(self, gi: int | None) -> np.ndarray:
+        """One sample: for group gi (narrowed or uniform), or with gi None for the feasibility phase's
+        joint planned DOFs (repair around a tree node, or uniform); see the module docstring."""
+        d = self._fdims if gi is None else self._dims[gi]
+        lo, hi = self._fbounds if gi is None else self._bounds[gi]
         u, z = self._next_random(len(d))
         span = hi - lo
-        valid = self.valid
-        if not valid and u[0] < _REPAIR_FRACTION and self._tree is not None:
-            anchor = self._tree.anchor(u[1])
-            sigma = span * _REPAIR_SIGMA[0] * (_REPAIR_SIGMA[1] / _REPAIR_SIGMA[0]) ** u[2]
-            return np.clip(anchor + sigma * z, lo, hi)
+        if gi is None:
+            if u[0] < _REPAIR_FRACTION and self._tree is not None:
+                anchor = self._tree.anchor(u[1])
+                sigma = span * _REPAIR_SIGMA[0] * (_REPAIR_SIGMA[1] / _REPAIR_SIGMA[0]) ** u[2]
+                return np.clip(anchor + sigma * z, lo, hi)
+            return lo + u[3:] * span
         n0 = self.narrow_start[gi]
-        if n0 is None and valid and self.group_samples[gi] >= self.narrow_after:
+        if n0 is None and self.group_samples[gi] >= self.narrow_after:
             n0 = self.narrow_start[gi] = self.group_samples[gi]
         if n0 is not None and u[0] >= _UNIFORM_FRACTION:
             m = self.group_samples[gi] - n0
@@ -237,16 +245,17 @@ class Search:
         return lo + u[3:] * (hi - lo)
 
     def iterate(self) -> int:
-        """Draw one sample for the current group and try it at every intermediate step.
+        """Draw one sample and try it at every intermediate step.
 
-        Returns the number of waypoints changed (feasibility phase: 1 when the layered trees
-        connected, 0 otherwise).
+        On a valid path the sample is the current group's (paper's rule); before, it covers all
+        planned groups at once and grows the layered trees.  Returns the number of waypoints
+        changed (feasibility phase: 1 when the layered trees connected, 0 otherwise).
         """
         gi = self.current_group()
         valid = self.valid
-        if not valid and (self._tree is None or self._tree.group != gi):
-            self._tree = LayeredTrees(self, gi)
-        c = self.draw(gi)
+        if not valid and self._tree is None:
+            self._tree = LayeredTrees(self.W, self.V, self.E, self._fdims, self._hold, self.delta)
+        c = self.draw(gi if valid else None)
         self.samples += 1
         self.group_samples[gi] += 1
         return self._improve(gi, c) if valid else self._grow(c)
@@ -255,28 +264,24 @@ class Search:
         """Feasibility phase: extend the forward/backward layered trees with the sample c."""
         tree = self._tree
         d = tree.dims
-        h = self.g.h
-        ts, fi, bi = [], [], []
-        for t in range(1, h - 1):
-            f = tree.fwd[t - 1].nearest(c)
-            b = tree.bwd[t + 1].nearest(c)
-            if f >= 0 or b >= 0:
-                ts.append(t)
-                fi.append(f)
-                bi.append(b)
+        fi_all, bi_all = tree.nearest(c)
+        ts = [t for t in range(1, self.g.h - 1) if fi_all[t - 1] >= 0 or bi_all[t - 1] >= 0]
         if not ts:
             return 0
+        fi = [fi_all[t - 1] for t in ts]
+        bi = [bi_all[t - 1] for t in ts]
         ts_a = np.array(ts)
-        C = self.W[ts_a].copy()
+        base = tree.base
+        C = base[ts_a].copy()
         C[:, d] = c
-        A = self.W[ts_a - 1].copy()
-        B = self.W[ts_a + 1].copy()
-        for k, t in enumerate(ts):
-            if fi[k] >= 0:
-                A[k, d] = tree.fwd[t - 1].values[fi[k]]
-            if bi[k] >= 0:
-                B[k, d] = tree.bwd[t + 1].values[bi[k]]
+        A = base[ts_a - 1].copy()
+        B = base[ts_a + 1].copy()
         has_f, has_b = np.array(fi) >= 0, np.array(bi) >= 0
+        for k in range(len(ts)):
+            if fi[k] >= 0:
+                A[k, d] = tree.fwd.values[fi[k]]
+            if bi[k] >= 0:
+                B[k, d] = tree.bwd.values[bi[k]]
         vc, left, right = self.checker.candidates(C, A, B, has_f, has_b, np.zeros(len(ts), dtype=bool))
         for k, t in enumerate(ts):
             if not vc[k]:
@@ -286,13 +291,20 @@ class Search:
                 self._tree = None
                 return 1
             if left[k]:
-                tree.fwd[t].add(c, fi[k])
+                tree.fwd.add(c, t, fi[k])
             if right[k]:
-                tree.bwd[t].add(c, bi[k])
+                tree.bwd.add(c, t, bi[k])
         return 0
 
     def _adopt(self, W: np.ndarray) -> None:
-        """Take W (h, n), checked by the trees, as the current (valid) path."""
+        """Take W (h, n), checked by the trees, as the current (valid) path.
+
+        Held (repeated) waypoints are first spread along the path's segments when the spread path
+        passes the checker too, so every fake-time step can take part in the improvement."""
+        if self._hold:
+            S = spread_waypoints(W, self.g.layout.interpolate, self.dist)
+            if S is not W and self.checker.states(S[1:-1]).all() and self.checker.motions(S[:-1], S[1:]).all():
+                W = S
         self.W[:] = W
         self.V[:] = True
         self.E[:] = True
@@ -326,76 +338,3 @@ class Search:
             accepted += 1
             last = t
         return accepted
-
-
-class Layer:
-    """Nodes of one fake-time layer of a layered tree: group values and parent indices."""
-
-    def __init__(self, k: int) -> None:
-        self.values = np.empty((16, k))
-        self.parents: list[int] = []
-
-    def __len__(self) -> int:
-        return len(self.parents)
-
-    def add(self, x: np.ndarray, parent: int) -> None:
-        n = len(self.parents)
-        if n == len(self.values):
-            self.values = np.concatenate([self.values, np.empty_like(self.values)])
-        self.values[n] = x
-        self.parents.append(parent)
-
-    def nearest(self, x: np.ndarray) -> int:
-        """Index of the node closest to x (group values, Euclidean), -1 if empty."""
-        n = len(self.parents)
-        if n == 0:
-            return -1
-        D = self.values[:n] - x
-        return int(np.argmin(np.einsum("ij,ij->i", D, D)))
-
-
-class LayeredTrees:
-    """Feasibility phase: a forward tree from the start and a backward tree from the goal whose
-    depth-t nodes are waypoints of fake-time step t (only the current group varies; the other DOFs
-    are those of the current path at that step).  Every node is valid and connected to its parent
-    by a valid motion, so there is no deadlock between neighbouring invalid waypoints.  Seeded with
-    the valid prefix and suffix of the current path."""
-
-    def __init__(self, search: Search, gi: int) -> None:
-        self.group = gi
-        self.dims = d = search._dims[gi]
-        self.base = search.W.copy()
-        h = len(self.base)
-        self.fwd = [Layer(len(d)) for _ in range(h)]
-        self.bwd = [Layer(len(d)) for _ in range(h)]
-        V, E, W = search.V, search.E, search.W
-        self.fwd[0].add(W[0, d], -1)
-        t = 1
-        while t < h - 1 and V[t] and E[t - 1]:
-            self.fwd[t].add(W[t, d], 0)
-            t += 1
-        self.bwd[h - 1].add(W[h - 1, d], -1)
-        t = h - 2
-        while t > 0 and V[t] and E[t]:
-            self.bwd[t].add(W[t, d], 0)
-            t -= 1
-
-    def anchor(self, u: float) -> np.ndarray:
-        """Group values of a tree node picked by u in [0, 1): a uniform layer, then a uniform node."""
-        layers = [layer for layer in (*self.fwd, *self.bwd) if len(layer)]
-        x = u * len(layers)
-        layer = layers[int(x)]
-        return layer.values[int((x - int(x)) * len(layer))]
-
-    def path(self, t: int, c: np.ndarray, f: int, b: int) -> np.ndarray:
-        """The waypoints (h, n) through forward node f at t-1, c at t, backward node b at t+1."""
-        W = self.base.copy()
-        d = self.dims
-        W[t, d] = c
-        for s in range(t - 1, -1, -1):
-            W[s, d] = self.fwd[s].values[f]
-            f = self.fwd[s].parents[f]
-        for s in range(t + 1, len(W)):
-            W[s, d] = self.bwd[s].values[b]
-            b = self.bwd[s].parents[b]
-        return W

@@ -22,6 +22,7 @@ so every planner is scored with it.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 
 import numpy as np
@@ -122,50 +123,76 @@ def interpolate_waypoints(start: np.ndarray, goal: np.ndarray, h: int) -> np.nda
 
 
 class RealVectorLayout:
-    """Reads and writes states of a RealVector space, or of a (nested) compound of RealVector spaces.
+    """Reads and writes states of a RealVector or SO2 space, or of a (nested) compound of them.
 
-    The flat vector of a state concatenates its subspaces' values in subspace order.
+    The flat vector of a state concatenates its subspaces' values in subspace order; an SO2 leaf is
+    one value in [-pi, pi) (a continuous joint).  Differences, distances and interpolation go
+    through the space's own rules: an SO2 value moves the short way round (wrap-around), as
+    ``SO2StateSpace.distance``/``interpolate`` do.
 
     Parameters
     ----------
     space : ob.StateSpace
-        ``ob.RealVectorStateSpace`` or ``ob.CompoundStateSpace`` whose leaves are RealVector spaces.
+        ``ob.RealVectorStateSpace`` (with bounds), ``ob.SO2StateSpace`` or an ``ob.CompoundStateSpace``
+        whose leaves are those.
 
     Raises
     ------
     ValueError
-        For any other space (SO2, SE3, ...): dimension-RRT interpolates and samples linearly.
+        For any other space type (SE3, SO3, ...; the message names it), or a RealVector space
+        without finite bounds (``low < high`` for every dimension).
     """
 
     def __init__(self, space: ob.StateSpace) -> None:
         self.space = space
-        # leaves: (access path of subspace indices, dimension, weight, lower, upper)
-        self._leaves: list[tuple[tuple[int, ...], int, float]] = []
+        # leaves: (access path of subspace indices, dimension, weight, is SO2)
+        self._leaves: list[tuple[tuple[int, ...], int, float, bool]] = []
         lows: list[float] = []
         highs: list[float] = []
         self._collect(space, (), 1.0, lows, highs)
-        self.n = sum(d for _, d, _ in self._leaves)
+        self.n = sum(d for _, d, _, _ in self._leaves)
         self.lower = np.array(lows, dtype=float)
         self.upper = np.array(highs, dtype=float)
         self.lower.setflags(write=False)
         self.upper.setflags(write=False)
-        bounds = np.cumsum([0] + [d for _, d, _ in self._leaves])
+        bounds = np.cumsum([0] + [d for _, d, _, _ in self._leaves])
         self._slices = [slice(int(bounds[i]), int(bounds[i + 1])) for i in range(len(self._leaves))]
-        self._weights = np.array([w for _, _, w in self._leaves])
-        self.is_plain = len(self._leaves) == 1 and self._leaves[0][0] == () and self._weights[0] == 1.0
+        self._weights = np.array([w for _, _, w, _ in self._leaves])
+        self.circular = np.zeros(self.n, dtype=bool)
+        """True for the SO2 (wrap-around) entries of the flat vector."""
+        for (_, _, _, so2), sl in zip(self._leaves, self._slices):
+            self.circular[sl] = so2
+        self.circular.setflags(write=False)
+        self.has_circular = bool(self.circular.any())
+        self.is_plain = (len(self._leaves) == 1 and self._leaves[0][0] == () and self._weights[0] == 1.0
+                         and not self.has_circular)
+        """A single RealVector space: the metric is the plain Euclidean norm."""
 
     def _collect(self, space: ob.StateSpace, path: tuple[int, ...], weight: float, lows: list, highs: list) -> None:
         if isinstance(space, ob.RealVectorStateSpace):
             b = space.getBounds()
-            self._leaves.append((path, int(space.getDimension()), weight))
-            lows.extend(float(v) for v in b.low)
-            highs.extend(float(v) for v in b.high)
-        elif isinstance(space, ob.CompoundStateSpace):
+            lo, hi = [float(v) for v in b.low], [float(v) for v in b.high]
+            bad = [i for i in range(len(lo)) if not (math.isfinite(lo[i]) and math.isfinite(hi[i]) and lo[i] < hi[i])]
+            if bad:
+                raise ValueError(
+                    f"RealVectorStateSpace{' (subspace ' + str(list(path)) + ')' if path else ''} has no valid bounds "
+                    f"for dimension(s) {bad} (low must be < high, both finite): call space.setBounds(low, high) first"
+                )
+            self._leaves.append((path, int(space.getDimension()), weight, False))
+            lows.extend(lo)
+            highs.extend(hi)
+        elif isinstance(space, ob.SO2StateSpace):
+            self._leaves.append((path, 1, weight, True))
+            lows.append(-math.pi)
+            highs.append(math.pi)
+        elif isinstance(space, ob.CompoundStateSpace) and type(space) is ob.CompoundStateSpace:
             for k in range(space.getSubspaceCount()):
                 self._collect(space.getSubspace(k), path + (k,), weight * space.getSubspaceWeight(k), lows, highs)
         else:
+            where = f" (subspace {list(path)})" if path else ""
             raise ValueError(
-                f"dimension-RRT needs a RealVector state space or a compound of them, got {type(space).__name__}"
+                f"dimension-RRT supports RealVectorStateSpace, SO2StateSpace and compounds of them; "
+                f"got {type(space).__name__}{where}"
             )
 
     def _leaf(self, state: ob.State, path: tuple[int, ...]) -> ob.State:
@@ -176,21 +203,45 @@ class RealVectorLayout:
     def read(self, state: ob.State) -> np.ndarray:
         """The state's values as a flat array (n,)."""
         out = np.empty(self.n)
-        for (path, d, _), sl in zip(self._leaves, self._slices):
+        for (path, d, _, so2), sl in zip(self._leaves, self._slices):
             leaf = self._leaf(state, path)
-            out[sl] = [leaf[i] for i in range(d)]
+            out[sl] = [leaf.value] if so2 else [leaf[i] for i in range(d)]
         return out
 
     def write(self, state: ob.State, values: np.ndarray) -> ob.State:
         """Write a flat array (n,) into the state; return the state."""
         values = np.asarray(values, dtype=float)
-        for (path, d, _), sl in zip(self._leaves, self._slices):
-            self._leaf(state, path)[0:d] = [float(v) for v in values[sl]]
+        for (path, d, _, so2), sl in zip(self._leaves, self._slices):
+            if so2:
+                self._leaf(state, path).value = float(values[sl][0])
+            else:
+                self._leaf(state, path)[0:d] = [float(v) for v in values[sl]]
         return state
+
+    def wrap(self, X: np.ndarray) -> np.ndarray:
+        """X (..., n) with its SO2 entries brought into [-pi, pi) (unchanged without SO2 leaves)."""
+        if not self.has_circular:
+            return X
+        X = np.array(X, dtype=float, copy=True)
+        X[..., self.circular] = np.mod(X[..., self.circular] + math.pi, 2.0 * math.pi) - math.pi
+        return X
+
+    def delta(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
+        """B - A, with SO2 entries taken the short way round (in [-pi, pi))."""
+        D = np.asarray(B, dtype=float) - np.asarray(A, dtype=float)
+        if self.has_circular:
+            D[..., self.circular] = np.mod(D[..., self.circular] + math.pi, 2.0 * math.pi) - math.pi
+        return D
+
+    def interpolate(self, A: np.ndarray, B: np.ndarray, t: np.ndarray | float) -> np.ndarray:
+        """The state a fraction t of the way from A to B along the space's geodesic (wrap-around for SO2)."""
+        t = np.asarray(t, dtype=float)
+        return self.wrap(np.asarray(A, dtype=float) + t[..., None] * self.delta(A, B) if t.ndim else
+                         np.asarray(A, dtype=float) + float(t) * self.delta(A, B))
 
     def distance(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
         """The space's metric between rows of A and B (..., n), as ``si.distance`` computes it."""
-        D = np.asarray(A) - np.asarray(B)
+        D = self.delta(A, B)
         if self.is_plain:
             return np.sqrt(np.einsum("...i,...i->...", D, D))
         return sum(w * np.linalg.norm(D[..., sl], axis=-1) for w, sl in zip(self._weights, self._slices))
@@ -271,7 +322,7 @@ class GroupedSpace:
 
     def initial_waypoints(self, start: np.ndarray, goal: np.ndarray) -> np.ndarray:
         """Initial path (h, n): prescribed groups as given, the others linear from start to goal."""
-        W = interpolate_waypoints(start, goal, self.h)
+        W = self.layout.interpolate(start, goal, np.linspace(0.0, 1.0, self.h))
         for g, traj in self.prescribed.items():
             W[:, self.group_dims(g)] = traj
         W[0], W[-1] = start, goal
