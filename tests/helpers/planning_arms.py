@@ -69,5 +69,6 @@ def planar_arm_setup(
                 state[i] = float(q[i])
     ss.setStartAndGoalStates(s0, s1, 1e-9)
     ss._valid_fn = valid  # type: ignore[attr-defined]  # keep the Python checker alive
+    ss.endpoint_states = (s0, s1)  # type: ignore[attr-defined]  # copies (never pdef.getStartState from Python)
     si.setup()
     return ss

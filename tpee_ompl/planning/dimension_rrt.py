@@ -44,12 +44,13 @@ import dataclasses
 import logging
 import math
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from ompl import base as ob
+from ompl import geometric as og
 
 from ..validation import check_bool, check_int, check_name, check_number
 from .dimension_search import Checker, Search
@@ -62,6 +63,8 @@ log = logging.getLogger(__name__)
 
 _PROGRESS_PERIOD = 0.01
 """Seconds between progress-trace entries (OMPL's benchmark records progress about as often)."""
+_POST_SHARE = 0.1
+"""Improvements are posted to the problem definition as found while posting costs at most this share of the time."""
 
 
 def _status(code: Any) -> ob.PlannerStatus:
@@ -199,6 +202,8 @@ class DimensionRRT(ob.Planner):
         self._stats: dict[str, Any] = self._empty_stats()
         self._ranges = {gi: rng_full[self.grouped.group_dims(gi)] for gi in self.grouped.planned}
         self._initial = initial
+        self._callback: Callable[[ob.Planner, list[ob.State], ob.Cost], object] | None = None
+        self._callback_failed = False
 
     @staticmethod
     def _check_initial(grouped: GroupedSpace, W: np.ndarray | None) -> np.ndarray | None:
@@ -227,6 +232,30 @@ class DimensionRRT(ob.Planner):
         """
         self._initial = self._check_initial(self.grouped, W)
 
+    def set_intermediate_solution_callback(
+        self, callback: Callable[[ob.Planner, list[ob.State], ob.Cost], object] | None
+    ) -> None:
+        """Call ``callback(planner, states, cost)`` for each path added to the problem definition.
+
+        The arguments of OMPL's intermediate-solution callback (which the 2.0.1 bindings do not accept
+        from Python).  ``states`` are the path's states (copies), ``cost`` its ``ob.Cost``.  An
+        exception in the callback is logged and the callback is not called again in that solve.
+        None removes it.
+        """
+        if callback is not None and not callable(callback):
+            raise ValueError(f"callback must be callable or None, got {type(callback).__name__}")
+        self._callback = callback
+
+    def _notify(self, path: og.PathGeometric, cost: float) -> None:
+        cb = self._callback
+        if cb is None or self._callback_failed:
+            return
+        try:
+            cb(self, list(path.getStates()), ob.Cost(cost))
+        except Exception:
+            log.exception("DimensionRRT: the intermediate-solution callback raised; not called again in this solve")
+            self._callback_failed = True
+
     # ------------------------------------------------------------------ reporting
     def settings(self) -> dict[str, str]:
         """Parameter name -> value as text (for the benchmark's ``plannerConfigs``)."""
@@ -252,11 +281,13 @@ class DimensionRRT(ob.Planner):
             "best_cost": math.inf,
             "iterations": 0,
             "progress": [],
+            "solutions_posted": 0,
         }
 
     def last_run_stats(self) -> dict[str, Any]:
         """Statistics of the last solve: samples, collision_checks, first_solution_time (s or None),
-        best_cost (inf if none), iterations, progress [(time_s, best_cost, samples), ...]."""
+        best_cost (inf if none), iterations, progress [(time_s, best_cost, samples), ...],
+        solutions_posted (paths added to the problem definition)."""
         out = dict(self._stats)
         out["progress"] = list(self._stats["progress"])
         return out
@@ -272,6 +303,7 @@ class DimensionRRT(ob.Planner):
         if isinstance(ptc, (int, float)):  # p.solve(1.0) from Python reaches here with a float
             ptc = ob.timedPlannerTerminationCondition(float(ptc))
         self._stats = self._empty_stats()
+        self._callback_failed = False
         try:
             return self._solve(ptc)
         except Exception:  # an exception escaping into ot.Benchmark would abort the whole benchmark
@@ -301,6 +333,9 @@ class DimensionRRT(ob.Planner):
     def _solve(self, ptc: ob.PlannerTerminationCondition) -> ob.PlannerStatus:
         t0 = time.perf_counter()
         si, pdef = self.getSpaceInformation(), self.getProblemDefinition()
+        if pdef is None:
+            log.error("DimensionRRT: no problem definition; call setProblemDefinition(pdef) or solve through og.SimpleSetup")
+            return _status(ob.PlannerStatus.ABORT)
         start, gstate, bad = self._endpoints()
         if bad is not None:
             return bad
@@ -314,49 +349,86 @@ class DimensionRRT(ob.Planner):
         checks0 = checker.counter()
         search = Search(self.grouped, checker, self._rng, q0, q1, self.narrow_after, self.narrowing, self._ranges,
                          self._initial)
+        poster = _Poster(self, si, pdef, t0)
         stats = self._stats
         progress = stats["progress"]
-        best_W, best_cost, first_time = None, math.inf, None
         cap = self.max_samples if self.grouped.planned else 0
         last_log = -math.inf
 
         def record(now: float) -> None:
-            progress.append((now - t0, best_cost, search.samples))
+            progress.append((now - t0, poster.found_cost, search.samples))
 
         if search.valid:
-            best_W, best_cost, first_time = search.W.copy(), search.cost, time.perf_counter() - t0
+            poster.offer(search.W, search.cost, time.perf_counter())
         record(time.perf_counter())
-        while not ptc() and (cap is None or search.samples < cap):
+        while not poster.satisfied and not ptc() and (cap is None or search.samples < cap):
             accepted = search.iterate()
             now = time.perf_counter()
-            if accepted and search.valid:
-                if first_time is None:
-                    first_time = now - t0
-                if search.cost < best_cost:
-                    best_W, best_cost = search.W.copy(), search.cost
-                    record(now)
-                    last_log = now
-                    continue
+            if accepted and search.valid and search.cost < poster.found_cost:
+                poster.offer(search.W, search.cost, now)
+                record(now)
+                last_log = now
+                continue
             if now - last_log >= _PROGRESS_PERIOD:
                 record(now)
                 last_log = now
+        poster.flush()
         record(time.perf_counter())
-
-        status = _status(ob.PlannerStatus.TIMEOUT)
-        if best_W is not None:
-            path = self.grouped.to_path(si, best_W)
-            # the start state was checked by _endpoints: only the motions are checked again here
-            if path_passes_motion_checks(si, path, check_first=False):
-                pdef.addSolutionPath(path, False, 0.0, self.getName())
-                status = _status(ob.PlannerStatus.EXACT_SOLUTION)
-            else:
-                log.warning("DimensionRRT: final si.checkMotion rejected the path; no solution reported")
-                best_cost, first_time = math.inf, None
         stats.update(
             samples=search.samples,
             iterations=search.samples,
             collision_checks=checker.counter() - checks0,
-            first_solution_time=first_time,
-            best_cost=best_cost,
+            first_solution_time=poster.first_time,
+            best_cost=poster.best_cost,
+            solutions_posted=poster.posted,
         )
-        return status
+        return _status(ob.PlannerStatus.EXACT_SOLUTION if poster.posted else ob.PlannerStatus.TIMEOUT)
+
+
+class _Poster:
+    """Hands improved paths to OMPL as they are found (module docstring, "Stopping").
+
+    An improvement is checked with ``si.checkMotion`` and added to the problem definition at once
+    when it is the first, when it satisfies the objective, or while posting has cost at most
+    ``_POST_SHARE`` of the time so far; otherwise it waits for the next post or :meth:`flush`.
+    """
+
+    def __init__(self, planner: DimensionRRT, si: ob.SpaceInformation, pdef: ob.ProblemDefinition, t0: float) -> None:
+        self.planner, self.si, self.pdef, self.t0 = planner, si, pdef, t0
+        self.opt = pdef.getOptimizationObjective() if pdef.hasOptimizationObjective() else None
+        self.found_cost = math.inf  # best cost the search found
+        self.best_cost = math.inf  # best cost posted (checked by si.checkMotion)
+        self.first_time: float | None = None
+        self.posted = 0
+        self.satisfied = False
+        self._pending: tuple[np.ndarray, float] | None = None
+        self._spent = 0.0
+
+    def offer(self, W: np.ndarray, cost: float, now: float) -> None:
+        self.found_cost = cost
+        self._pending = (W.copy(), cost)
+        sat = self.opt is not None and bool(self.opt.isSatisfied(ob.Cost(cost)))
+        if self.posted == 0 or sat or self._spent <= _POST_SHARE * (now - self.t0):
+            self.flush()
+            self.satisfied = sat and self.posted > 0 and self.best_cost == cost
+
+    def flush(self) -> None:
+        """Post the pending improvement, if any (after ``si.checkMotion`` over the whole path)."""
+        if self._pending is None:
+            return
+        t = time.perf_counter()
+        W, cost = self._pending
+        self._pending = None
+        planner = self.planner
+        path = planner.grouped.to_path(self.si, W)
+        # the start state was checked by _endpoints: only the motions are checked again here
+        if path_passes_motion_checks(self.si, path, check_first=False):
+            self.pdef.addSolutionPath(path, False, 0.0, planner.getName())
+            self.posted += 1
+            self.best_cost = cost
+            if self.first_time is None:
+                self.first_time = time.perf_counter() - self.t0
+            planner._notify(path, cost)
+        else:
+            log.warning("DimensionRRT: si.checkMotion rejected a path the search accepted; not reported")
+        self._spent += time.perf_counter() - t

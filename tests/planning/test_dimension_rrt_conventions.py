@@ -1,0 +1,138 @@
+"""DimensionRRT stops the way OMPL planners stop, and plans foreign set-ups (several planned groups, SO2)."""
+
+from __future__ import annotations
+
+import logging
+import math
+
+import pytest
+from ompl import base as ob
+
+from tests.helpers.planning_arms import planar_arm_setup
+from tpee_ompl.examples.planar_arm import make_planar_arm_setup
+from tpee_ompl.planning.dimension_rrt import DimensionRRT
+from tpee_ompl.planning.paths import path_passes_motion_checks
+
+CAP = 3000
+
+
+def _run(ss, ptc=None, **kw):
+    planner = DimensionRRT(ss.getSpaceInformation(), **kw)
+    ss.clear()
+    ss.setPlanner(planner)
+    status = ss.solve(ob.timedPlannerTerminationCondition(60.0) if ptc is None else ptc)
+    return planner, status
+
+
+def test_exact_solution_termination_stops_at_the_first_path() -> None:
+    ss = make_planar_arm_setup()
+    full = _run(ss, seed=3, max_samples=CAP)[0].last_run_stats()  # before ss.clear() resets it
+    ptc = ob.plannerOrTerminationCondition(ob.exactSolnPlannerTerminationCondition(ss.getProblemDefinition()),
+                                           ob.timedPlannerTerminationCondition(60.0))
+    planner, status = _run(ss, ptc, seed=3, max_samples=CAP)
+    stats = planner.last_run_stats()
+    assert status == ob.PlannerStatus.EXACT_SOLUTION and ss.haveExactSolutionPath()
+    assert stats["solutions_posted"] == 1 and stats["samples"] < full["samples"] == CAP
+    assert path_passes_motion_checks(ss.getSpaceInformation(), ss.getSolutionPath())
+
+
+def test_infinite_cost_threshold_means_first_solution() -> None:
+    ss = make_planar_arm_setup()
+    ss.getProblemDefinition().getOptimizationObjective().setCostThreshold(ob.Cost(math.inf))
+    planner, status = _run(ss, seed=4, max_samples=CAP)
+    stats = planner.last_run_stats()
+    assert status == ob.PlannerStatus.EXACT_SOLUTION
+    assert stats["solutions_posted"] == 1 and stats["samples"] < CAP
+    assert ss.getSolutionPath().length() == pytest.approx(stats["best_cost"])
+
+
+def test_finite_cost_threshold_stops_once_satisfied() -> None:
+    ss = make_planar_arm_setup()
+    progress = _run(ss, seed=5, max_samples=CAP)[0].last_run_stats()["progress"]
+    costs = [c for _, c, _ in progress if math.isfinite(c)]
+    threshold = 0.5 * (costs[0] + costs[-1])  # halfway between the first and the final path
+    ss.getProblemDefinition().getOptimizationObjective().setCostThreshold(ob.Cost(threshold))
+    planner, status = _run(ss, seed=5, max_samples=CAP)
+    stats = planner.last_run_stats()
+    assert status == ob.PlannerStatus.EXACT_SOLUTION
+    assert stats["best_cost"] <= threshold and stats["samples"] < CAP
+
+
+def test_callback_sees_every_posted_path_checked_and_improving() -> None:
+    ss = make_planar_arm_setup()
+    si = ss.getSpaceInformation()
+    seen = []
+
+    def callback(planner, states, cost):
+        assert isinstance(planner, DimensionRRT) and isinstance(cost, ob.Cost)
+        seen.append((cost.value(), path_passes_motion_checks(si, states)))
+
+    planner = DimensionRRT(si, seed=6, max_samples=1500)
+    planner.set_intermediate_solution_callback(callback)
+    ss.setPlanner(planner)
+    assert ss.solve(60.0) == ob.PlannerStatus.EXACT_SOLUTION
+    stats = planner.last_run_stats()
+    assert len(seen) == stats["solutions_posted"] >= 1
+    assert all(ok for _, ok in seen)
+    costs = [c for c, _ in seen]
+    assert costs == sorted(costs, reverse=True) and len(set(costs)) == len(costs)
+    assert costs[-1] == pytest.approx(stats["best_cost"]) == pytest.approx(ss.getSolutionPath().length())
+
+
+def test_raising_callback_is_logged_and_planning_goes_on(caplog) -> None:
+    ss = make_planar_arm_setup()
+    calls = []
+
+    def callback(*args):
+        calls.append(args)
+        raise RuntimeError("boom")
+
+    planner = DimensionRRT(ss.getSpaceInformation(), seed=6, max_samples=800)
+    planner.set_intermediate_solution_callback(callback)
+    ss.setPlanner(planner)
+    with caplog.at_level(logging.ERROR):
+        assert ss.solve(60.0) == ob.PlannerStatus.EXACT_SOLUTION
+    assert len(calls) == 1 and "callback raised" in caplog.text
+    with pytest.raises(ValueError, match="callable"):
+        planner.set_intermediate_solution_callback(3)
+
+
+def test_solve_without_problem_definition_is_a_clear_abort(caplog) -> None:
+    ss = make_planar_arm_setup()
+    planner = DimensionRRT(ss.getSpaceInformation(), max_samples=10)
+    with caplog.at_level(logging.ERROR):
+        status = ob.Planner.solve(planner, 1.0)
+    assert status == ob.PlannerStatus.ABORT
+    assert "no problem definition" in caplog.text and "Traceback" not in caplog.text
+    assert all(r.exc_info is None for r in caplog.records)
+
+
+def test_unbounded_real_vector_space_is_refused_at_construction() -> None:
+    si = ob.SpaceInformation(ob.RealVectorStateSpace(2))
+    with pytest.raises(ValueError, match="bounds"):
+        DimensionRRT(si)
+
+
+@pytest.mark.parametrize("groups", [[[0, 1], [2, 3], [4, 5]], [[0, 1, 2], [3, 4, 5]], [[5, 0], [1, 4], [2], [3]]])
+def test_six_joint_arm_with_several_planned_groups_gets_a_path(groups) -> None:
+    ss = planar_arm_setup(6)
+    si = ss.getSpaceInformation()
+    pdef = ss.getProblemDefinition()
+    assert not si.checkMotion(*ss.endpoint_states)  # the straight motion is blocked
+    ptc = ob.plannerOrTerminationCondition(ob.exactSolnPlannerTerminationCondition(pdef),
+                                           ob.timedPlannerTerminationCondition(60.0))
+    planner, status = _run(ss, ptc, groups=groups, seed=0, max_samples=2000)
+    assert status == ob.PlannerStatus.EXACT_SOLUTION
+    assert path_passes_motion_checks(si, ss.getSolutionPath())
+
+
+def test_continuous_joints_plan_across_plus_minus_pi() -> None:
+    # start and goal either side of +-pi: the short way (0.6 rad) crosses the wrap, the long way 5.7 rad
+    ss = planar_arm_setup(3, start=(2.9, 0.2, 0.0), goal=(-2.9, 0.2, 0.0), obstacles=((5.0, 5.0, 0.1),),
+                          continuous=True)
+    planner, status = _run(ss, seed=0, max_samples=200)
+    assert status == ob.PlannerStatus.EXACT_SOLUTION
+    path = ss.getSolutionPath()
+    assert path_passes_motion_checks(ss.getSpaceInformation(), path)
+    assert path.length() == pytest.approx(2 * math.pi - 5.8, abs=1e-9)
+    assert planner.last_run_stats()["best_cost"] == pytest.approx(path.length())
