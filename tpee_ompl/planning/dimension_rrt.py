@@ -403,6 +403,7 @@ class _Poster:
         self.satisfied = False
         self._pending: tuple[np.ndarray, float] | None = None
         self._spent = 0.0
+        self._passed: set[bytes] = set()
 
     def offer(self, W: np.ndarray, cost: float, now: float) -> None:
         self.found_cost = cost
@@ -421,8 +422,13 @@ class _Poster:
         self._pending = None
         planner = self.planner
         path = planner.grouped.to_path(self.si, W)
-        # the start state was checked by _endpoints: only the motions are checked again here
-        if path_passes_motion_checks(self.si, path, check_first=False):
+        # the start state was checked by _endpoints; a segment that already passed si.checkMotion
+        # (same two waypoints in an earlier posted path) is not checked again
+        keys = [W[k : k + 2].tobytes() for k in range(len(W) - 1)]
+        states = path.getStates()
+        todo = [k for k, key in enumerate(keys) if key not in self._passed]
+        if path_passes_motion_checks(self.si, states, check_first=False, segments=todo):
+            self._passed.update(keys)
             self.pdef.addSolutionPath(path, False, 0.0, planner.getName())
             self.posted += 1
             self.best_cost = cost

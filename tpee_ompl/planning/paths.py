@@ -79,7 +79,11 @@ def array_to_path(
 
 
 def path_passes_motion_checks(
-    si: ob.SpaceInformation, waypoints: og.PathGeometric | Sequence[ob.State] | np.ndarray, *, check_first: bool = True
+    si: ob.SpaceInformation,
+    waypoints: og.PathGeometric | Sequence[ob.State] | np.ndarray,
+    *,
+    check_first: bool = True,
+    segments: Sequence[int] | None = None,
 ) -> bool:
     """OMPL's whole-path check: the first state is valid and every segment passes ``si.checkMotion``.
 
@@ -98,6 +102,9 @@ def path_passes_motion_checks(
     check_first : bool
         False skips ``si.isValid`` of the first state, for a caller that has just checked it
         (the motion checks never check a motion's first state).
+    segments : sequence of int, optional
+        Check only these segments (k: ``w[k] -> w[k + 1]``), for a caller that knows the others
+        passed ``si.checkMotion`` already (dimension-RRT re-checks only the segments an improvement changed).
 
     Raises
     ------
@@ -129,7 +136,9 @@ def path_passes_motion_checks(
         return True
     if check_first and not si.isValid(states[0]):
         return False
-    return all(si.checkMotion(a, b) for a, b in itertools.pairwise(states))
+    if segments is None:
+        return all(si.checkMotion(a, b) for a, b in itertools.pairwise(states))
+    return all(si.checkMotion(states[k], states[k + 1]) for k in segments)
 
 
 MIN_JOINT_STEP = 1e-4
