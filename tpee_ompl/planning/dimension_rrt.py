@@ -12,15 +12,20 @@ runs first and costs no collision check.  Steps are tried in turn ``t = 1 .. h-2
 steps are never both replaced by one sample (the motion between them was not checked).
 
 Feasibility phase (before the first valid path; the paper leaves it open): a forward tree from the
-start and a backward tree from the goal whose depth-t nodes are waypoints of step t (only the
-current group varies).  They are seeded with the valid prefix and suffix of the initial path
-(prescribed groups as given, the others linear).  The sample is tried at every step t: connected to
-the nearest forward node of step t-1 it joins the forward tree, to the nearest backward node of
-step t+1 the backward tree, to both and the path is complete.  Every node is valid and reached by
-a valid motion, so two neighbouring waypoints that both start in collision cannot deadlock it (the
-literal rule needs both motions valid, impossible when both neighbours collide).  Half of its
-samples are Gaussian around a random tree node (sigma log-uniform in 1-10 % of the bound widths) so
-the trees grow out of narrow pockets; the other half are uniform.
+start and a backward tree from the goal whose depth-t nodes are waypoints of step t.  The trees vary
+ALL planned groups jointly (one sample covers every planned DOF; with a single planned group, as in
+the TPEE case, that is the group) and are built once, so progress in one group is never lost when
+the improvement phase's group turns over (a per-group feasibility phase stalled on a 6-joint arm
+split in three groups).  They are seeded with the valid prefix and suffix of the initial path
+(prescribed groups as given, the others straight).  The sample is tried at every step t: connected
+to the nearest forward node of step t-1 it joins the forward tree, to the nearest backward node of
+step t+1 the backward tree, to both and the path is complete.  Without prescribed groups a node
+also serves later (forward) or earlier (backward) steps by staying put (a zero-length motion), and
+the repeated waypoints of the resulting path are spread along its segments (kept only if that path
+passes the checker).  Every node is valid and reached by a valid motion, so two neighbouring
+waypoints that both start in collision cannot deadlock it.  Half of its samples are Gaussian around
+a random tree node (sigma log-uniform in 1-10 % of the bound widths) so the trees grow out of narrow
+pockets; the other half are uniform.
 
 Narrowing: once a valid path exists and the group has drawn ``narrow_after`` samples, 90 % of the
 samples come from the bounding box of the current path's group values (all ``h`` steps), padded
@@ -31,8 +36,19 @@ Batching: the candidate waypoints of one sample and their motions go through the
 checker's batched ``are_valid(Q)`` when it has one (two calls per sample at most: candidates plus
 every 8th interior motion state, then the remaining interior states of the survivors); otherwise
 per-state ``si.isValid`` and per-motion ``si.checkMotion``.  Motion states are those OMPL's
-discrete motion validator checks.  An exact solution is reported only after every segment of the
-final path passed ``si.checkMotion`` (:func:`~tpee_ompl.planning.paths.path_passes_motion_checks`).
+discrete motion validator checks.
+
+Stopping like an OMPL planner: each improved path is added to the problem definition as it is found
+(so ``ob.exactSolnPlannerTerminationCondition(pdef)`` stops at the first), after every segment not
+already checked in an earlier posted path passed ``si.checkMotion``
+(:func:`~tpee_ompl.planning.paths.path_passes_motion_checks`); after the first, improvements are
+posted while posting costs at most 10 % of the run time and the best one always at the end.  The
+planner stops once ``opt.isSatisfied(cost)`` (a cost threshold of ``inf`` = first solution).  An
+optional Python callback (:meth:`DimensionRRT.set_intermediate_solution_callback`) gets the arguments
+of OMPL's intermediate-solution callback for each posted path.
+
+Spaces: RealVector (bounded), SO2 (continuous joints: differences, distance and interpolation the
+short way round, like ``SO2StateSpace``) and compounds of them; anything else is refused by name.
 
 This module holds the settings (:class:`DimensionRRTOptions`) and the OMPL planner; the search
 itself (checker, iteration, layered trees) is :mod:`tpee_ompl.planning.dimension_search`.
@@ -55,7 +71,7 @@ from ompl import geometric as og
 from ..validation import check_bool, check_int, check_name, check_number
 from .dimension_search import Checker, Search
 from .grouped_space import GroupedSpace
-from .paths import path_passes_motion_checks
+from .solution_posting import SolutionPoster
 
 __all__ = ["DimensionRRT", "DimensionRRTOptions"]
 
@@ -63,8 +79,6 @@ log = logging.getLogger(__name__)
 
 _PROGRESS_PERIOD = 0.01
 """Seconds between progress-trace entries (OMPL's benchmark records progress about as often)."""
-_POST_SHARE = 0.1
-"""Improvements are posted to the problem definition as found while posting costs at most this share of the time."""
 
 
 def _status(code: Any) -> ob.PlannerStatus:
@@ -139,7 +153,7 @@ class DimensionRRT(ob.Planner):
     Parameters
     ----------
     si : ob.SpaceInformation
-        A RealVector space, or a compound of RealVector spaces.
+        A bounded RealVector space, an SO2 space, or a compound of them.
     options : DimensionRRTOptions, optional
         The planner's settings (defaults if omitted).
     prescribed : dict {group index: array (h, k_i)}, optional
@@ -156,7 +170,8 @@ class DimensionRRT(ob.Planner):
     ------
     ValueError
         Overlapping, missing or out-of-range DOF indices, ``h < 3``, ``max_samples < 1``, bad
-        ``narrowing``/``narrow_after``/``range_``, or a space that is not RealVector-based.
+        ``narrowing``/``narrow_after``/``range_``, a space type other than RealVector/SO2/compound
+        (named in the message), or a RealVector space without bounds.
     TypeError
         An override that is not a field of :class:`DimensionRRTOptions`.
     """
@@ -349,7 +364,7 @@ class DimensionRRT(ob.Planner):
         checks0 = checker.counter()
         search = Search(self.grouped, checker, self._rng, q0, q1, self.narrow_after, self.narrowing, self._ranges,
                          self._initial)
-        poster = _Poster(self, si, pdef, t0)
+        poster = SolutionPoster(self, si, pdef, t0, self.grouped.to_path, self._notify)
         stats = self._stats
         progress = stats["progress"]
         cap = self.max_samples if self.grouped.planned else 0
@@ -383,58 +398,3 @@ class DimensionRRT(ob.Planner):
             solutions_posted=poster.posted,
         )
         return _status(ob.PlannerStatus.EXACT_SOLUTION if poster.posted else ob.PlannerStatus.TIMEOUT)
-
-
-class _Poster:
-    """Hands improved paths to OMPL as they are found (module docstring, "Stopping").
-
-    An improvement is checked with ``si.checkMotion`` and added to the problem definition at once
-    when it is the first, when it satisfies the objective, or while posting has cost at most
-    ``_POST_SHARE`` of the time so far; otherwise it waits for the next post or :meth:`flush`.
-    """
-
-    def __init__(self, planner: DimensionRRT, si: ob.SpaceInformation, pdef: ob.ProblemDefinition, t0: float) -> None:
-        self.planner, self.si, self.pdef, self.t0 = planner, si, pdef, t0
-        self.opt = pdef.getOptimizationObjective() if pdef.hasOptimizationObjective() else None
-        self.found_cost = math.inf  # best cost the search found
-        self.best_cost = math.inf  # best cost posted (checked by si.checkMotion)
-        self.first_time: float | None = None
-        self.posted = 0
-        self.satisfied = False
-        self._pending: tuple[np.ndarray, float] | None = None
-        self._spent = 0.0
-        self._passed: set[bytes] = set()
-
-    def offer(self, W: np.ndarray, cost: float, now: float) -> None:
-        self.found_cost = cost
-        self._pending = (W.copy(), cost)
-        sat = self.opt is not None and bool(self.opt.isSatisfied(ob.Cost(cost)))
-        if self.posted == 0 or sat or self._spent <= _POST_SHARE * (now - self.t0):
-            self.flush()
-            self.satisfied = sat and self.posted > 0 and self.best_cost == cost
-
-    def flush(self) -> None:
-        """Post the pending improvement, if any (after ``si.checkMotion`` over the whole path)."""
-        if self._pending is None:
-            return
-        t = time.perf_counter()
-        W, cost = self._pending
-        self._pending = None
-        planner = self.planner
-        path = planner.grouped.to_path(self.si, W)
-        # the start state was checked by _endpoints; a segment that already passed si.checkMotion
-        # (same two waypoints in an earlier posted path) is not checked again
-        keys = [W[k : k + 2].tobytes() for k in range(len(W) - 1)]
-        states = path.getStates()
-        todo = [k for k, key in enumerate(keys) if key not in self._passed]
-        if path_passes_motion_checks(self.si, states, check_first=False, segments=todo):
-            self._passed.update(keys)
-            self.pdef.addSolutionPath(path, False, 0.0, planner.getName())
-            self.posted += 1
-            self.best_cost = cost
-            if self.first_time is None:
-                self.first_time = time.perf_counter() - self.t0
-            planner._notify(path, cost)
-        else:
-            log.warning("DimensionRRT: si.checkMotion rejected a path the search accepted; not reported")
-        self._spent += time.perf_counter() - t

@@ -1,0 +1,79 @@
+"""Posting dimension-RRT's improved paths to OMPL as they are found: checked, throttled, with a callback."""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+from collections.abc import Callable
+
+import numpy as np
+from ompl import base as ob
+from ompl import geometric as og
+
+from .paths import path_passes_motion_checks
+
+__all__ = ["SolutionPoster"]
+
+log = logging.getLogger("tpee_ompl.planning.dimension_rrt")
+
+_POST_SHARE = 0.1
+"""After the first, improvements are posted as found while posting costs at most this share of the run time."""
+
+
+class SolutionPoster:
+    """Hands improved paths to OMPL as they are found (see :mod:`tpee_ompl.planning.dimension_rrt`, "Stopping").
+
+    An improvement is checked with ``si.checkMotion`` and added to the problem definition at once
+    when it is the first, when it satisfies the objective, or while posting has cost at most
+    ``_POST_SHARE`` of the time so far; otherwise it waits for the next post or :meth:`flush`.
+    """
+
+    def __init__(self, planner: ob.Planner, si: ob.SpaceInformation, pdef: ob.ProblemDefinition, t0: float,
+                 to_path: Callable[[ob.SpaceInformation, np.ndarray], og.PathGeometric],
+                 notify: Callable[[og.PathGeometric, float], None]) -> None:
+        self.planner, self.si, self.pdef, self.t0 = planner, si, pdef, t0
+        self.to_path, self.notify = to_path, notify
+        self.opt = pdef.getOptimizationObjective() if pdef.hasOptimizationObjective() else None
+        self.found_cost = math.inf  # best cost the search found
+        self.best_cost = math.inf  # best cost posted (checked by si.checkMotion)
+        self.first_time: float | None = None
+        self.posted = 0
+        self.satisfied = False
+        self._pending: tuple[np.ndarray, float] | None = None
+        self._spent = 0.0
+        self._passed: set[bytes] = set()
+
+    def offer(self, W: np.ndarray, cost: float, now: float) -> None:
+        self.found_cost = cost
+        self._pending = (W.copy(), cost)
+        sat = self.opt is not None and bool(self.opt.isSatisfied(ob.Cost(cost)))
+        if self.posted == 0 or sat or self._spent <= _POST_SHARE * (now - self.t0):
+            self.flush()
+            self.satisfied = sat and self.posted > 0 and self.best_cost == cost
+
+    def flush(self) -> None:
+        """Post the pending improvement, if any (after ``si.checkMotion`` over the whole path)."""
+        if self._pending is None:
+            return
+        t = time.perf_counter()
+        W, cost = self._pending
+        self._pending = None
+        planner = self.planner
+        path = self.to_path(self.si, W)
+        # the start state was checked by _endpoints; a segment that already passed si.checkMotion
+        # (same two waypoints in an earlier posted path) is not checked again
+        keys = [W[k : k + 2].tobytes() for k in range(len(W) - 1)]
+        states = path.getStates()
+        todo = [k for k, key in enumerate(keys) if key not in self._passed]
+        if path_passes_motion_checks(self.si, states, check_first=False, segments=todo):
+            self._passed.update(keys)
+            self.pdef.addSolutionPath(path, False, 0.0, planner.getName())
+            self.posted += 1
+            self.best_cost = cost
+            if self.first_time is None:
+                self.first_time = time.perf_counter() - self.t0
+            self.notify(path, cost)
+        else:
+            log.warning("DimensionRRT: si.checkMotion rejected a path the search accepted; not reported")
+        self._spent += time.perf_counter() - t
