@@ -9,6 +9,7 @@ from ompl import base as ob
 
 from tpee_ompl.library import PathLibrary
 from tpee_ompl.library.planner import LibraryDimensionRRT, infer_sector
+from tpee_ompl.model.queries import load_queries
 from tpee_ompl.model.sectors import posture_preset
 from tpee_ompl.model.wearer_arm import WearerArm
 from tpee_ompl.planning.paths import path_passes_motion_checks, path_to_array
@@ -63,16 +64,30 @@ def test_a_satisfied_cost_threshold_stops_at_the_library_path(robot, library):
     assert planner.last_run_stats()["samples"] == 0
 
 
-def test_a_pair_without_demonstrations_is_planned_from_scratch(robot, library):
-    start, goal = _query(robot, 3, 4, 3)  # the stand-in library has no 3->4 demonstrations
-    ss, planner, status = _solve(robot, library, start, goal, max_samples=2000, seed=0)
+def _stored(name: str, i: int, j: int):
+    return next(q for q in load_queries(name) if (q.from_sector, q.to_sector) == (i, j))
+
+
+def test_a_pair_without_demonstrations_is_planned_when_the_straight_motion_collides(robot, library):
+    q = _stored("planning_necessary", 3, 4)  # its straight motion collides; the stand-in library has no 3->4
+    ss, planner, status = _solve(robot, library, q.start, q.goal, max_samples=2000, seed=0)
     stats = planner.last_run_stats()
-    assert stats["library_outcome"] in ("planned", "failed") and stats["candidates_tried"] == 0
+    assert stats["candidates_tried"] == 0
     if status == ob.PlannerStatus.EXACT_SOLUTION:
         assert stats["library_outcome"] == "planned" and stats["samples"] > 0
         assert path_passes_motion_checks(ss.getSpaceInformation(), ss.getSolutionPath())
     else:
-        assert status == ob.PlannerStatus.TIMEOUT and not ss.haveExactSolutionPath()
+        assert status == ob.PlannerStatus.TIMEOUT and stats["library_outcome"] == "failed"
+        assert not ss.haveExactSolutionPath()
+
+
+def test_a_free_straight_motion_is_taken_when_the_library_has_nothing(robot, library):
+    q = _stored("paper_random", 3, 4)  # paper-style queries: the straight motion is free
+    ss, planner, status = _solve(robot, library, q.start, q.goal, max_samples=50, seed=0)
+    stats = planner.last_run_stats()
+    assert status == ob.PlannerStatus.EXACT_SOLUTION and stats["library_outcome"] == "straight"
+    assert stats["progress"][0][2] == 0  # found before any dimension-RRT sample
+    assert path_passes_motion_checks(ss.getSpaceInformation(), ss.getSolutionPath())
 
 
 def test_sector_pair_is_inferred_from_the_presets_or_refused(robot, library):
