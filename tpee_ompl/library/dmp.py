@@ -329,8 +329,7 @@ def learn_dmp(demo: np.ndarray, options: DMPOptions | None = None) -> DMP:
     target = free[-1] * amplitude / S  # scaled: a(T); absolute: a(T) (g - y0)
     weights = weights + np.outer(target - weights @ c, c) / (c @ c)
 
-    forcing = integrate(np.zeros(D), np.zeros(D), (phi @ weights.T) * x[:, None], options)
-    return DMP(weights, y0.copy(), g.copy(), scaled, options, free, forcing)
+    return DMP.from_weights(weights, y0.copy(), g.copy(), scaled, P, options)  # what loading a library does too
 
 
 def generate(dmp: DMP, start: np.ndarray, goal: np.ndarray) -> np.ndarray:
