@@ -9,7 +9,15 @@ library, tracker) -> ``bench`` (campaigns) -> ``cli``.  What a user needs first 
 """
 
 from .library.dmp import DMP, DMPOptions, generate, generate_blended, learn_dmp
-from .library import LibraryFileError, PathLibrary, QueryResult, Tracker, TrackerOptions, make_default_planner
+from .library import (
+    LibraryDimensionRRT,
+    LibraryFileError,
+    PathLibrary,
+    QueryResult,
+    Tracker,
+    TrackerOptions,
+    make_default_planner,
+)
 from .model.pointing import AimingError, BlindAreaError, UnreachableTargetError, aim, aim_batch, aim_checked
 from .model.queries import Query, QuerySetError, load_queries
 from .model.sectors import (
@@ -63,6 +71,7 @@ __all__ = [
     "path_length",
     "motion_states",
     # the real-time layer
+    "LibraryDimensionRRT",
     "PathLibrary",
     "QueryResult",
     "LibraryFileError",

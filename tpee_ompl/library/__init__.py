@@ -21,10 +21,13 @@ from .demos import (
 from .dmp import DMP, DMPOptions, generate, generate_blended, learn_dmp
 from .evaluation import benchmark_queries
 from .path_library import PathLibrary, QueryResult
+from .planner import LibraryDimensionRRT, infer_sector
 from .storage import FORMAT_VERSION, LibraryFileError
 from .tracker import Tracker, TrackerOptions, make_default_planner
 
 __all__ = [
+    "LibraryDimensionRRT",
+    "infer_sector",
     "DEMO_MARGINS",
     "DMP",
     "DMPOptions",

@@ -39,6 +39,7 @@ generation: automatic real-time goal adaptation and obstacle avoidance".
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -174,11 +175,30 @@ class DMP:
             raise ValueError(f"start, goal and scaled must have shape ({D},) to match weights {weights.shape}")
         if N != options.basis_count(n_steps):
             raise ValueError(f"weights have {N} basis functions; options give {options.basis_count(n_steps)}")
-        x = canonical_phase(n_steps, options.alpha_x)
-        phi = basis_functions(x, N, options.alpha_x, options.width, normalized=True)
-        free = _free_response(n_steps, options)
-        forcing = integrate(np.zeros(D), np.zeros(D), (phi @ weights.T) * x[:, None], options)
+        x, phi, free, impulse = _grid(n_steps, options)
+        f = (phi @ weights.T) * x[:, None]
+        # integrate(0, 0, f) is linear and time-invariant in f: its impulse response convolved with f
+        forcing = np.stack([np.convolve(f[:, d], impulse)[:n_steps] for d in range(D)], axis=1)
         return cls(weights, start, goal, scaled, options, free, forcing)
+
+
+@functools.lru_cache(maxsize=8)
+def _grid(n_steps: int, options: DMPOptions) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """What every DMP on one grid shares: phase (P,), normalised basis (P, N), free response (P,), and the
+    impulse response (P,) of eq. 12's rollout from rest at 0 towards 0 to a unit forcing at step 0.
+
+    Loading a library rebuilds hundreds of DMPs on one grid; with these a rebuild is a convolution
+    instead of a rollout loop.  The arrays are read-only (shared by the cache).
+    """
+    x = canonical_phase(n_steps, options.alpha_x)
+    phi = basis_functions(x, options.basis_count(n_steps), options.alpha_x, options.width, normalized=True)
+    free = _free_response(n_steps, options)
+    unit = np.zeros((n_steps, 1))
+    unit[0] = 1.0
+    impulse = integrate(np.zeros(1), np.zeros(1), unit, options)[:, 0]
+    for a in (x, phi, free, impulse):
+        a.setflags(write=False)
+    return x, phi, free, impulse
 
 
 def canonical_phase(n_steps: int, alpha_x: float) -> np.ndarray:
@@ -309,8 +329,7 @@ def learn_dmp(demo: np.ndarray, options: DMPOptions | None = None) -> DMP:
     target = free[-1] * amplitude / S  # scaled: a(T); absolute: a(T) (g - y0)
     weights = weights + np.outer(target - weights @ c, c) / (c @ c)
 
-    forcing = integrate(np.zeros(D), np.zeros(D), (phi @ weights.T) * x[:, None], options)
-    return DMP(weights, y0.copy(), g.copy(), scaled, options, free, forcing)
+    return DMP.from_weights(weights, y0.copy(), g.copy(), scaled, P, options)  # what loading a library does too
 
 
 def generate(dmp: DMP, start: np.ndarray, goal: np.ndarray) -> np.ndarray:

@@ -1,0 +1,120 @@
+"""LibraryDimensionRRT: a validated library path at once, refined by dimension-RRT; plans from scratch without one."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from helpers.library_standins import sampler
+from ompl import base as ob
+
+from tpee_ompl.library import PathLibrary
+from tpee_ompl.library.planner import LibraryDimensionRRT, infer_sector
+from tpee_ompl.model.queries import load_queries
+from tpee_ompl.model.sectors import posture_preset
+from tpee_ompl.model.wearer_arm import WearerArm
+from tpee_ompl.planning.paths import path_passes_motion_checks, path_to_array
+from tpee_ompl.planning.setup import make_simple_setup
+
+
+def _query(robot: WearerArm, i: int, j: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    return sampler(robot)(np.random.default_rng(seed), i, j)
+
+
+def _solve(robot, library, start, goal, ptc=None, **kw):
+    ss = make_simple_setup(robot, start, goal)
+    planner = LibraryDimensionRRT(ss.getSpaceInformation(), library, **kw)
+    ss.setPlanner(planner)
+    status = ss.solve(ptc(ss) if ptc else 5.0)
+    return ss, planner, status
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_library_path_is_the_first_exact_solution_and_the_final_path_is_proven(robot, library: PathLibrary, seed):
+    start, goal = _query(robot, 1, 2, seed)
+    ss, planner, status = _solve(robot, library, start, goal, max_samples=150, seed=seed)
+    stats = planner.last_run_stats()
+    assert status == ob.PlannerStatus.EXACT_SOLUTION and ss.haveExactSolutionPath()
+    assert stats["library_outcome"] in ("dmp", "repaired") and stats["candidates_tried"] >= 1
+    first_cost = stats["progress"][0][1]
+    assert stats["best_cost"] <= first_cost  # refinement never makes it worse
+    path = ss.getSolutionPath()
+    W = path_to_array(path, 4)
+    assert np.allclose(W[0], start) and np.allclose(W[-1], goal)
+    assert path_passes_motion_checks(ss.getSpaceInformation(), path)
+    assert path.length() == pytest.approx(stats["best_cost"])
+
+
+def test_first_solution_stops_at_the_library_path_under_ompls_exact_solution_condition(robot, library):
+    start, goal = _query(robot, 1, 2, 0)
+    ss, planner, status = _solve(
+        robot, library, start, goal,
+        ptc=lambda ss: ob.plannerOrTerminationCondition(ob.exactSolnPlannerTerminationCondition(ss.getProblemDefinition()),
+                                                        ob.timedPlannerTerminationCondition(30.0)))
+    assert status == ob.PlannerStatus.EXACT_SOLUTION
+    assert planner.last_run_stats()["samples"] == 0  # no dimension-RRT sample was drawn
+
+
+def test_a_satisfied_cost_threshold_stops_at_the_library_path(robot, library):
+    start, goal = _query(robot, 1, 2, 1)
+    ss = make_simple_setup(robot, start, goal)
+    ss.getProblemDefinition().getOptimizationObjective().setCostThreshold(ob.Cost(float("inf")))
+    planner = LibraryDimensionRRT(ss.getSpaceInformation(), library)
+    ss.setPlanner(planner)
+    assert ss.solve(30.0) == ob.PlannerStatus.EXACT_SOLUTION
+    assert planner.last_run_stats()["samples"] == 0
+
+
+def _stored(name: str, i: int, j: int):
+    return next(q for q in load_queries(name) if (q.from_sector, q.to_sector) == (i, j))
+
+
+def test_a_pair_without_demonstrations_is_planned_when_the_straight_motion_collides(robot, library):
+    q = _stored("planning_necessary", 3, 4)  # its straight motion collides; the stand-in library has no 3->4
+    ss, planner, status = _solve(robot, library, q.start, q.goal, max_samples=2000, seed=0)
+    stats = planner.last_run_stats()
+    assert stats["candidates_tried"] == 0
+    if status == ob.PlannerStatus.EXACT_SOLUTION:
+        assert stats["library_outcome"] == "planned" and stats["samples"] > 0
+        assert path_passes_motion_checks(ss.getSpaceInformation(), ss.getSolutionPath())
+    else:
+        assert status == ob.PlannerStatus.TIMEOUT and stats["library_outcome"] == "failed"
+        assert not ss.haveExactSolutionPath()
+
+
+def test_a_free_straight_motion_is_taken_when_the_library_has_nothing(robot, library):
+    q = _stored("paper_random", 3, 4)  # paper-style queries: the straight motion is free
+    ss, planner, status = _solve(robot, library, q.start, q.goal, max_samples=50, seed=0)
+    stats = planner.last_run_stats()
+    assert status == ob.PlannerStatus.EXACT_SOLUTION and stats["library_outcome"] == "straight"
+    assert stats["progress"][0][2] == 0  # found before any dimension-RRT sample
+    assert path_passes_motion_checks(ss.getSpaceInformation(), ss.getSolutionPath())
+
+
+def test_sector_pair_is_inferred_from_the_presets_or_refused(robot, library):
+    assert [infer_sector(np.r_[posture_preset(k), 0.1, -0.2]) for k in (1, 2, 3, 4)] == [1, 2, 3, 4]
+    assert infer_sector(np.r_[posture_preset(1) + 0.01, 0.0, 0.0]) is None
+    start, goal = _query(robot, 1, 2, 0)
+    start = start.copy()
+    start[0] += 0.01  # valid, but at no Table-1 preset
+    if robot.is_valid(start):
+        _, _, status = _solve(robot, library, start, goal, max_samples=10)
+        assert status == ob.PlannerStatus.INVALID_START
+
+
+@pytest.mark.parametrize(("kwargs", "match"), [
+    ({"from_sector": 1}, "both"),
+    ({"from_sector": 2, "to_sector": 2}, "cross-sector"),
+    ({"from_sector": 1, "to_sector": 7}, "sector"),
+    ({"max_samples": 0}, "max_samples"),
+    ({"options": "fast"}, "DimensionRRTOptions"),
+])
+def test_bad_settings_raise_value_error_naming_them(robot, library, kwargs, match):
+    ss = make_simple_setup(robot)
+    with pytest.raises(ValueError, match=match):
+        LibraryDimensionRRT(ss.getSpaceInformation(), library, **kwargs)
+
+
+def test_not_a_library_is_refused(robot):
+    ss = make_simple_setup(robot)
+    with pytest.raises(ValueError, match="PathLibrary"):
+        LibraryDimensionRRT(ss.getSpaceInformation(), object())

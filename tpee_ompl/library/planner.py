@@ -1,0 +1,235 @@
+"""The paper's real-time pipeline as one OMPL planner: a library path at once, then dimension-RRT while time remains.
+
+:class:`LibraryDimensionRRT` answers a cross-sector query with the DMP path library (section 4.2:
+the closest demonstrations' blended DMP paths, each checked with ``si.checkMotion`` over the whole
+path) and reports the first valid one as an exact solution; then it keeps improving with
+dimension-RRT (section 4.1) seeded by the closest demonstration's DMP path at the fake-time steps,
+sharing the problem definition, so the best path either found is the answer.  When no library path
+is valid it tries Table 3's straight motion, then plans.  It is an ordinary ``ob.Planner``: ``og.SimpleSetup``,
+``ot.Benchmark`` and the benchmark campaigns use it like any other.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+import math
+import time
+from typing import Any
+
+import numpy as np
+from ompl import base as ob
+
+from ..model.queries import straight_motion
+from ..model.sectors import SECTORS, check_sector, posture_preset
+from ..planning.dimension_rrt import DimensionRRT, DimensionRRTOptions
+from ..planning.paths import array_to_path, path_passes_motion_checks, state_to_array
+from ..planning.tpee import tpee_dimension_rrt
+from .path_library import PathLibrary
+
+__all__ = ["LibraryDimensionRRT", "infer_sector"]
+
+log = logging.getLogger(__name__)
+
+PRESET_TOLERANCE = 1e-6
+"""Radians. How close DOF1/DOF2 must be to a Table-1 preset for :func:`infer_sector` to name its sector."""
+
+
+def infer_sector(q: np.ndarray) -> int | None:
+    """The posture sector whose Table-1 preset (DOF1, DOF2) the configuration ``q`` is at, or None."""
+    for k in SECTORS:
+        if np.allclose(np.asarray(q[:2], dtype=float), posture_preset(k), atol=PRESET_TOLERANCE, rtol=0.0):
+            return k
+    return None
+
+
+def _status(code: Any) -> ob.PlannerStatus:
+    return ob.PlannerStatus(code)
+
+
+class LibraryDimensionRRT(ob.Planner):
+    """A validated library path in milliseconds, refined by dimension-RRT until the termination condition.
+
+    Parameters
+    ----------
+    si : ob.SpaceInformation
+        The wearer arm's space (``make_simple_setup``): RealVector(4).
+    library : PathLibrary
+        The DMP path library (e.g. ``PathLibrary.load(default_library_path(), robot)``); its own
+        fallback planner is not used (this planner plans under the termination condition instead).
+    from_sector, to_sector : int, optional
+        The sector pair; by default inferred at each solve from the start's and goal's DOF1/DOF2
+        (the Table-1 presets, :func:`infer_sector`).
+    options : DimensionRRTOptions, optional
+        Settings of the refining dimension-RRT (its ``name`` is ignored; this planner's is ``name``).
+    name : str
+        Planner name (``geometric_<name>`` in a Benchmark database).
+    **overrides
+        Fields of :class:`DimensionRRTOptions` replacing those of ``options``.
+
+    Every exact path passed ``si.checkMotion`` over the whole path (the library path here, the
+    dimension-RRT path in :class:`DimensionRRT`); the problem definition keeps the cheaper.
+    """
+
+    def __init__(
+        self,
+        si: ob.SpaceInformation,
+        library: PathLibrary,
+        from_sector: int | None = None,
+        to_sector: int | None = None,
+        options: DimensionRRTOptions | None = None,
+        *,
+        name: str = "LibraryDimensionRRT",
+        **overrides: Any,
+    ) -> None:
+        # everything is checked before ob.Planner.__init__ (an exception after it crashes at GC)
+        if not isinstance(library, PathLibrary):
+            raise ValueError(f"library must be a PathLibrary, got {type(library).__name__}")
+        if not isinstance(si, ob.SpaceInformation):
+            raise ValueError(f"si must be an ompl.base.SpaceInformation, got {type(si).__name__}")
+        if (from_sector is None) != (to_sector is None):
+            raise ValueError("give both from_sector and to_sector, or neither (inferred from start and goal)")
+        pair = None if from_sector is None else (check_sector(from_sector), check_sector(to_sector))
+        if pair is not None and pair[0] == pair[1]:
+            raise ValueError(f"({pair[0]}, {pair[1]}) is not a cross-sector motion")
+        opts = options if options is not None else DimensionRRTOptions()
+        if not isinstance(opts, DimensionRRTOptions):
+            raise ValueError(f"options must be a DimensionRRTOptions, got {type(opts).__name__}")
+        opts = dataclasses.replace(opts, name=name, **overrides)
+        super().__init__(si, name)
+        self.library = library
+        self.pair = pair
+        self.options = opts
+        self._inner: DimensionRRT | None = None
+        self._stats: dict[str, Any] = self._empty_stats()
+
+    # ------------------------------------------------------------------ reporting
+    def settings(self) -> dict[str, str]:
+        """Parameter name -> value as text (for the benchmark's ``plannerConfigs``)."""
+        lib = self.library
+        return {
+            "pair": "inferred" if self.pair is None else f"{self.pair[0]}->{self.pair[1]}",
+            "library_demos": str(len(lib)),
+            "library_model_hash": str(lib.robot.model_hash),
+            "n_candidates": str(lib.n_candidates),
+            "query_stride": str(lib.query_stride),
+            "max_samples": str(self.options.max_samples),
+            "seed": str(self.options.seed),
+        }
+
+    @staticmethod
+    def _empty_stats() -> dict[str, Any]:
+        return {"samples": 0, "iterations": 0, "collision_checks": 0, "first_solution_time": None,
+                "best_cost": math.inf, "progress": [], "library_outcome": None, "candidates_tried": 0,
+                "library_seconds": None}
+
+    def last_run_stats(self) -> dict[str, Any]:
+        """Statistics of the last solve: ``library_outcome`` ("dmp": the closest demonstration's DMP path,
+        "repaired": a later candidate's, "straight": Table 3's straight motion, "planned": dimension-RRT's,
+        "failed"), ``candidates_tried``, ``library_seconds``, and those of :class:`DimensionRRT`
+        (samples, first_solution_time, best_cost, progress [(time_s, best_cost, samples), ...])."""
+        out = dict(self._stats)
+        out["progress"] = list(self._stats["progress"])
+        return out
+
+    # ------------------------------------------------------------------ OMPL overrides
+    def clear(self) -> None:
+        """Forget the last run."""
+        super().clear()
+        self._inner = None
+        self._stats = self._empty_stats()
+
+    def solve(self, ptc: ob.PlannerTerminationCondition | float) -> ob.PlannerStatus:
+        """The library's first valid path, then dimension-RRT until ``ptc``; see the class docstring."""
+        if isinstance(ptc, (int, float)):
+            ptc = ob.timedPlannerTerminationCondition(float(ptc))
+        self._stats = self._empty_stats()
+        try:
+            return self._solve(ptc)
+        except Exception:  # an exception escaping into ot.Benchmark would abort the whole benchmark
+            log.exception("LibraryDimensionRRT.solve failed")
+            return _status(ob.PlannerStatus.CRASH)
+
+    def _endpoints(self) -> tuple[np.ndarray, np.ndarray] | ob.PlannerStatus:
+        si, pdef = self.getSpaceInformation(), self.getProblemDefinition()
+        pis = self.getPlannerInputStates()  # never pdef.getStartState(i) (see OMPL_PYTHON.md)
+        start = pis.nextStart()
+        if start is None and pis.getSeenStartStatesCount() > 0:
+            pis.restart()
+            start = pis.nextStart()
+        if start is None or not (si.satisfiesBounds(start) and si.isValid(start)):
+            return _status(ob.PlannerStatus.INVALID_START)
+        goal = pdef.getGoal()
+        if not isinstance(goal, ob.GoalState):
+            log.error("LibraryDimensionRRT needs a goal that is a single state, got %s", type(goal).__name__)
+            return _status(ob.PlannerStatus.UNRECOGNIZED_GOAL_TYPE)
+        n = si.getStateDimension()
+        return state_to_array(start, n), state_to_array(goal.getState(), n)
+
+    def _solve(self, ptc: ob.PlannerTerminationCondition) -> ob.PlannerStatus:
+        t0 = time.perf_counter()
+        si, pdef = self.getSpaceInformation(), self.getProblemDefinition()
+        ends = self._endpoints()
+        if isinstance(ends, ob.PlannerStatus):
+            return ends
+        start, goal = ends
+        i, j = self.pair if self.pair is not None else (infer_sector(start), infer_sector(goal))
+        if i is None or j is None or i == j:
+            log.error("LibraryDimensionRRT: start and goal are not at two different Table-1 posture presets "
+                      "(give from_sector/to_sector); start DOF1/DOF2 %s, goal %s", start[:2], goal[:2])
+            return _status(ob.PlannerStatus.INVALID_START if i is None else ob.PlannerStatus.INVALID_GOAL)
+        stats, progress = self._stats, self._stats["progress"]
+        lib = self.library
+        have_exact = False
+        seed = None
+        if (i, j) in lib.pairs and len(lib.pairs[(i, j)].starts):
+            order = lib.demo_order(start, goal, i, j)
+            for rank, k in enumerate(order[: lib.n_candidates]):
+                stats["candidates_tried"] += 1
+                W = lib.generate(start, goal, i, j, int(k), stride=lib.query_stride)
+                path = array_to_path(si, W)
+                if path_passes_motion_checks(si, path):
+                    pdef.addSolutionPath(path, False, 0.0, self.getName())
+                    now = time.perf_counter() - t0
+                    cost = float(path.cost(pdef.getOptimizationObjective()).value())
+                    stats.update(library_outcome="dmp" if rank == 0 else "repaired", first_solution_time=now,
+                                 best_cost=cost)
+                    progress.append((now, cost, 0))
+                    have_exact = True
+                    break
+            seed = lib.generate(start, goal, i, j, int(order[0]), stride=lib.per_step)
+        if not have_exact:  # Table 3's straight motion: often free when the library's paths are not
+            path = array_to_path(si, straight_motion(start, goal, i, j))
+            if path_passes_motion_checks(si, path):
+                pdef.addSolutionPath(path, False, 0.0, self.getName())
+                now = time.perf_counter() - t0
+                cost = float(path.cost(pdef.getOptimizationObjective()).value())
+                stats.update(library_outcome="straight", first_solution_time=now, best_cost=cost)
+                progress.append((now, cost, 0))
+                have_exact = True
+        stats["library_seconds"] = time.perf_counter() - t0
+        if stats["library_outcome"] is None:
+            stats["library_outcome"] = "planned"
+        opt = pdef.getOptimizationObjective()
+        if have_exact and (ptc() or opt.isSatisfied(ob.Cost(stats["best_cost"]))):
+            return _status(ob.PlannerStatus.EXACT_SOLUTION)
+        inner = tpee_dimension_rrt(si, i, j, self.options,
+                                   initial_waypoints=seed if seed is not None and seed.shape[0] == self.options.h
+                                   else None)
+        inner.setProblemDefinition(pdef)
+        self._inner = inner
+        t_inner = time.perf_counter() - t0
+        status = inner.solve(ptc)
+        s = inner.last_run_stats()
+        stats.update(samples=s["samples"], iterations=s["iterations"], collision_checks=s["collision_checks"])
+        for t, cost, samples in s["progress"]:
+            if math.isfinite(cost) and cost < stats["best_cost"]:
+                if stats["first_solution_time"] is None:
+                    stats["first_solution_time"] = t_inner + t
+                stats["best_cost"] = cost
+                progress.append((t_inner + t, cost, samples))
+        progress.append((time.perf_counter() - t0, stats["best_cost"], stats["samples"]))
+        if have_exact or status == ob.PlannerStatus.EXACT_SOLUTION:
+            return _status(ob.PlannerStatus.EXACT_SOLUTION)
+        stats["library_outcome"] = "failed"
+        return status
