@@ -1,0 +1,48 @@
+"""SimplifiedPlanner: RRTConnect + OMPL's PathSimplifier as one planner, its path proven and never longer."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from ompl import base as ob
+from ompl import geometric as og
+
+from tpee_ompl.model.queries import load_queries
+from tpee_ompl.planning.paths import path_passes_motion_checks, path_to_array
+from tpee_ompl.planning.setup import make_simple_setup
+from tpee_ompl.planning.simplified import SimplifiedPlanner
+
+
+@pytest.mark.parametrize("index", [0, 37, 95])
+def test_simplified_path_is_proven_reaches_the_goal_and_is_no_longer_than_the_raw_one(robot, index):
+    q = load_queries("planning_necessary")[index]
+    ss = make_simple_setup(robot, q.start, q.goal)
+    si = ss.getSpaceInformation()
+    planner = SimplifiedPlanner(si, og.RRTConnect(si))
+    ss.setPlanner(planner)
+    status = ss.solve(5.0)
+    assert status == ob.PlannerStatus.EXACT_SOLUTION and planner.getName() == "RRTConnectSimplify"
+    stats = planner.last_run_stats()
+    path = ss.getSolutionPath()
+    W = path_to_array(path, 4)
+    assert np.allclose(W[0], q.start) and np.allclose(W[-1], q.goal)
+    assert path_passes_motion_checks(si, path)
+    assert stats["best_cost"] <= stats["raw_cost"] and path.length() == pytest.approx(stats["best_cost"])
+    assert stats["first_solution_time"] is not None
+
+
+def test_a_planner_that_finds_nothing_reports_its_status(robot):
+    q = load_queries("planning_necessary")[0]
+    ss = make_simple_setup(robot, q.start, q.goal)
+    si = ss.getSpaceInformation()
+    planner = SimplifiedPlanner(si, og.RRTConnect(si))
+    ss.setPlanner(planner)
+    status = ss.solve(ob.PlannerTerminationCondition(lambda: True))  # no time at all
+    assert status != ob.PlannerStatus.EXACT_SOLUTION and not ss.haveExactSolutionPath()
+    assert planner.last_run_stats()["first_solution_time"] is None
+
+
+def test_inner_must_be_an_ompl_planner(robot):
+    si = make_simple_setup(robot).getSpaceInformation()
+    with pytest.raises(ValueError, match="inner"):
+        SimplifiedPlanner(si, "RRTConnect")

@@ -1,0 +1,112 @@
+"""A planner followed by OMPL's path simplifier, as one planner: the pipeline most OMPL and MoveIt users run.
+
+``SimplifiedPlanner(si, og.RRTConnect(si))`` plans with RRTConnect until its first exact path, then
+shortens it with ``og.PathSimplifier.simplify`` until the simplifier converges or the termination
+condition ends it.  The simplification is part of the planner's time (so a benchmark compares it at
+equal time with an anytime planner), and the simplified path is added to the problem definition
+after it passed ``si.checkMotion`` over the whole path.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+from typing import Any
+
+from ompl import base as ob
+from ompl import geometric as og
+
+from .paths import path_passes_motion_checks
+
+__all__ = ["SimplifiedPlanner"]
+
+log = logging.getLogger(__name__)
+
+
+class SimplifiedPlanner(ob.Planner):
+    """``inner`` until its first exact solution, then OMPL's ``PathSimplifier`` in the remaining time.
+
+    Parameters
+    ----------
+    si : ob.SpaceInformation
+    inner : ob.Planner
+        The planner that finds the first path (e.g. ``og.RRTConnect(si)``), on the same ``si``.
+    name : str, optional
+        Planner name (default ``<inner name>Simplify``, e.g. ``RRTConnectSimplify``).
+    """
+
+    def __init__(self, si: ob.SpaceInformation, inner: ob.Planner, name: str | None = None) -> None:
+        if not isinstance(inner, ob.Planner):
+            raise ValueError(f"inner must be an ompl.base.Planner, got {type(inner).__name__}")
+        if name is not None and (not isinstance(name, str) or not name):
+            raise ValueError(f"name must be a non-empty string, got {name!r}")
+        super().__init__(si, name or f"{inner.getName()}Simplify")
+        self.inner = inner
+        self._inner_setup = False
+        self._stats: dict[str, Any] = self._empty_stats()
+
+    @staticmethod
+    def _empty_stats() -> dict[str, Any]:
+        return {"first_solution_time": None, "raw_cost": math.inf, "best_cost": math.inf, "simplify_time": 0.0,
+                "progress": []}
+
+    def settings(self) -> dict[str, str]:
+        """Parameter name -> value as text (for the benchmark's ``plannerConfigs``)."""
+        return {"inner": self.inner.getName(), "simplifier": "PathSimplifier.simplify(path, ptc)"}
+
+    def last_run_stats(self) -> dict[str, Any]:
+        """first_solution_time (s, the inner planner's exact path), raw_cost, best_cost (after
+        simplifying), simplify_time (s), progress [(time_s, best_cost, 0), ...]."""
+        out = dict(self._stats)
+        out["progress"] = list(self._stats["progress"])
+        return out
+
+    def clear(self) -> None:
+        """Forget the last run (and the inner planner's)."""
+        super().clear()
+        self.inner.clear()
+        self._stats = self._empty_stats()
+
+    def solve(self, ptc: ob.PlannerTerminationCondition | float) -> ob.PlannerStatus:
+        """Plan with the inner planner, then simplify its exact path until converged or ``ptc``."""
+        if isinstance(ptc, (int, float)):
+            ptc = ob.timedPlannerTerminationCondition(float(ptc))
+        self._stats = self._empty_stats()
+        try:
+            return self._solve(ptc)
+        except Exception:  # an exception escaping into ot.Benchmark would abort the whole benchmark
+            log.exception("SimplifiedPlanner.solve failed")
+            return ob.PlannerStatus(ob.PlannerStatus.CRASH)
+
+    def _solve(self, ptc: ob.PlannerTerminationCondition) -> ob.PlannerStatus:
+        t0 = time.perf_counter()
+        si, pdef = self.getSpaceInformation(), self.getProblemDefinition()
+        if pdef is None:
+            log.error("SimplifiedPlanner: no problem definition")
+            return ob.PlannerStatus(ob.PlannerStatus.ABORT)
+        self.inner.setProblemDefinition(pdef)
+        if not self._inner_setup:  # the bindings expose setup() but not isSetup()
+            self.inner.setup()
+            self._inner_setup = True
+        status = self.inner.solve(ptc)
+        if not pdef.hasExactSolution():
+            return status
+        stats, opt = self._stats, pdef.getOptimizationObjective()
+        raw = og.PathGeometric(pdef.getSolutionPath())
+        now = time.perf_counter() - t0
+        stats.update(first_solution_time=now, raw_cost=float(raw.cost(opt).value()))
+        stats["best_cost"] = stats["raw_cost"]
+        stats["progress"].append((now, stats["raw_cost"], 0))
+        if ptc():
+            return ob.PlannerStatus(ob.PlannerStatus.EXACT_SOLUTION)
+        path = og.PathGeometric(raw)
+        t1 = time.perf_counter()
+        og.PathSimplifier(si, pdef.getGoal(), opt).simplify(path, ptc)
+        stats["simplify_time"] = time.perf_counter() - t1
+        cost = float(path.cost(opt).value())
+        if cost < stats["raw_cost"] and path_passes_motion_checks(si, path):
+            pdef.addSolutionPath(path, False, 0.0, self.getName())
+            stats["best_cost"] = cost
+        stats["progress"].append((time.perf_counter() - t0, stats["best_cost"], 0))
+        return ob.PlannerStatus(ob.PlannerStatus.EXACT_SOLUTION)
