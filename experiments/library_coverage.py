@@ -38,7 +38,7 @@ def main(argv: list[str] | None = None) -> None:
     report = {"library": str(default_library_path()), "build_seed": lib.build_params.get("seed"), "sets": {}}
     for name in args.sets:
         counts: dict[str, collections.Counter] = collections.defaultdict(collections.Counter)
-        nearest = []
+        nearest, first, solved = [], [], 0
         for q in load_queries(name, robot):
             pair = (q.from_sector, q.to_sector)
             pd = lib.pairs[pair]
@@ -48,11 +48,19 @@ def main(argv: list[str] | None = None) -> None:
             planner = LibraryDimensionRRT(ss.getSpaceInformation(), lib, seed=1)
             ss.setPlanner(planner)
             ss.solve(args.budget)
-            counts[f"{pair[0]}->{pair[1]}"][planner.last_run_stats()["library_outcome"]] += 1
+            stats = planner.last_run_stats()
+            counts[f"{pair[0]}->{pair[1]}"][stats["library_outcome"]] += 1
+            if ss.haveExactSolutionPath():
+                solved += 1
+                first.append(stats["first_solution_time"])
         total = sum(counts.values(), collections.Counter())
+        first_ms = np.array(first) * 1e3
         report["sets"][name] = {"per_pair": {k: dict(v) for k, v in sorted(counts.items())}, "total": dict(total),
-                                "nearest_demo_rad": {"min": min(nearest), "median": float(np.median(nearest))}}
-        print(f"\n## {name}: {sum(total.values())} queries, budget {args.budget} s")
+                                "nearest_demo_rad": {"min": min(nearest), "median": float(np.median(nearest))},
+                                "solved": solved, "first_path_ms": {"median": float(np.median(first_ms)),
+                                                                    "p95": float(np.percentile(first_ms, 95))}}
+        print(f"\n## {name}: {sum(total.values())} queries, budget {args.budget} s: {solved} solved; "
+              f"time to the first exact path median {np.median(first_ms):.2f} ms, p95 {np.percentile(first_ms, 95):.2f} ms")
         print("| pair | first candidate valid | later candidate | straight motion | planned | failed |\n|---|---|---|---|---|---|")
         for k, v in sorted(counts.items()):
             print(f"| {k} | {v['dmp']} | {v['repaired']} | {v['straight']} | {v['planned']} | {v['failed']} |")
