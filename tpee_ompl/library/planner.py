@@ -24,6 +24,7 @@ from ..model.queries import straight_motion
 from ..model.sectors import SECTORS, check_sector, posture_preset
 from ..planning.dimension_rrt import DimensionRRT, DimensionRRTOptions
 from ..planning.paths import array_to_path, path_passes_motion_checks, state_to_array
+from ..planning.planner_base import PythonPlanner, planner_status
 from ..planning.tpee import tpee_dimension_rrt
 from .path_library import PathLibrary
 
@@ -43,11 +44,7 @@ def infer_sector(q: np.ndarray) -> int | None:
     return None
 
 
-def _status(code: Any) -> ob.PlannerStatus:
-    return ob.PlannerStatus(code)
-
-
-class LibraryDimensionRRT(ob.Planner):
+class LibraryDimensionRRT(PythonPlanner):
     """A validated library path in milliseconds, refined by dimension-RRT until the termination condition.
 
     Parameters
@@ -101,7 +98,6 @@ class LibraryDimensionRRT(ob.Planner):
         self.pair = pair
         self.options = opts
         self._inner: DimensionRRT | None = None
-        self._stats: dict[str, Any] = self._empty_stats()
 
     # ------------------------------------------------------------------ reporting
     def settings(self) -> dict[str, str]:
@@ -119,52 +115,20 @@ class LibraryDimensionRRT(ob.Planner):
 
     @staticmethod
     def _empty_stats() -> dict[str, Any]:
-        return {"samples": 0, "iterations": 0, "collision_checks": 0, "first_solution_time": None,
-                "best_cost": math.inf, "progress": [], "library_outcome": None, "candidates_tried": 0,
-                "library_seconds": None}
+        return {**PythonPlanner._empty_stats(), "samples": 0, "iterations": 0, "collision_checks": 0,
+                "library_outcome": None, "candidates_tried": 0, "library_seconds": None}
 
     def last_run_stats(self) -> dict[str, Any]:
         """Statistics of the last solve: ``library_outcome`` ("dmp": the closest demonstration's DMP path,
         "repaired": a later candidate's, "straight": Table 3's straight motion, "planned": dimension-RRT's,
         "failed"), ``candidates_tried``, ``library_seconds``, and those of :class:`DimensionRRT`
         (samples, first_solution_time, best_cost, progress [(time_s, best_cost, samples), ...])."""
-        out = dict(self._stats)
-        out["progress"] = list(self._stats["progress"])
-        return out
+        return super().last_run_stats()
 
-    # ------------------------------------------------------------------ OMPL overrides
     def clear(self) -> None:
         """Forget the last run."""
         super().clear()
         self._inner = None
-        self._stats = self._empty_stats()
-
-    def solve(self, ptc: ob.PlannerTerminationCondition | float) -> ob.PlannerStatus:
-        """The library's first valid path, then dimension-RRT until ``ptc``; see the class docstring."""
-        if isinstance(ptc, (int, float)):
-            ptc = ob.timedPlannerTerminationCondition(float(ptc))
-        self._stats = self._empty_stats()
-        try:
-            return self._solve(ptc)
-        except Exception:  # an exception escaping into ot.Benchmark would abort the whole benchmark
-            log.exception("LibraryDimensionRRT.solve failed")
-            return _status(ob.PlannerStatus.CRASH)
-
-    def _endpoints(self) -> tuple[np.ndarray, np.ndarray] | ob.PlannerStatus:
-        si, pdef = self.getSpaceInformation(), self.getProblemDefinition()
-        pis = self.getPlannerInputStates()  # never pdef.getStartState(i) (see OMPL_PYTHON.md)
-        start = pis.nextStart()
-        if start is None and pis.getSeenStartStatesCount() > 0:
-            pis.restart()
-            start = pis.nextStart()
-        if start is None or not (si.satisfiesBounds(start) and si.isValid(start)):
-            return _status(ob.PlannerStatus.INVALID_START)
-        goal = pdef.getGoal()
-        if not isinstance(goal, ob.GoalState):
-            log.error("LibraryDimensionRRT needs a goal that is a single state, got %s", type(goal).__name__)
-            return _status(ob.PlannerStatus.UNRECOGNIZED_GOAL_TYPE)
-        n = si.getStateDimension()
-        return state_to_array(start, n), state_to_array(goal.getState(), n)
 
     def _solve(self, ptc: ob.PlannerTerminationCondition) -> ob.PlannerStatus:
         t0 = time.perf_counter()
@@ -172,12 +136,13 @@ class LibraryDimensionRRT(ob.Planner):
         ends = self._endpoints()
         if isinstance(ends, ob.PlannerStatus):
             return ends
-        start, goal = ends
+        n = si.getStateDimension()
+        start, goal = state_to_array(ends[0], n), state_to_array(ends[1], n)
         i, j = self.pair if self.pair is not None else (infer_sector(start), infer_sector(goal))
         if i is None or j is None or i == j:
             log.error("LibraryDimensionRRT: start and goal are not at two different Table-1 posture presets "
                       "(give from_sector/to_sector); start DOF1/DOF2 %s, goal %s", start[:2], goal[:2])
-            return _status(ob.PlannerStatus.INVALID_START if i is None else ob.PlannerStatus.INVALID_GOAL)
+            return planner_status(ob.PlannerStatus.INVALID_START if i is None else ob.PlannerStatus.INVALID_GOAL)
         stats, progress = self._stats, self._stats["progress"]
         lib = self.library
         have_exact = False
@@ -212,7 +177,7 @@ class LibraryDimensionRRT(ob.Planner):
             stats["library_outcome"] = "planned"
         opt = pdef.getOptimizationObjective()
         if have_exact and (ptc() or opt.isSatisfied(ob.Cost(stats["best_cost"]))):
-            return _status(ob.PlannerStatus.EXACT_SOLUTION)
+            return planner_status(ob.PlannerStatus.EXACT_SOLUTION)
         inner = tpee_dimension_rrt(si, i, j, self.options,
                                    initial_waypoints=seed if seed is not None and seed.shape[0] == self.options.h
                                    else None)
@@ -230,6 +195,6 @@ class LibraryDimensionRRT(ob.Planner):
                 progress.append((t_inner + t, cost, samples))
         progress.append((time.perf_counter() - t0, stats["best_cost"], stats["samples"]))
         if have_exact or status == ob.PlannerStatus.EXACT_SOLUTION:
-            return _status(ob.PlannerStatus.EXACT_SOLUTION)
+            return planner_status(ob.PlannerStatus.EXACT_SOLUTION)
         stats["library_outcome"] = "failed"
         return status

@@ -71,6 +71,7 @@ from ompl import geometric as og
 from ..validation import check_bool, check_int, check_name, check_number
 from .dimension_search import Checker, Search
 from .grouped_space import GroupedSpace
+from .planner_base import PythonPlanner, planner_status
 from .solution_posting import SolutionPoster
 
 __all__ = ["DimensionRRT", "DimensionRRTOptions"]
@@ -79,10 +80,6 @@ log = logging.getLogger(__name__)
 
 _PROGRESS_PERIOD = 0.01
 """Seconds between progress-trace entries (OMPL's benchmark records progress about as often)."""
-
-
-def _status(code: Any) -> ob.PlannerStatus:
-    return ob.PlannerStatus(code)
 
 
 @dataclass(frozen=True)
@@ -147,7 +144,7 @@ def _resolve_options(options: DimensionRRTOptions | None, overrides: Mapping[str
     return dataclasses.replace(options, **overrides) if overrides else options
 
 
-class DimensionRRT(ob.Planner):
+class DimensionRRT(PythonPlanner):
     """Dimension-RRT (paper sec. 4.1.2): anytime, fake-time, DOF-grouped path optimisation.
 
     Parameters
@@ -214,7 +211,6 @@ class DimensionRRT(ob.Planner):
         self.range_ = rng_full
         self.batch = opts.batch
         self._rng = np.random.default_rng(opts.seed)
-        self._stats: dict[str, Any] = self._empty_stats()
         self._ranges = {gi: rng_full[self.grouped.group_dims(gi)] for gi in self.grouped.planned}
         self._initial = initial
         self._callback: Callable[[ob.Planner, list[ob.State], ob.Cost], object] | None = None
@@ -303,63 +299,25 @@ class DimensionRRT(ob.Planner):
         """Statistics of the last solve: samples, collision_checks, first_solution_time (s or None),
         best_cost (inf if none), iterations, progress [(time_s, best_cost, samples), ...],
         solutions_posted (paths added to the problem definition)."""
-        out = dict(self._stats)
-        out["progress"] = list(self._stats["progress"])
-        return out
+        return super().last_run_stats()
 
-    # ------------------------------------------------------------------ OMPL overrides
-    def clear(self) -> None:
-        """Forget the last run (the random generator keeps its state, so runs differ)."""
-        super().clear()
-        self._stats = self._empty_stats()
-
-    def solve(self, ptc: ob.PlannerTerminationCondition | float) -> ob.PlannerStatus:
-        """Plan until ``ptc`` or the sample cap; see the module docstring."""
-        if isinstance(ptc, (int, float)):  # p.solve(1.0) from Python reaches here with a float
-            ptc = ob.timedPlannerTerminationCondition(float(ptc))
-        self._stats = self._empty_stats()
+    def _start_run(self) -> None:
+        super()._start_run()
         self._callback_failed = False
-        try:
-            return self._solve(ptc)
-        except Exception:  # an exception escaping into ot.Benchmark would abort the whole benchmark
-            log.exception("DimensionRRT.solve failed")
-            return _status(ob.PlannerStatus.CRASH)
-
-    def _endpoints(self) -> tuple[ob.State | None, ob.State | None, ob.PlannerStatus | None]:
-        si, pdef = self.getSpaceInformation(), self.getProblemDefinition()
-        # never pdef.getStartState(i): its Python wrapper frees a state pdef owns (crash at exit)
-        pis = self.getPlannerInputStates()
-        start = pis.nextStart()
-        if start is None and pis.getSeenStartStatesCount() > 0:  # solve() again without clear()
-            pis.restart()
-            start = pis.nextStart()
-        if start is None or not (si.satisfiesBounds(start) and si.isValid(start)):
-            return None, None, _status(ob.PlannerStatus.INVALID_START)
-        goal = pdef.getGoal()
-        if isinstance(goal, ob.GoalState):
-            gstate = goal.getState()
-        else:
-            log.error("DimensionRRT needs a goal that is a single state, got %s", type(goal).__name__)
-            return None, None, _status(ob.PlannerStatus.UNRECOGNIZED_GOAL_TYPE)
-        if not (si.satisfiesBounds(gstate) and si.isValid(gstate)):
-            return None, None, _status(ob.PlannerStatus.INVALID_GOAL)
-        return start, gstate, None
 
     def _solve(self, ptc: ob.PlannerTerminationCondition) -> ob.PlannerStatus:
         t0 = time.perf_counter()
         si, pdef = self.getSpaceInformation(), self.getProblemDefinition()
-        if pdef is None:
-            log.error("DimensionRRT: no problem definition; call setProblemDefinition(pdef) or solve through og.SimpleSetup")
-            return _status(ob.PlannerStatus.ABORT)
-        start, gstate, bad = self._endpoints()
-        if bad is not None:
-            return bad
+        ends = self._endpoints()
+        if isinstance(ends, ob.PlannerStatus):
+            return ends
+        start, gstate = ends
         layout = self.grouped.layout
         q0, q1 = layout.read(start), layout.read(gstate)
         mismatch = self.grouped.endpoint_mismatch(q0, q1)
         if mismatch is not None:
             log.error("the %s state is not on the prescribed trajectory", mismatch)
-            return _status(ob.PlannerStatus.INVALID_START if mismatch == "start" else ob.PlannerStatus.INVALID_GOAL)
+            return planner_status(ob.PlannerStatus.INVALID_START if mismatch == "start" else ob.PlannerStatus.INVALID_GOAL)
         checker = Checker(si, layout, self.batch)
         checks0 = checker.counter()
         search = Search(self.grouped, checker, self._rng, q0, q1, self.narrow_after, self.narrowing, self._ranges,
@@ -397,4 +355,4 @@ class DimensionRRT(ob.Planner):
             best_cost=poster.best_cost,
             solutions_posted=poster.posted,
         )
-        return _status(ob.PlannerStatus.EXACT_SOLUTION if poster.posted else ob.PlannerStatus.TIMEOUT)
+        return planner_status(ob.PlannerStatus.EXACT_SOLUTION if poster.posted else ob.PlannerStatus.TIMEOUT)

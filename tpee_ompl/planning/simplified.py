@@ -18,13 +18,14 @@ from ompl import base as ob
 from ompl import geometric as og
 
 from .paths import path_passes_motion_checks
+from .planner_base import PythonPlanner, planner_status
 
 __all__ = ["SimplifiedPlanner"]
 
 log = logging.getLogger(__name__)
 
 
-class SimplifiedPlanner(ob.Planner):
+class SimplifiedPlanner(PythonPlanner):
     """``inner`` until its first exact solution, then OMPL's ``PathSimplifier`` in the remaining time.
 
     Parameters
@@ -44,12 +45,10 @@ class SimplifiedPlanner(ob.Planner):
         super().__init__(si, name or f"{inner.getName()}Simplify")
         self.inner = inner
         self._inner_setup = False
-        self._stats: dict[str, Any] = self._empty_stats()
 
     @staticmethod
     def _empty_stats() -> dict[str, Any]:
-        return {"first_solution_time": None, "raw_cost": math.inf, "best_cost": math.inf, "simplify_time": 0.0,
-                "progress": []}
+        return {**PythonPlanner._empty_stats(), "raw_cost": math.inf, "simplify_time": 0.0}
 
     def settings(self) -> dict[str, str]:
         """Parameter name -> value as text (for the benchmark's ``plannerConfigs``)."""
@@ -58,33 +57,16 @@ class SimplifiedPlanner(ob.Planner):
     def last_run_stats(self) -> dict[str, Any]:
         """first_solution_time (s, the inner planner's exact path), raw_cost, best_cost (after
         simplifying), simplify_time (s), progress [(time_s, best_cost, 0), ...]."""
-        out = dict(self._stats)
-        out["progress"] = list(self._stats["progress"])
-        return out
+        return super().last_run_stats()
 
     def clear(self) -> None:
         """Forget the last run (and the inner planner's)."""
         super().clear()
         self.inner.clear()
-        self._stats = self._empty_stats()
-
-    def solve(self, ptc: ob.PlannerTerminationCondition | float) -> ob.PlannerStatus:
-        """Plan with the inner planner, then simplify its exact path until converged or ``ptc``."""
-        if isinstance(ptc, (int, float)):
-            ptc = ob.timedPlannerTerminationCondition(float(ptc))
-        self._stats = self._empty_stats()
-        try:
-            return self._solve(ptc)
-        except Exception:  # an exception escaping into ot.Benchmark would abort the whole benchmark
-            log.exception("SimplifiedPlanner.solve failed")
-            return ob.PlannerStatus(ob.PlannerStatus.CRASH)
 
     def _solve(self, ptc: ob.PlannerTerminationCondition) -> ob.PlannerStatus:
         t0 = time.perf_counter()
         si, pdef = self.getSpaceInformation(), self.getProblemDefinition()
-        if pdef is None:
-            log.error("SimplifiedPlanner: no problem definition")
-            return ob.PlannerStatus(ob.PlannerStatus.ABORT)
         self.inner.setProblemDefinition(pdef)
         if not self._inner_setup:  # the bindings expose setup() but not isSetup()
             self.inner.setup()
@@ -99,7 +81,7 @@ class SimplifiedPlanner(ob.Planner):
         stats["best_cost"] = stats["raw_cost"]
         stats["progress"].append((now, stats["raw_cost"], 0))
         if ptc():
-            return ob.PlannerStatus(ob.PlannerStatus.EXACT_SOLUTION)
+            return planner_status(ob.PlannerStatus.EXACT_SOLUTION)
         path = og.PathGeometric(raw)
         t1 = time.perf_counter()
         og.PathSimplifier(si, pdef.getGoal(), opt).simplify(path, ptc)
@@ -109,4 +91,4 @@ class SimplifiedPlanner(ob.Planner):
             pdef.addSolutionPath(path, False, 0.0, self.getName())
             stats["best_cost"] = cost
         stats["progress"].append((time.perf_counter() - t0, stats["best_cost"], 0))
-        return ob.PlannerStatus(ob.PlannerStatus.EXACT_SOLUTION)
+        return planner_status(ob.PlannerStatus.EXACT_SOLUTION)

@@ -1,0 +1,95 @@
+"""What every Python planner of the package shares: OMPL's solve contract, per-run statistics, the query's ends.
+
+OMPL calls ``solve`` with a termination condition (a Python caller may pass seconds) and expects a
+``PlannerStatus`` back, never an exception: one escaping into ``ot.Benchmark`` aborts the whole
+benchmark.  :class:`PythonPlanner` wraps a subclass's ``_solve`` in that contract, keeps its
+``last_run_stats()``, and reads the start and the single goal state the way the bindings allow
+(``pdef.getStartState(i)`` frees a state the problem definition owns: never call it).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from typing import Any
+
+from ompl import base as ob
+
+__all__ = ["PythonPlanner", "planner_status"]
+
+log = logging.getLogger(__name__)
+
+
+def planner_status(code: Any) -> ob.PlannerStatus:
+    """An ``ob.PlannerStatus`` object (OMPL needs the object, not the enum value)."""
+    return ob.PlannerStatus(code)
+
+
+class PythonPlanner(ob.Planner):
+    """Base of the package's ``ob.Planner`` subclasses: subclasses implement ``_solve(ptc)``.
+
+    A subclass validates its arguments BEFORE calling ``super().__init__`` (an exception after
+    ``ob.Planner.__init__`` leaves a half-built nanobind trampoline that crashes at collection), and
+    extends :meth:`_empty_stats` with its own counters.
+    """
+
+    def __init__(self, si: ob.SpaceInformation, name: str) -> None:
+        super().__init__(si, name)
+        self._stats: dict[str, Any] = self._empty_stats()
+
+    @staticmethod
+    def _empty_stats() -> dict[str, Any]:
+        return {"first_solution_time": None, "best_cost": math.inf, "progress": []}
+
+    def last_run_stats(self) -> dict[str, Any]:
+        """Statistics of the last solve (a copy): at least ``first_solution_time`` (s or None),
+        ``best_cost`` (inf if none) and ``progress`` [(time_s, best_cost, samples), ...]."""
+        out = dict(self._stats)
+        out["progress"] = list(self._stats["progress"])
+        return out
+
+    def clear(self) -> None:
+        """Forget the last run."""
+        super().clear()
+        self._stats = self._empty_stats()
+
+    def _start_run(self) -> None:
+        """Reset per-run state before ``_solve`` (statistics; subclasses may add)."""
+        self._stats = self._empty_stats()
+
+    def solve(self, ptc: ob.PlannerTerminationCondition | float) -> ob.PlannerStatus:
+        """Run ``_solve`` under ``ptc`` (or that many seconds); an exception is logged and becomes CRASH."""
+        if isinstance(ptc, (int, float)):  # p.solve(1.0) from Python reaches here with a float
+            ptc = ob.timedPlannerTerminationCondition(float(ptc))
+        self._start_run()
+        try:
+            if self.getProblemDefinition() is None:
+                log.error("%s: no problem definition; call setProblemDefinition(pdef) or solve through "
+                          "og.SimpleSetup", self.getName())
+                return planner_status(ob.PlannerStatus.ABORT)
+            return self._solve(ptc)
+        except Exception:  # an exception escaping into ot.Benchmark would abort the whole benchmark
+            log.exception("%s.solve failed", self.getName())
+            return planner_status(ob.PlannerStatus.CRASH)
+
+    def _solve(self, ptc: ob.PlannerTerminationCondition) -> ob.PlannerStatus:
+        raise NotImplementedError
+
+    def _endpoints(self) -> tuple[ob.State, ob.State] | ob.PlannerStatus:
+        """The start and the goal state, both within bounds and valid, or the status saying which is not."""
+        si, pdef = self.getSpaceInformation(), self.getProblemDefinition()
+        pis = self.getPlannerInputStates()
+        start = pis.nextStart()
+        if start is None and pis.getSeenStartStatesCount() > 0:  # solve() again without clear()
+            pis.restart()
+            start = pis.nextStart()
+        if start is None or not (si.satisfiesBounds(start) and si.isValid(start)):
+            return planner_status(ob.PlannerStatus.INVALID_START)
+        goal = pdef.getGoal()
+        if not isinstance(goal, ob.GoalState):
+            log.error("%s needs a goal that is a single state, got %s", self.getName(), type(goal).__name__)
+            return planner_status(ob.PlannerStatus.UNRECOGNIZED_GOAL_TYPE)
+        gstate = goal.getState()
+        if not (si.satisfiesBounds(gstate) and si.isValid(gstate)):
+            return planner_status(ob.PlannerStatus.INVALID_GOAL)
+        return start, gstate
