@@ -26,8 +26,9 @@ def test_animate_writes_a_gif_of_a_planned_motion(tmp_path):
 def test_animate_with_unreadable_path_file_is_one_line(tmp_path, capsys):
     bad = tmp_path / "p.json"
     bad.write_text("{not json")
-    assert main(["animate", "--path", str(bad), "-o", str(tmp_path / "m.gif")]) == 2
+    assert main(["animate", "--path", str(bad), "-o", str(tmp_path / "m.gif")]) == 1  # bad content: a runtime error
     assert "cannot read a path" in capsys.readouterr().err
+    assert not (tmp_path / "m.gif").exists()
 
 
 def test_view_without_meshcat_says_what_to_install(capsys):

@@ -93,8 +93,24 @@ def output_path(out_path: str | os.PathLike) -> Path:
     return out
 
 
+def image_suffixes() -> tuple[str, ...]:
+    """The file suffixes a figure can be written as (``.png``, ``.pdf``, ``.svg``, ...: matplotlib's)."""
+    from matplotlib.backend_bases import FigureCanvasBase
+
+    return tuple(sorted("." + k for k in FigureCanvasBase.get_supported_filetypes()))
+
+
 def write_figure(fig: Figure, out: Path, dpi: int, **savefig_kwargs: Any) -> Path:
-    """Save ``fig`` to ``out`` (format from the suffix), log it, and return ``out``."""
-    fig.savefig(out, dpi=dpi, **savefig_kwargs)
+    """Save ``fig`` to exactly ``out`` (format from its suffix), atomically; log it and return ``out``.
+
+    A name without a known image suffix is refused (matplotlib would add ``.png`` and write another
+    file than the one named); an existing file is replaced in one step, never left half-written.
+    """
+    from ..files import atomic_path
+
+    if out.suffix.lower() not in image_suffixes():
+        raise ValueError(f"figure file {out}: give a name ending in one of {' '.join(image_suffixes())}")
+    with atomic_path(out) as tmp:
+        fig.savefig(tmp, dpi=dpi, format=out.suffix[1:].lower(), **savefig_kwargs)
     log.info("wrote %s", out)
     return out
