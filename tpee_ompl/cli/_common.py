@@ -25,6 +25,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "MAX_COUNT",
+    "MAX_SECONDS",
     "CliError",
     "Parser",
     "add_force_arg",
@@ -42,6 +43,7 @@ __all__ = [
     "positive_float",
     "positive_int",
     "seed",
+    "seconds",
     "sector",
 ]
 
@@ -119,6 +121,18 @@ def angle(text: str) -> float:
     return v
 
 
+MAX_SECONDS = 86_400.0
+"""Longest time limit a ``--time`` argument may give (a day)."""
+
+
+def seconds(text: str) -> float:
+    """argparse type: a time limit in seconds, finite, > 0 and at most :data:`MAX_SECONDS`."""
+    v = positive_float(text)
+    if v > MAX_SECONDS:
+        raise argparse.ArgumentTypeError(f"a time limit must be at most {MAX_SECONDS:g} s: {text}")
+    return v
+
+
 def positive_float(text: str) -> float:
     """argparse type: a finite float > 0."""
     v = finite(text)
@@ -184,12 +198,14 @@ def check_output(path: str | Path, option: str, force: bool, suffixes: tuple[str
     from ..files import check_output_path
 
     p = Path(path)
-    if suffixes and p.suffix.lower() not in suffixes:
-        raise CliError(f"{option} {p}: give a file name ending in {' or '.join(suffixes)}")
     try:
-        return check_output_path(p, force=force, what=option)
+        check_output_path(p, force=force, what=option)
     except (ValueError, FileExistsError) as exc:
         raise CliError(str(exc)) from None
+    if suffixes and p.suffix.lower() not in suffixes:
+        listed = " or ".join(suffixes) if len(suffixes) <= 4 else ", ".join(suffixes[:4]) + ", ..."
+        raise CliError(f"{option} {p}: give a file name ending in {listed}")
+    return p
 
 
 # ---------------------------------------------------------------------------------------- the model

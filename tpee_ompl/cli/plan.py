@@ -27,6 +27,7 @@ from ._common import (
     load_robot,
     positive_float,
     positive_int,
+    seconds,
     sector,
     seed,
 )
@@ -155,7 +156,7 @@ def add_plan_args(p: argparse.ArgumentParser, required: bool = False) -> None:
                    help="start posture sector (1-4)")
     p.add_argument("--to", dest="to_sector", type=sector, required=required, default=4, help="goal posture sector (1-4)")
     p.add_argument("--planner", choices=tuple(PLANNERS), default="dimension-rrt")
-    p.add_argument("--time", type=positive_float, default=5.0, help="time limit in seconds (default 5)")
+    p.add_argument("--time", type=seconds, default=5.0, help="time limit in seconds, at most a day (default 5)")
     p.add_argument("--samples", type=positive_int, default=None, help="sample / iteration cap")
     p.add_argument("--seed", type=seed, default=1, help="OMPL / planner seed, 1..2^32-1 (default 1)")
     p.add_argument("--queries", default="planning_necessary",
