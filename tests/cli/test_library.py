@@ -81,3 +81,19 @@ def test_every_subcommand_help_shows_an_example_and_the_default_file(sub: str, c
         build_parser().parse_args(["library", sub, "--help"])
     out = capsys.readouterr().out
     assert "example:" in out and f"tpee-ompl library {sub}" in out and str(DEFAULT_LIBRARY) in out
+
+
+def test_build_never_replaces_a_library_without_force(robot, small_file: str, tmp_path) -> None:
+    import shutil
+
+    target = tmp_path / "lib.npz"
+    shutil.copy(small_file, target)
+    before = target.read_bytes()
+    argv = ["library", "build", "--pairs", "1-2", "--per-pair", "1", "--max-samples", "200", "--seed", "3",
+            "--library", str(target)]
+    with pytest.raises(CliError, match="--force"):
+        _run(argv)
+    assert target.read_bytes() == before
+    assert _run([*argv, "--force"]) == 0
+    assert PathLibrary.load(target, robot).build_params["seed"] == 3
+    assert [p.name for p in tmp_path.iterdir()] == ["lib.npz"]  # no temporary file left
