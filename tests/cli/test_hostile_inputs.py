@@ -118,6 +118,8 @@ USAGE = [
      "--goal"),
     ("library-query-start-outside-limits", ["library", "query", "--from", "1", "--to", "4", "--start", "9", "0",
                                             "0", "0", "--goal", *map(str, GOAL)], "--start"),
+    ("library-query-start-in-collision", ["library", "query", "--from", "1", "--to", "4", "--start", *IN_COLLISION,
+                                          "--goal", *map(str, GOAL)], "--start"),
     ("library-query-start-nan", ["library", "query", "--from", "1", "--to", "4", "--start", "nan", "0", "0", "0",
                                  "--goal", *map(str, GOAL)], "--start"),
     ("library-query-library-missing", ["library", "query", "--library", "missing.npz", "--query-set",
@@ -147,6 +149,8 @@ RUNTIME = [
     ("animate-path-of-strings", ["animate", "--path", "{in}/path_strings.json", "-o", "m.gif"], "waypoint 0"),
     ("animate-path-three-values", ["animate", "--path", "{in}/path_short.json", "-o", "m.gif"], "waypoint 1"),
     ("animate-path-not-json", ["animate", "--path", "{in}/path_not_json.json", "-o", "m.gif"], "--path"),
+    ("plan-queries-nested-too-deep", ["plan", "--from", "1", "--to", "4", "--queries", "{in}/deep.json"],
+     "deep.json"),
     ("plan-urdf-malformed", ["plan", "--from", "1", "--to", "4", *SG, "--urdf", "{in}/bad.urdf"], "bad.urdf"),
 ]
 CASES = [pytest.param(a, 2, n, id=i) for i, a, n in USAGE] + [pytest.param(a, 1, n, id=i) for i, a, n in RUNTIME]
@@ -167,6 +171,7 @@ def inputs(tmp_path_factory) -> Path:
     write_path_file(d / "path_strings.json", [[str(v) for v in START], GOAL])
     write_path_file(d / "path_short.json", [START, GOAL[:3]])
     (d / "path_not_json.json").write_text("{not json")
+    (d / "deep.json").write_text("[" * 100_000 + "]" * 100_000)
     (d / "bad.urdf").write_text("<robot name='x'><link name=")
     return d
 

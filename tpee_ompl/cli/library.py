@@ -160,10 +160,12 @@ def run_query(args: argparse.Namespace) -> int:
 
 
 def _check_endpoints(robot, start: np.ndarray, goal: np.ndarray) -> None:
-    """Start and goal are configurations inside the joint limits (ValueError naming which)."""
+    """Start and goal are collision-free configurations inside the joint limits (ValueError naming which)."""
     for name, q in (("start", start), ("goal", goal)):
         if not robot.within_limits(q):
             raise ValueError(f"{name} {np.round(q, 4).tolist()} is outside the joint limits")
+        if not robot.is_valid(q):
+            raise ValueError(f"{name} {np.round(q, 4).tolist()} is in collision")
 
 
 def run_stats(args: argparse.Namespace) -> int:

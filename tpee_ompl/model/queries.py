@@ -169,7 +169,7 @@ def load_query_set(name_or_path: str | os.PathLike, robot: WearerArm | None = No
         raise FileNotFoundError(f"query set {str(name_or_path)!r} not found (looked at {p})")
     try:
         doc = json.loads(p.read_text(encoding="utf-8"))
-    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+    except (UnicodeDecodeError, json.JSONDecodeError, RecursionError) as exc:
         raise QuerySetError(f"{p}: not a JSON query set (truncated or corrupt?): {exc}") from exc
     if not isinstance(doc, dict):
         raise QuerySetError(f"{p}: expected a JSON object at the top level, got {type(doc).__name__}")
