@@ -37,8 +37,9 @@ bench-full: $(STAMP)
 		--anytime
 
 # Default cross-sector DMP path library (12 pairs x <= 20 dimension-RRT demos, ~3.5 min on 2 cores).
+# --force: this target rebuilds the packaged library on purpose (library build never replaces a file without it).
 library: $(STAMP)
-	$(PY) experiments/build_library.py --workers 2 --library tpee_ompl/data/library/default.npz
+	$(PY) experiments/build_library.py --workers 2 --force --library tpee_ompl/data/library/default.npz
 
 clean-env:
 	rm -rf $(VENV)

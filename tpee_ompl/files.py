@@ -14,7 +14,7 @@ import tempfile
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
-__all__ = ["OutputExistsError", "atomic_path", "atomic_write", "atomic_write_bytes", "atomic_write_text",
+__all__ = ["OutputExistsError", "atomic_path", "atomic_path_with_suffix", "atomic_write", "atomic_write_bytes", "atomic_write_text",
            "check_output_path"]
 
 
@@ -62,6 +62,28 @@ def atomic_path(path: str | os.PathLike, *, force: bool = True, suffix: str | No
     target.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp_name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=(target.suffix if suffix is None else suffix) + ".part",
                                     dir=target.parent)
+    os.close(fd)
+    tmp = Path(tmp_name)
+    try:
+        yield tmp
+        with open(tmp, "rb+") as f:
+            os.fsync(f.fileno())
+        os.replace(tmp, target)
+    finally:
+        with contextlib.suppress(FileNotFoundError):
+            tmp.unlink()
+
+
+@contextlib.contextmanager
+def atomic_path_with_suffix(path: str | os.PathLike, *, force: bool = True) -> Iterator[Path]:
+    """:func:`atomic_path` for writers that choose the format by the file name's suffix and cannot be
+    told otherwise (Pillow's GIF writer, ffmpeg): the temporary file ends with ``path``'s own suffix
+    (``.m.gif.XXXX.part.gif``)."""
+    target = Path(path)
+    if target.exists() and not force:
+        raise OutputExistsError(f"{target} exists; pass --force to replace it")
+    target.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp_name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".part" + target.suffix, dir=target.parent)
     os.close(fd)
     tmp = Path(tmp_name)
     try:

@@ -60,11 +60,18 @@ def check_name(name: str, value: Any) -> str:
 
 
 def as_float_array(x: object, what: str) -> np.ndarray:
-    """``np.asarray(x, dtype=float)``, raising ValueError (naming ``what``) for non-numeric input."""
+    """``x`` as a float array, raising ValueError (naming ``what``) for non-numeric input.
+
+    Complex numbers (numpy would drop the imaginary part with a warning), strings (numpy would parse
+    ``"1"`` as 1.0) and dates are refused, not coerced; booleans and integers become floats.
+    """
     try:
-        return np.asarray(x, dtype=float)
+        a = np.asarray(x)
+        if a.dtype.kind in "cUSMmV":
+            raise TypeError(f"{a.dtype} values are not real numbers")
+        return a.astype(float, copy=False)
     except (TypeError, ValueError) as exc:
-        raise ValueError(f"{what} must be numbers, got {x!r} ({exc})") from exc
+        raise ValueError(f"{what} must be real numbers, got {x!r} ({exc})"[:400]) from exc
 
 
 MAX_SEED = 2**32 - 1

@@ -7,6 +7,7 @@ import json
 import numpy as np
 import pytest
 
+from tpee_ompl.cli._common import CliError
 from tpee_ompl.cli.library import DEFAULT_LIBRARY, build_parser
 from tpee_ompl.library import PathLibrary
 
@@ -53,18 +54,18 @@ def test_query_from_a_named_set_prints_a_checked_path_as_json(robot, small_file:
 
 
 def test_missing_library_file_names_the_fix(tmp_path) -> None:
-    with pytest.raises(FileNotFoundError, match="make library"):
+    with pytest.raises(CliError, match="make library"):
         _run(["library", "stats", "--library", str(tmp_path / "none.npz")])
 
 
 def test_query_without_a_query_names_the_missing_options(small_file: str) -> None:
-    with pytest.raises(ValueError, match="missing --start --goal"):
+    with pytest.raises(CliError, match="missing --start --goal"):
         _run(["library", "query", "--library", small_file, "--from", "1", "--to", "2"])
 
 
 @pytest.mark.parametrize("extra, match", [(["--workers", "0"], "--workers"), (["--demo-margins", "nan"], "--demo-margins")])
 def test_bad_build_options_name_the_option(extra: list[str], match: str, tmp_path) -> None:
-    with pytest.raises(ValueError, match=match):
+    with pytest.raises(CliError, match=match):
         _run(["library", "build", "--pairs", "1-2", "--library", str(tmp_path / "x.npz"), *extra])
 
 
@@ -80,3 +81,19 @@ def test_every_subcommand_help_shows_an_example_and_the_default_file(sub: str, c
         build_parser().parse_args(["library", sub, "--help"])
     out = capsys.readouterr().out
     assert "example:" in out and f"tpee-ompl library {sub}" in out and str(DEFAULT_LIBRARY) in out
+
+
+def test_build_never_replaces_a_library_without_force(robot, small_file: str, tmp_path) -> None:
+    import shutil
+
+    target = tmp_path / "lib.npz"
+    shutil.copy(small_file, target)
+    before = target.read_bytes()
+    argv = ["library", "build", "--pairs", "1-2", "--per-pair", "1", "--max-samples", "200", "--seed", "3",
+            "--library", str(target)]
+    with pytest.raises(CliError, match="--force"):
+        _run(argv)
+    assert target.read_bytes() == before
+    assert _run([*argv, "--force"]) == 0
+    assert PathLibrary.load(target, robot).build_params["seed"] == 3
+    assert [p.name for p in tmp_path.iterdir()] == ["lib.npz"]  # no temporary file left

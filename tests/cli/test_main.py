@@ -43,3 +43,33 @@ def test_library_query_without_a_library_file_is_one_line(capsys, tmp_path):
     assert main(["library", "stats", "--library", str(tmp_path / "none.npz")]) == 2
     err = capsys.readouterr().err
     assert "not found" in err and err.count("\n") == 1
+
+
+def _raising(exc: BaseException):
+    def command(args):
+        raise exc
+    return command
+
+
+@pytest.mark.parametrize(("exc", "code", "text"), [
+    (TypeError("'NoneType' object is not subscriptable"), 1, "unexpected TypeError"),
+    (IndexError("index 0 is out of bounds"), 1, "unexpected IndexError"),
+    (RuntimeError("planner failed\non two lines"), 1, "planner failed on two lines"),
+    (ValueError("damaged file x.npz"), 1, "damaged file x.npz"),
+])
+def test_any_exception_at_run_time_is_one_line_with_exit_code_1(monkeypatch, capsys, exc, code, text):
+    import tpee_ompl.cli.plan as plan
+
+    monkeypatch.setattr(plan, "cmd_aim", _raising(exc))
+    assert main(["aim", "--target", "5", "2", "1.5"]) == code
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and text in err and "Traceback" not in err
+
+
+def test_verbose_adds_the_traceback_of_an_unexpected_error(monkeypatch, capsys):
+    import tpee_ompl.cli.plan as plan
+
+    monkeypatch.setattr(plan, "cmd_aim", _raising(TypeError("boom")))
+    assert main(["-v", "aim", "--target", "5", "2", "1.5"]) == 1
+    err = capsys.readouterr().err
+    assert "Traceback" in err and err.strip().splitlines()[-1].endswith("(run with -v for the traceback)")

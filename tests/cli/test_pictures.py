@@ -26,8 +26,9 @@ def test_animate_writes_a_gif_of_a_planned_motion(tmp_path):
 def test_animate_with_unreadable_path_file_is_one_line(tmp_path, capsys):
     bad = tmp_path / "p.json"
     bad.write_text("{not json")
-    assert main(["animate", "--path", str(bad), "-o", str(tmp_path / "m.gif")]) == 2
+    assert main(["animate", "--path", str(bad), "-o", str(tmp_path / "m.gif")]) == 1  # bad content: a runtime error
     assert "cannot read a path" in capsys.readouterr().err
+    assert not (tmp_path / "m.gif").exists()
 
 
 def test_view_without_meshcat_says_what_to_install(capsys):
@@ -38,3 +39,26 @@ def test_view_without_meshcat_says_what_to_install(capsys):
         assert "pip install" in capsys.readouterr().err
     else:
         pytest.skip("meshcat is installed: the viewer would block")
+
+
+def test_show_writes_exactly_the_named_file_and_replaces_it_only_with_force(tmp_path, capsys):
+    out = tmp_path / "scene.svg"
+    assert main(["show", "-o", str(out)]) == 0
+    assert f"wrote {out} " in capsys.readouterr().out
+    assert out.read_bytes().lstrip().startswith(b"<?xml") and [p.name for p in tmp_path.iterdir()] == ["scene.svg"]
+    out.write_bytes(b"older")
+    assert main(["show", "-o", str(out)]) == 2
+    assert "--force" in capsys.readouterr().err and out.read_bytes() == b"older"
+    assert main(["show", "-o", str(out), "--force"]) == 0
+    assert out.read_bytes().lstrip().startswith(b"<?xml") and [p.name for p in tmp_path.iterdir()] == ["scene.svg"]
+
+
+def test_animate_reads_a_path_file_and_writes_the_gif(tmp_path, capsys):
+    from helpers.cli_queries import GOAL, START
+    from helpers.hostile_files import write_path_file
+
+    path = write_path_file(tmp_path / "p.json", [START, GOAL])
+    out = tmp_path / "m.gif"
+    assert main(["animate", "--path", str(path), "--frames", "3", "-o", str(out)]) == 0
+    assert_image(out, GIF_SIGNATURE, 1)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["m.gif", "p.json"]  # no temporary file left

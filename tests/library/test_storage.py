@@ -2,10 +2,14 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
+from helpers.hostile_files import LIBRARY_DEFECTS, write_library_file
 from helpers.library_standins import RRT_PAIRS, necessary_queries
 
+from tpee_ompl.files import OutputExistsError
 from tpee_ompl.library import LibraryFileError, PathLibrary
 from tpee_ompl.model.wearer_arm import WearerArm
 
@@ -53,3 +57,44 @@ def test_build_parameters_survive_the_round_trip(robot: WearerArm, rrt_library: 
     for k in range(2):
         assert np.array_equal(loaded.generate(q.start, q.goal, q.from_sector, q.to_sector, k, stride=10),
                               rrt_library.generate(q.start, q.goal, q.from_sector, q.to_sector, k, stride=10))
+
+
+# ---------------------------------------------------------------------------------------- hostile files
+@pytest.mark.parametrize("defect", sorted(LIBRARY_DEFECTS))
+def test_a_malformed_library_file_is_refused_naming_the_field(robot: WearerArm, tmp_path, defect: str) -> None:
+    change, name = LIBRARY_DEFECTS[defect]
+    f = write_library_file(tmp_path / "lib.npz", change)
+    with pytest.raises(LibraryFileError, match=re.escape(name)) as exc:
+        PathLibrary.load(f, robot)
+    assert str(f) in str(exc.value)
+
+
+def test_the_one_pair_library_the_defects_start_from_loads(robot: WearerArm, tmp_path) -> None:
+    lib = PathLibrary.load(write_library_file(tmp_path / "lib.npz"), robot)
+    assert list(lib.pairs) == [(1, 2)] and len(lib) == 20 and lib.n_candidates == 3
+
+
+def test_save_without_force_refuses_an_existing_file_and_leaves_it(library: PathLibrary, tmp_path) -> None:
+    f = tmp_path / "lib.npz"
+    f.write_bytes(b"precious")
+    with pytest.raises(OutputExistsError, match="--force"):
+        library.save(f, force=False)
+    assert f.read_bytes() == b"precious"
+    library.save(f, force=True)
+    assert f.read_bytes()[:2] == b"PK"
+
+
+def test_an_interrupted_save_leaves_the_old_file_and_no_temporary(library: PathLibrary, tmp_path, monkeypatch) -> None:
+    import tpee_ompl.library.storage as storage
+
+    f = library.save(tmp_path / "lib.npz")
+    before = f.read_bytes()
+
+    def interrupted(fh, **arrays):
+        fh.write(b"PK half a zip")
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(storage.np, "savez_compressed", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        library.save(f)
+    assert f.read_bytes() == before and [p.name for p in tmp_path.iterdir()] == ["lib.npz"]

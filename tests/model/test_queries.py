@@ -3,13 +3,15 @@
 from __future__ import annotations
 
 import json
+import re
 from collections import Counter
 
 import numpy as np
 import pytest
+from helpers.hostile_files import QUERY_DEFECTS, other_model_query_file, write_query_file
 
 from tpee_ompl.model.pointing import aim_errors
-from tpee_ompl.model.queries import FORMAT_VERSION, Query, load_queries, load_query_set, straight_motion
+from tpee_ompl.model.queries import FORMAT_VERSION, Query, QuerySetError, load_queries, load_query_set, straight_motion
 from tpee_ompl.model.sectors import cross_sector_trajectory, in_pointing_sector, posture_preset
 
 
@@ -62,3 +64,32 @@ def test_bad_query_files_and_queries_raise(tmp_path):
     q = Query(0, 1, 2, np.zeros(3), np.ones(3), np.zeros(4), np.zeros(4))
     with pytest.raises(ValueError):
         q.start[0] = 1.0  # stored arrays are read-only
+
+
+# ---------------------------------------------------------------------------------------- hostile files
+@pytest.mark.parametrize("defect", sorted(QUERY_DEFECTS))
+def test_a_malformed_query_is_refused_naming_the_field_not_coerced(tmp_path, defect):
+    change, name = QUERY_DEFECTS[defect]
+    f = write_query_file(tmp_path / "q.json", change)
+    with pytest.raises(QuerySetError, match=re.escape(name)) as exc:
+        load_queries(f)
+    assert str(f) in str(exc.value)
+
+
+def test_the_small_query_set_the_defects_start_from_loads(robot, tmp_path):
+    assert len(load_queries(write_query_file(tmp_path / "q.json"), robot)) == 4
+
+
+def test_a_query_set_for_another_model_is_refused_with_the_robot(robot, tmp_path):
+    f = other_model_query_file(tmp_path / "q.json")
+    assert len(load_queries(f)) == 4  # without a robot there is nothing to compare with
+    with pytest.raises(QuerySetError, match="model_hash"):
+        load_queries(f, robot)
+
+
+@pytest.mark.parametrize("value", [["1", "2", "3", "4"], [1, 2, 3, True], [1, 2, 3], "1234", None])
+def test_query_from_dict_takes_only_json_numbers(value):
+    d = load_queries("planning_necessary")[0].to_dict()
+    d["start"] = value
+    with pytest.raises(QuerySetError, match="'start'"):
+        Query.from_dict(d)

@@ -173,6 +173,25 @@ def test_wrong_shaped_or_non_finite_configurations_raise_value_error(robot, q):
         robot.is_valid(np.array(q, dtype=float))
 
 
+@pytest.mark.parametrize("q", [np.zeros(4) + 0j, np.zeros(4) + 1e-3j, ["0", "0", "0", "0"], np.array(["0.1"] * 4)])
+def test_complex_or_string_configurations_are_refused_not_coerced(robot, q, recwarn):
+    for check in (robot.is_valid, robot.check_config, robot.muzzle, robot.are_valid):
+        with pytest.raises(ValueError, match="real numbers"):
+            check(q)
+    assert not [w for w in recwarn if "imaginary" in str(w.message)]
+
+
+@pytest.mark.parametrize("n", [0, 3, 5])
+def test_is_valid_values_with_another_number_of_values_names_the_length(robot, n):
+    with pytest.raises(ValueError, match=f"needs 4 values.*got {n}"):
+        robot.is_valid_values([0.1] * n)
+
+
+def test_is_valid_values_agrees_with_is_valid(robot, rng):
+    Q = rng.uniform(robot.lower, robot.upper, size=(200, 4))
+    assert [robot.is_valid_values(q.tolist()) for q in Q] == [robot.is_valid(q) for q in Q]
+
+
 def test_batch_of_wrong_shape_raises_value_error(robot):
     with pytest.raises(ValueError, match=r"shape \(N, 4\)"):
         robot.are_valid(np.zeros((4, 3)))

@@ -1,36 +1,70 @@
 """What every ``tpee-ompl`` command group shares: the user-facing error, argument types, model options.
 
-A command raises :class:`CliError` (or ValueError, FileNotFoundError, ...) with a one-line message;
-:func:`tpee_ompl.cli.main.main` prints it on stderr and exits with code 2.
+Exit codes (:func:`tpee_ompl.cli.main.main`): **2** for a usage error -- argparse's own, or a
+:class:`CliError` raised while the arguments are checked, before any work starts (a bad value, a
+missing input file, an output that exists without ``--force``); **1** for a runtime error -- anything
+raised once the work has started (a damaged library or query file, a model mismatch, a planner
+failure, an unexpected exception).  Either way: one line on stderr, no traceback (``-v`` adds it).
+
+:func:`argument` turns a ValueError raised while one argument is checked into a :class:`CliError`
+naming it; :func:`check_input_file` and :func:`check_output` are the input- and output-file checks.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import inspect
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from pathlib import Path
 from typing import TYPE_CHECKING, Any, NoReturn
 
 if TYPE_CHECKING:
     from ..model.wearer_arm import WearerArm
 
 __all__ = [
+    "MAX_COUNT",
+    "MAX_SECONDS",
     "CliError",
     "Parser",
-    "seed",
+    "add_force_arg",
+    "angle",
     "add_model_args",
+    "argument",
+    "check_input_file",
+    "check_model_args",
+    "check_output",
     "default_of",
     "finite",
+    "index",
     "load_robot",
+    "numpy_seed",
     "positive_float",
     "positive_int",
+    "seed",
+    "seconds",
     "sector",
 ]
 
+MAX_COUNT = 10**7
+"""Largest count an argument may ask for (samples, frames, steps): more is refused as a usage error,
+not attempted (a typo must not allocate exabytes or run for a year)."""
+
 
 class CliError(Exception):
-    """A user-facing error: printed as one line, exit code 2."""
+    """A usage error: printed as one line, exit code 2 (the argument or file named in the message)."""
+
+
+@contextlib.contextmanager
+def argument(name: str) -> Iterator[None]:
+    """Check one argument: a ValueError raised inside becomes a :class:`CliError` starting with ``name``."""
+    try:
+        yield
+    except CliError:
+        raise
+    except ValueError as exc:
+        raise CliError(f"{name}: {exc}") from None
 
 
 class Parser(argparse.ArgumentParser):
@@ -47,17 +81,55 @@ class Parser(argparse.ArgumentParser):
 # ---------------------------------------------------------------------------------------- argument types
 def finite(text: str) -> float:
     """argparse type: a finite float."""
-    v = float(text)
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
     if not math.isfinite(v):
         raise argparse.ArgumentTypeError(f"not a finite number: {text}")
     return v
 
 
+def _int(text: str) -> int:
+    try:
+        return int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not an integer: {text!r}") from None
+
+
 def positive_int(text: str) -> int:
-    """argparse type: an int > 0."""
-    v = int(text)
-    if v <= 0:
-        raise argparse.ArgumentTypeError(f"must be a positive integer: {text}")
+    """argparse type: an int in [1, :data:`MAX_COUNT`]."""
+    v = _int(text)
+    if not 0 < v <= MAX_COUNT:
+        raise argparse.ArgumentTypeError(f"must be a positive integer <= {MAX_COUNT:.0e}: {text}")
+    return v
+
+
+def index(text: str) -> int:
+    """argparse type: an index >= 0 (a negative one is refused, not counted from the end)."""
+    v = _int(text)
+    if v < 0:
+        raise argparse.ArgumentTypeError(f"must be an index >= 0: {text}")
+    return v
+
+
+def angle(text: str) -> float:
+    """argparse type: an angle in radians, within [-2 pi, 2 pi]."""
+    v = finite(text)
+    if abs(v) > 2 * math.pi:
+        raise argparse.ArgumentTypeError(f"an angle in radians must be within [-2 pi, 2 pi]: {text}")
+    return v
+
+
+MAX_SECONDS = 86_400.0
+"""Longest time limit a ``--time`` argument may give (a day)."""
+
+
+def seconds(text: str) -> float:
+    """argparse type: a time limit in seconds, finite, > 0 and at most :data:`MAX_SECONDS`."""
+    v = positive_float(text)
+    if v > MAX_SECONDS:
+        raise argparse.ArgumentTypeError(f"a time limit must be at most {MAX_SECONDS:g} s: {text}")
     return v
 
 
@@ -74,9 +146,19 @@ def seed(text: str) -> int:
     from ..validation import check_seed
 
     try:
-        return check_seed("seed", int(text))
+        return check_seed("seed", _int(text))
     except ValueError as exc:
         raise argparse.ArgumentTypeError(str(exc).removeprefix("seed ")) from None
+
+
+def numpy_seed(text: str) -> int:
+    """argparse type: a seed for numpy only (no OMPL), an integer in [0, 2**32 - 1]."""
+    from ..validation import MAX_SEED
+
+    v = _int(text)
+    if not 0 <= v <= MAX_SEED:
+        raise argparse.ArgumentTypeError(f"must be an integer in [0, {MAX_SEED}]: {text}")
+    return v
 
 
 def sector(text: str) -> int:
@@ -84,7 +166,7 @@ def sector(text: str) -> int:
     from ..model.sectors import check_sector
 
     try:
-        return check_sector(int(text))
+        return check_sector(_int(text))
     except ValueError as exc:
         raise argparse.ArgumentTypeError(str(exc)) from None
 
@@ -94,6 +176,38 @@ def default_of(func: Callable[..., Any], name: str) -> Any:
     return inspect.signature(func).parameters[name].default
 
 
+# ---------------------------------------------------------------------------------------- files
+def check_input_file(path: str | Path, option: str, what: str = "file", hint: str = "") -> Path:
+    """``path`` if it is an existing file; else a :class:`CliError` naming ``option`` (a usage error)."""
+    p = Path(path)
+    if p.is_dir():
+        raise CliError(f"{option} {p}: is a folder, not a {what}")
+    if not p.is_file():
+        raise CliError(f"{option} {p}: {what} not found{hint}")
+    return p
+
+
+def add_force_arg(p: argparse.ArgumentParser) -> None:
+    """``--force``: replace an existing output file."""
+    p.add_argument("--force", action="store_true", help="replace the output file if it exists")
+
+
+def check_output(path: str | Path, option: str, force: bool, suffixes: tuple[str, ...] = ()) -> Path:
+    """Check an output file before any work starts (:func:`tpee_ompl.files.check_output_path`): not a
+    folder, not an existing file unless ``force``, and (when given) one of ``suffixes``.  Creates nothing."""
+    from ..files import check_output_path
+
+    p = Path(path)
+    try:
+        check_output_path(p, force=force, what=option)
+    except (ValueError, FileExistsError) as exc:
+        raise CliError(str(exc)) from None
+    if suffixes and p.suffix.lower() not in suffixes:
+        listed = " or ".join(suffixes) if len(suffixes) <= 4 else ", ".join(suffixes[:4]) + ", ..."
+        raise CliError(f"{option} {p}: give a file name ending in {listed}")
+    return p
+
+
 # ---------------------------------------------------------------------------------------- the model
 def add_model_args(p: argparse.ArgumentParser) -> None:
     """``--urdf`` / ``--srdf``: another wearer + arm model than the packaged one."""
@@ -101,10 +215,23 @@ def add_model_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--srdf", default=None, help="SRDF file with disabled collision pairs (with --urdf)")
 
 
+def check_model_args(args: argparse.Namespace) -> None:
+    """Usage checks of ``--urdf`` / ``--srdf`` (files exist, ``--srdf`` only with ``--urdf``)."""
+    urdf, srdf = getattr(args, "urdf", None), getattr(args, "srdf", None)
+    if srdf and not urdf:
+        raise CliError("--srdf needs --urdf")
+    if urdf:
+        check_input_file(urdf, "--urdf", "URDF file")
+    if srdf:
+        check_input_file(srdf, "--srdf", "SRDF file")
+
+
 def load_robot(args: argparse.Namespace) -> WearerArm:
-    """The model the ``--urdf`` / ``--srdf`` arguments name (the packaged one by default)."""
+    """The model the ``--urdf`` / ``--srdf`` arguments name (the packaged one by default).
+
+    Missing files are usage errors (exit 2); a file that does not load is a runtime error (exit 1).
+    """
     from ..model.wearer_arm import WearerArm
 
-    if getattr(args, "srdf", None) and not getattr(args, "urdf", None):
-        raise CliError("--srdf needs --urdf")
+    check_model_args(args)
     return WearerArm(args.urdf, args.srdf) if getattr(args, "urdf", None) else WearerArm()

@@ -1,8 +1,9 @@
 """``tpee-ompl library build|query|stats``: the cross-sector path library on the command line.
 
 :func:`register` adds the ``library`` subcommand to the main parser; each sub-subcommand sets
-``func`` (``args -> int``).  Errors are raised as ValueError / FileNotFoundError with a one-line
-message for the main CLI to print.
+``func`` (``args -> int``).  Usage errors (a bad option, a missing input file, an existing output
+without ``--force``) are raised as :class:`~tpee_ompl.cli._common.CliError` before any work; a damaged
+library or query file found while working is a LibraryFileError / QuerySetError (exit code 1).
 """
 
 from __future__ import annotations
@@ -21,7 +22,18 @@ from ..library.dmp import DMPOptions
 from ..library import PathLibrary
 from ..planning.paths import path_length
 from ..resources import default_library_path
-from ._common import Parser
+from ._common import (
+    CliError,
+    Parser,
+    add_force_arg,
+    argument,
+    check_input_file,
+    check_output,
+    finite,
+    index,
+    numpy_seed,
+    sector,
+)
 
 __all__ = ["DEFAULT_LIBRARY", "build_parser", "register", "run_build", "run_query", "run_stats"]
 
@@ -55,11 +67,16 @@ def _pair(text: str) -> tuple[int, int]:
     return i, j
 
 
+def _check_library_file(path: Path) -> Path:
+    """``--library`` names an existing file (a usage error otherwise, with the fix)."""
+    return check_input_file(path, "--library", "path library",
+                            hint=": build it with 'make library' or 'tpee-ompl library build'")
+
+
 def _load(path: Path, fallback: bool = True, max_samples: int = _BUILD_DEFAULTS.max_samples) -> PathLibrary:
     from ..model.wearer_arm import default_robot
 
-    if not path.exists():
-        raise FileNotFoundError(f"path library {path} not found: build it with 'make library' or 'tpee-ompl library build'")
+    _check_library_file(path)
     robot = default_robot()
     plan = dimension_rrt_planner(robot, max_samples=max_samples) if fallback else None
     return PathLibrary.load(path, robot, plan=plan)
@@ -79,8 +96,8 @@ def _build_options(args: argparse.Namespace) -> LibraryBuildOptions:
         message = str(exc)
         name = next((n for n in given if message.startswith((n, n.replace("_", " ")))), None)
         if name is None:
-            raise
-        raise ValueError(f"--{name.replace('_', '-')}: {message}") from None
+            raise CliError(message) from None
+        raise CliError(f"--{name.replace('_', '-')}: {message}") from None
 
 
 def run_build(args: argparse.Namespace) -> int:
@@ -88,11 +105,10 @@ def run_build(args: argparse.Namespace) -> int:
     from ..model.wearer_arm import default_robot
 
     options = _build_options(args)
-    out = Path(args.library)
-    out.parent.mkdir(parents=True, exist_ok=True)
+    out = check_output(args.library, "--library", args.force, (".npz",))
     t0 = time.perf_counter()
     lib = PathLibrary.build_default(default_robot(), options)
-    lib.save(out)
+    lib.save(out, force=args.force)
     s = lib.stats()
     print(f"wrote {out}: {len(lib)} demonstrations in {len(lib.pairs)} pairs "
           f"({s['build_sampled']} drawn, {s['build_rejected_similar']} too similar, "
@@ -103,20 +119,33 @@ def run_build(args: argparse.Namespace) -> int:
 
 def run_query(args: argparse.Namespace) -> int:
     """Answer one query from the library and print the outcome (and the path with --json)."""
+    from ..model.wearer_arm import default_robot
+
+    _check_library_file(Path(args.library))
+    given = [n for n, v in (("--from", args.from_sector), ("--to", args.to_sector), ("--start", args.start),
+                            ("--goal", args.goal)) if v is not None]
     if args.query_set is not None:
         from ..model.queries import load_queries
 
-        queries = load_queries(args.query_set)
-        if not 0 <= args.index < len(queries):
-            raise ValueError(f"--index must be in 0..{len(queries) - 1} for query set {args.query_set!r}, got {args.index}")
+        if given:
+            raise CliError(f"give --query-set NAME --index K, or --from --to --start --goal, not both ({' '.join(given)})")
+        try:
+            queries = load_queries(args.query_set, default_robot())
+        except FileNotFoundError as exc:
+            raise CliError(f"--query-set: {exc}") from None
+        if args.index >= len(queries):
+            raise CliError(f"--index must be in 0..{len(queries) - 1} for query set {args.query_set!r}, got {args.index}")
         q = queries[args.index]
         start, goal, i, j = q.start, q.goal, q.from_sector, q.to_sector
     else:
-        missing = [n for n, v in (("--from", args.from_sector), ("--to", args.to_sector), ("--start", args.start),
-                                  ("--goal", args.goal)) if v is None]
+        missing = [n for n in ("--from", "--to", "--start", "--goal") if n not in given]
         if missing:
-            raise ValueError(f"give --query-set NAME --index K, or all of --from --to --start --goal (missing {' '.join(missing)})")
+            raise CliError(f"give --query-set NAME --index K, or all of --from --to --start --goal (missing {' '.join(missing)})")
+        if args.from_sector == args.to_sector:
+            raise CliError(f"--from and --to are both sector {args.from_sector}: a query joins two sectors")
         start, goal, i, j = np.array(args.start), np.array(args.goal), args.from_sector, args.to_sector
+        with argument("--start/--goal"):
+            _check_endpoints(default_robot(), start, goal)
     lib = _load(Path(args.library), fallback=not args.no_fallback)
     res = lib.query(start, goal, i, j)
     if args.json:
@@ -130,9 +159,18 @@ def run_query(args: argparse.Namespace) -> int:
     return 0 if res.path is not None else 1
 
 
+def _check_endpoints(robot, start: np.ndarray, goal: np.ndarray) -> None:
+    """Start and goal are collision-free configurations inside the joint limits (ValueError naming which)."""
+    for name, q in (("start", start), ("goal", goal)):
+        if not robot.within_limits(q):
+            raise ValueError(f"{name} {np.round(q, 4).tolist()} is outside the joint limits")
+        if not robot.is_valid(q):
+            raise ValueError(f"{name} {np.round(q, 4).tolist()} is in collision")
+
+
 def run_stats(args: argparse.Namespace) -> int:
     """Print what a library file holds: demonstrations per pair, build parameters and counters."""
-    path = Path(args.library)
+    path = _check_library_file(Path(args.library))
     lib = _load(path, fallback=False)
     print(f"{path}: {len(lib)} demonstrations, {path.stat().st_size / 1e6:.2f} MB, model {lib.robot.model_hash}")
     print("per pair: " + ", ".join(f"{i}->{j}: {len(pd.starts)}" for (i, j), pd in sorted(lib.pairs.items())))
@@ -160,17 +198,18 @@ def register(subparsers: argparse._SubParsersAction, formatter_class: type = arg
     d = _BUILD_DEFAULTS
     b.add_argument("--per-pair", type=int, default=d.per_pair,
                    help=f"demonstrations per ordered sector pair (default {d.per_pair})")
-    b.add_argument("--seed", type=int, default=d.seed, help=f"seed of the sampler and the planner (default {d.seed})")
+    b.add_argument("--seed", type=numpy_seed, default=d.seed,
+                   help=f"seed of the sampler and the planner, 0..2^32-1 (default {d.seed})")
     b.add_argument("--pairs", type=_pair, nargs="+", metavar="I-J",
                    help=f"sector pairs (default all {len(d.pairs)})")
-    b.add_argument("--min-difference", type=float, default=d.min_difference,
+    b.add_argument("--min-difference", type=finite, default=d.min_difference,
                    help="new demo kept only if its DOF3/DOF4 (start, goal) differs by this many rad "
                         f"(default {d.min_difference:g})")
     b.add_argument("--max-attempts", type=int, default=d.max_attempts,
                    help="draws per pair before giving up on per-pair (default 3 x per-pair)")
     b.add_argument("--max-samples", type=int, default=d.max_samples,
                    help=f"dimension-RRT samples per demo (default {d.max_samples})")
-    b.add_argument("--timeout", type=float, default=d.timeout,
+    b.add_argument("--timeout", type=finite, default=d.timeout,
                    help=f"dimension-RRT time limit per demo, s (default {d.timeout:g})")
     b.add_argument("--demo-margins", type=float, nargs="*", default=list(d.demo_margins), metavar="M",
                    help="margins (m) around the pointing system tried, widest first, before the robot's own "
@@ -180,16 +219,17 @@ def register(subparsers: argparse._SubParsersAction, formatter_class: type = arg
     b.add_argument("--dmp-scaling", choices=("none", "amplitude"), default=d.dmp_options.scaling,
                    help="DMP forcing: 'amplitude' = eq. 13's x(g - y0), 'none' = absolute "
                         f"(default {d.dmp_options.scaling}; docs/dmp.md says why)")
+    add_force_arg(b)
     b.set_defaults(func=run_build)
 
     q = sub.add_parser("query", help="answer one query", epilog=_QUERY_EXAMPLE, formatter_class=formatter_class)
     common(q)
     q.add_argument("--query-set", metavar="NAME", help="take the query from a named set (e.g. planning_necessary)")
-    q.add_argument("--index", type=int, default=0, help="index in --query-set (default 0)")
-    q.add_argument("--from", dest="from_sector", type=int, choices=range(1, 5), help="start sector")
-    q.add_argument("--to", dest="to_sector", type=int, choices=range(1, 5), help="goal sector")
-    q.add_argument("--start", type=float, nargs=4, metavar="Q", help="start configuration, 4 angles in rad")
-    q.add_argument("--goal", type=float, nargs=4, metavar="Q", help="goal configuration, 4 angles in rad")
+    q.add_argument("--index", type=index, default=0, help="index in --query-set, from 0 (default 0)")
+    q.add_argument("--from", dest="from_sector", type=sector, help="start sector (1-4)")
+    q.add_argument("--to", dest="to_sector", type=sector, help="goal sector (1-4)")
+    q.add_argument("--start", type=finite, nargs=4, metavar="Q", help="start configuration, 4 angles in rad")
+    q.add_argument("--goal", type=finite, nargs=4, metavar="Q", help="goal configuration, 4 angles in rad")
     q.add_argument("--no-fallback", action="store_true", help="do not fall back to dimension-RRT")
     q.add_argument("--json", action="store_true", help="print the result (with the path) as JSON")
     q.set_defaults(func=run_query)

@@ -2,8 +2,11 @@
 
 One module per command group, each with ``register(sub, fmt)``: :mod:`.plan` (plan, aim, track),
 :mod:`.pictures` (show, animate, workspace, view), :mod:`.library` (library build|query|stats) and
-the bench group.  Every subcommand is one function; errors from bad input are printed as one line
-on stderr with exit code 2, never a traceback.
+the bench group.  Every subcommand is one function.  Errors are one line on stderr, never a
+traceback (``-v`` adds it): exit code 2 for a usage error (argparse's, or a
+:class:`~tpee_ompl.cli._common.CliError` from the argument checks that run before any work), 1 for
+an error at run time (a damaged input file, a model mismatch, a failure, anything unexpected),
+130 when interrupted.
 """
 
 from __future__ import annotations
@@ -12,6 +15,7 @@ import argparse
 import gc
 import logging
 import sys
+import traceback
 from collections.abc import Sequence
 
 from ._common import CliError, Parser
@@ -42,15 +46,32 @@ def main(argv: Sequence[str] | None = None) -> int:
                         format="%(levelname)s %(name)s: %(message)s")
     try:
         return int(args.func(args) or 0)
-    except (CliError, ValueError, FileNotFoundError, ImportError, KeyError, RuntimeError) as exc:
-        msg = exc.args[0] if isinstance(exc, KeyError) and exc.args else exc
-        print(f"tpee-ompl {args.command}: error: {msg}", file=sys.stderr)
-        return 2
+    except Exception as exc:  # noqa: BLE001 (the last resort: one line, never a traceback without -v)
+        if args.verbose:
+            traceback.print_exc()
+        code, message = _describe(exc)
+        print(f"tpee-ompl {args.command}: error: {message}", file=sys.stderr)
+        return code
     except KeyboardInterrupt:
         print(f"tpee-ompl {args.command}: interrupted", file=sys.stderr)
         return 130
     finally:
         gc.collect()  # break si <-> Python checker cycles before exit (nanobind leak warnings otherwise)
+
+
+def _describe(exc: Exception) -> tuple[int, str]:
+    """Exit code and one-line message for an exception a command raised."""
+    if isinstance(exc, CliError):
+        return 2, str(exc)
+    if isinstance(exc, ImportError):  # an optional extra is missing: the message says what to install
+        return 2, str(exc)
+    if isinstance(exc, KeyError) and exc.args:
+        return 1, str(exc.args[0])
+    if isinstance(exc, (ValueError, OSError, RuntimeError)):
+        message = str(exc) or type(exc).__name__
+    else:
+        message = f"unexpected {type(exc).__name__}: {exc} (run with -v for the traceback)"
+    return 1, " ".join(message.split())  # one line, whatever the exception's text
 
 
 if __name__ == "__main__":

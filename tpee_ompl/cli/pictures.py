@@ -8,10 +8,29 @@ import json
 import numpy as np
 
 from ..viz.animation import animate_path
-from ._common import CliError, add_model_args, default_of, finite, load_robot, positive_int
-from .plan import add_plan_args, plan_motion
+from ._common import (
+    CliError,
+    add_force_arg,
+    add_model_args,
+    argument,
+    check_input_file,
+    check_model_args,
+    check_output,
+    default_of,
+    finite,
+    load_robot,
+    numpy_seed,
+    positive_int,
+)
+from .plan import add_plan_args, check_plan_args, plan_motion
 
-__all__ = ["DEFAULT_SCENE_Q", "DEFAULT_SCENE_TARGET", "cmd_animate", "cmd_show", "cmd_view", "cmd_workspace", "register"]
+__all__ = ["ANIMATION_SUFFIXES", "DEFAULT_SCENE_Q", "DEFAULT_SCENE_TARGET", "MAX_FRAMES", "cmd_animate", "cmd_show",
+           "cmd_view", "cmd_workspace", "register"]
+
+ANIMATION_SUFFIXES = (".gif", ".mp4")
+"""What ``animate -o`` writes: a GIF (Pillow) or an MP4 (ffmpeg)."""
+MAX_FRAMES = 2000
+"""Most frames ``animate --frames`` accepts (every frame is kept in memory until the file is written)."""
 
 DEFAULT_SCENE_Q = (50.0, 20.0, 17.0, -37.0)
 """Degrees: the sector 4 preset aiming forward-left-up (``show`` and ``view`` without ``--q``)."""
@@ -21,34 +40,61 @@ DEFAULT_SCENE_TARGET = (4.0, 1.5, 1.9)
 
 def cmd_show(args: argparse.Namespace) -> int:
     """Draw the wearer, the arm at q and the line of sight to the target into a PNG."""
+    from ..viz._common import check_target, image_suffixes
     from ..viz.scene import save_scene
 
+    check_output(args.output, "--output", args.force, image_suffixes())
     robot = load_robot(args)
     q = np.array(args.q) if args.q is not None else np.radians(DEFAULT_SCENE_Q)
+    with argument("--q"):
+        q = robot.check_config(q)
     if args.target is not None:
-        target = np.array(args.target)
+        with argument("--target"):
+            target = check_target(args.target)
     else:
         target = np.array(DEFAULT_SCENE_TARGET) if args.q is None else None
-    out = save_scene(robot, robot.check_config(q), args.output, target=target, sectors=args.sectors)
+    out = save_scene(robot, q, args.output, target=target, sectors=args.sectors)
     print(f"wrote {out} (q = {np.round(q, 4).tolist()} rad, valid: {robot.is_valid(q)})")
     return 0
 
 
-def _read_path(file: str) -> np.ndarray:
-    """The 'path' list of waypoints in a JSON file (e.g. from ``plan --json``)."""
+def _read_path(file: str, nq: int) -> np.ndarray:
+    """The 'path' list of waypoints in a JSON file (e.g. from ``plan --json``): at least one waypoint of
+    ``nq`` finite numbers (JSON numbers, not strings or booleans); ValueError naming the file otherwise."""
     try:
-        with open(file) as fh:
-            return np.asarray(json.load(fh)["path"], dtype=float)
-    except (OSError, KeyError, json.JSONDecodeError, TypeError) as exc:
-        raise CliError(f"cannot read a path from {file}: {exc}") from None
+        with open(file, encoding="utf-8") as fh:
+            doc = json.load(fh)
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError, RecursionError) as exc:
+        raise ValueError(f"cannot read a path from --path {file}: {exc}") from None
+    W = doc.get("path") if isinstance(doc, dict) else None
+    if not isinstance(W, list) or not W:
+        raise ValueError(f"--path {file}: expected a JSON object with a non-empty 'path' list of waypoints")
+    for k, w in enumerate(W):
+        if (not isinstance(w, list) or len(w) != nq
+                or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in w)
+                or not np.all(np.isfinite(np.asarray(w, dtype=float)))):
+            raise ValueError(f"--path {file}: waypoint {k} must be {nq} finite numbers, got {w!r}"[:300])
+    return np.asarray(W, dtype=float)
 
 
 def cmd_animate(args: argparse.Namespace) -> int:
     """Plan a cross-sector motion (or read one from --path JSON) and write an animation."""
+    from matplotlib import animation
+
+    check_output(args.output, "--output", args.force, ANIMATION_SUFFIXES)
+    if args.output.lower().endswith(".mp4") and not animation.writers.is_available("ffmpeg"):
+        raise CliError(f"--output {args.output}: writing .mp4 needs ffmpeg on PATH; write a .gif instead")
+    if args.frames > MAX_FRAMES:
+        raise CliError(f"--frames {args.frames}: at most {MAX_FRAMES} frames")
+    if args.frames < 2:
+        raise CliError(f"--frames {args.frames}: an animation needs at least 2 frames")
     if args.path:
-        W = _read_path(args.path)
+        check_input_file(args.path, "--path", "path file")
+        check_model_args(args)
         robot = load_robot(args)
+        W = _read_path(args.path, robot.nq)
     else:
+        check_plan_args(args)
         result, robot = plan_motion(args)
         if not result["exact"]:
             raise CliError(f"{args.planner} found no exact path ({result['status']}); nothing to animate")
@@ -61,8 +107,10 @@ def cmd_animate(args: argparse.Namespace) -> int:
 
 def cmd_workspace(args: argparse.Namespace) -> int:
     """Monte-Carlo pointing workspace (the paper's Fig. 4) into a PNG."""
+    from ..viz._common import image_suffixes
     from ..viz.workspace import pointing_workspace
 
+    check_output(args.output, "--output", args.force, image_suffixes())
     robot = load_robot(args)
     pointing_workspace(robot, args.samples, np.random.default_rng(args.seed), args.output)
     print(f"wrote {args.output} ({args.samples} samples, seed {args.seed})")
@@ -77,7 +125,9 @@ def cmd_view(args: argparse.Namespace) -> int:
 
     robot = load_robot(args)
     q = np.array(args.q) if args.q is not None else np.radians(DEFAULT_SCENE_Q)
-    view_meshcat(robot, robot.check_config(q), open_browser=not args.no_browser)
+    with argument("--q"):
+        q = robot.check_config(q)
+    view_meshcat(robot, q, open_browser=not args.no_browser)
     print("meshcat viewer running; press Ctrl-C to stop")
     while True:
         time.sleep(1.0)
@@ -92,7 +142,8 @@ def register(sub: argparse._SubParsersAction, fmt: type) -> None:
     p.add_argument("--q", type=finite, nargs=4, metavar="Q", help="DOF1..DOF4 in radians (default: a sector-4 scene)")
     p.add_argument("--target", type=finite, nargs=3, metavar=("X", "Y", "Z"), help="target point (m, world frame)")
     p.add_argument("--sectors", action="store_true", help="overlay the posture sectors")
-    p.add_argument("-o", "--output", default="scene.png")
+    p.add_argument("-o", "--output", default="scene.png", help="image file (.png, .pdf, .svg, ...; default scene.png)")
+    add_force_arg(p)
     add_model_args(p)
     p.set_defaults(func=cmd_show)
 
@@ -103,16 +154,19 @@ def register(sub: argparse._SubParsersAction, fmt: type) -> None:
                                    "tpee-ompl animate --path p.json -o m.gif")
     add_plan_args(p)
     p.add_argument("--path", help="JSON file with a 'path' list of waypoints (e.g. from plan --json)")
-    p.add_argument("--frames", type=positive_int, default=default_of(animate_path, "frames"))
-    p.add_argument("-o", "--output", default="motion.gif")
+    p.add_argument("--frames", type=positive_int, default=default_of(animate_path, "frames"),
+                   help=f"frames, 2..{MAX_FRAMES} (default %(default)s)")
+    p.add_argument("-o", "--output", default="motion.gif", help="a .gif or .mp4 file (default motion.gif)")
+    add_force_arg(p)
     p.set_defaults(func=cmd_animate)
 
     p = sub.add_parser("workspace", help="Monte-Carlo pointing workspace (Fig. 4)", formatter_class=fmt,
                        description="Sample collision-free configurations and draw where the barrel can point.\n\n"
                                    "example:\n  tpee-ompl workspace --samples 4000 -o workspace.png")
     p.add_argument("--samples", type=positive_int, default=4000)
-    p.add_argument("--seed", type=int, default=0)
-    p.add_argument("-o", "--output", default="workspace.png")
+    p.add_argument("--seed", type=numpy_seed, default=0, help="sampling seed, 0..2^32-1 (default 0)")
+    p.add_argument("-o", "--output", default="workspace.png", help="image file (default workspace.png)")
+    add_force_arg(p)
     add_model_args(p)
     p.set_defaults(func=cmd_workspace)
 

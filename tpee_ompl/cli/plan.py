@@ -12,12 +12,34 @@ from ..bench.config import CLI_PLANNER_NAMES
 from ..library import dimension_rrt_planner
 from ..model.pointing import aim
 from ..resources import default_library_path
-from ._common import CliError, add_model_args, default_of, finite, load_robot, positive_float, positive_int, sector
+from ._common import (
+    CliError,
+    add_force_arg,
+    angle,
+    add_model_args,
+    argument,
+    check_input_file,
+    check_model_args,
+    check_output,
+    default_of,
+    finite,
+    index,
+    load_robot,
+    positive_float,
+    positive_int,
+    seconds,
+    sector,
+    seed,
+)
 
 if TYPE_CHECKING:
     from ..model.wearer_arm import WearerArm
 
-__all__ = ["PLANNERS", "add_plan_args", "cmd_aim", "cmd_plan", "cmd_track", "plan_motion", "register"]
+__all__ = ["MAX_TRACK_SAMPLES", "PLANNERS", "add_plan_args", "check_plan_args", "cmd_aim", "cmd_plan", "cmd_track",
+           "plan_motion", "register"]
+
+MAX_TRACK_SAMPLES = 100_000
+"""Most target samples ``track`` accepts (``--duration`` x ``--rate``): more is refused before any work."""
 
 PLANNERS = CLI_PLANNER_NAMES
 """``--planner`` choices: CLI name -> planner class name (``ompl.geometric.<name>``; DimensionRRT is this package's)."""
@@ -42,20 +64,35 @@ def _make_planner(name: str, si: Any, from_sector: int, to_sector: int, samples:
     return planner, None
 
 
-def _start_and_goal(args: argparse.Namespace) -> tuple[np.ndarray, np.ndarray, str | None]:
-    """--start/--goal, or the --query-index'th query of --queries for the sector pair; and the query id."""
+def check_plan_args(args: argparse.Namespace) -> None:
+    """Usage checks of one planning problem's arguments that argparse cannot do alone (before any work)."""
+    if (args.start is None) != (args.goal is None):
+        raise CliError("give both --start and --goal, or neither")
+    if args.from_sector == args.to_sector:
+        raise CliError(f"--from and --to are both sector {args.from_sector}: a cross-sector motion needs two sectors")
+    check_model_args(args)
+
+
+def _start_and_goal(args: argparse.Namespace, robot: WearerArm) -> tuple[np.ndarray, np.ndarray, str | None]:
+    """--start/--goal, or the --query-index'th query of --queries for the sector pair; and the query id.
+
+    The query set must have been made for ``robot`` (its ``model_hash``).
+    """
     if args.start is not None and args.goal is not None:
         return np.array(args.start), np.array(args.goal), None
-    if args.start is not None or args.goal is not None:
-        raise CliError("give both --start and --goal, or neither")
     from ..model.queries import load_queries
 
+    try:
+        queries = load_queries(args.queries, robot)
+    except FileNotFoundError as exc:
+        raise CliError(f"--queries: {exc}") from None
     pair = (args.from_sector, args.to_sector)
-    matching = [q for q in load_queries(args.queries) if (q.from_sector, q.to_sector) == pair]
+    matching = [q for q in queries if (q.from_sector, q.to_sector) == pair]
     if not matching:
-        raise CliError(f"query set {args.queries!r} has no query from sector {args.from_sector} to {args.to_sector}")
+        raise CliError(f"--queries {args.queries}: no query from sector {args.from_sector} to {args.to_sector}")
     if args.query_index >= len(matching):
-        raise CliError(f"--query-index {args.query_index}: the set has {len(matching)} queries for that pair")
+        raise CliError(f"--query-index {args.query_index}: the set has {len(matching)} queries for that pair "
+                       f"(0..{len(matching) - 1})")
     q = matching[args.query_index]
     return np.asarray(q.start), np.asarray(q.goal), q.id
 
@@ -68,14 +105,18 @@ def plan_motion(args: argparse.Namespace) -> tuple[dict, WearerArm]:
     from ..planning.paths import path_passes_motion_checks, path_to_array
     from ..planning.setup import make_simple_setup
 
+    check_plan_args(args)
     ou.setLogLevel(ou.LOG_WARN)
-    if args.seed is not None:
-        ou.RNG.setSeed(args.seed)
+    ou.RNG.setSeed(args.seed)
     robot = load_robot(args)
-    start, goal, qid = _start_and_goal(args)
-    ss = make_simple_setup(robot, start, goal)
+    start, goal, qid = _start_and_goal(args, robot)
+    if qid is None:
+        with argument("--start/--goal"):
+            ss = make_simple_setup(robot, start, goal)
+    else:
+        ss = make_simple_setup(robot, start, goal)
     si = ss.getSpaceInformation()
-    planner, ptc_factory = _make_planner(args.planner, si, args.from_sector, args.to_sector, args.samples, args.seed or 0)
+    planner, ptc_factory = _make_planner(args.planner, si, args.from_sector, args.to_sector, args.samples, args.seed)
     ss.setPlanner(planner)
     checks0 = robot.collision_checks
     if ptc_factory is not None:
@@ -115,11 +156,12 @@ def add_plan_args(p: argparse.ArgumentParser, required: bool = False) -> None:
                    help="start posture sector (1-4)")
     p.add_argument("--to", dest="to_sector", type=sector, required=required, default=4, help="goal posture sector (1-4)")
     p.add_argument("--planner", choices=tuple(PLANNERS), default="dimension-rrt")
-    p.add_argument("--time", type=positive_float, default=5.0, help="time limit in seconds (default 5)")
+    p.add_argument("--time", type=seconds, default=5.0, help="time limit in seconds, at most a day (default 5)")
     p.add_argument("--samples", type=positive_int, default=None, help="sample / iteration cap")
-    p.add_argument("--seed", type=int, default=1)
-    p.add_argument("--queries", default="planning_necessary", help="query set name or JSON file")
-    p.add_argument("--query-index", type=int, default=0, help="which query of that pair (default 0)")
+    p.add_argument("--seed", type=seed, default=1, help="OMPL / planner seed, 1..2^32-1 (default 1)")
+    p.add_argument("--queries", default="planning_necessary",
+                   help="query set name or JSON file (made for the loaded model: its model_hash must match)")
+    p.add_argument("--query-index", type=index, default=0, help="which query of that pair, from 0 (default 0)")
     p.add_argument("--start", type=finite, nargs=4, default=None, metavar="Q", help="start DOF1..DOF4 (rad)")
     p.add_argument("--goal", type=finite, nargs=4, default=None, metavar="Q", help="goal DOF1..DOF4 (rad)")
     add_model_args(p)
@@ -132,7 +174,8 @@ def cmd_aim(args: argparse.Namespace) -> int:
     from ..model.sectors import select_sector
 
     robot = load_robot(args)
-    target = check_target(np.array(args.target), robot)
+    with argument("--target"):
+        target = check_target(np.array(args.target), robot)
     sector_ = args.sector if args.sector is not None else select_sector(target)
     q = aim(target, sector_, pan_reference=args.pan_reference)
     perp, _, ang = aim_errors(robot, q, target)
@@ -172,6 +215,14 @@ def cmd_track(args: argparse.Namespace) -> int:
     """Run the Fig. 10 tracking strategy on a scripted target stream and report its events."""
     from ..library.tracker import Tracker, make_default_planner
 
+    n_samples = args.duration * args.rate
+    if not n_samples <= MAX_TRACK_SAMPLES:
+        raise CliError(f"--duration {args.duration:g} x --rate {args.rate:g} = {n_samples:.3g} target samples; "
+                       f"at most {MAX_TRACK_SAMPLES} are tracked")
+    if args.output:
+        check_output(args.output, "--output", args.force)
+    if args.planner == "library":
+        check_input_file(args.library, "--library", "path library")
     robot = load_robot(args)
     if args.planner == "dimension-rrt":
         plan = dimension_rrt_planner(robot, max_samples=args.samples, seed=args.seed)
@@ -193,9 +244,12 @@ def cmd_track(args: argparse.Namespace) -> int:
     kinds = ("aim", "cross-sector", "blind-area", "unreachable")
     summary = {k: result.count(k) for k in kinds}
     if args.output:
+        from ..files import atomic_path
+
         header = "t,dof1,dof2,dof3,dof4,sector"
-        np.savetxt(args.output, np.c_[result.times, result.configurations, result.sectors], delimiter=",",
-                   header=header, comments="")
+        with atomic_path(args.output) as tmp:
+            np.savetxt(tmp, np.c_[result.times, result.configurations, result.sectors], delimiter=",",
+                       header=header, comments="")
     if args.json:
         print(json.dumps({"script": args.script, "samples": len(stream), "trajectory_points": len(result.times),
                           "events": summary}))
@@ -224,7 +278,7 @@ def register(sub: argparse._SubParsersAction, fmt: type) -> None:
                                    "  tpee-ompl aim --target 5 2 1.5\n  tpee-ompl aim --target -4 -3 1 --sector 1 --json")
     p.add_argument("--target", type=finite, nargs=3, required=True, metavar=("X", "Y", "Z"), help="metres, world frame")
     p.add_argument("--sector", type=sector, default=None, help="posture sector (default: chosen from the target)")
-    p.add_argument("--pan-reference", type=finite, default=default_of(aim, "pan_reference"),
+    p.add_argument("--pan-reference", type=angle, default=default_of(aim, "pan_reference"),
                    help="pan angle the smaller rotation is measured from")
     p.add_argument("--json", action="store_true")
     add_model_args(p)
@@ -241,10 +295,11 @@ def register(sub: argparse._SubParsersAction, fmt: type) -> None:
                    help="path library file (with --planner library; default: the packaged one)")
     p.add_argument("--samples", type=positive_int, default=default_of(dimension_rrt_planner, "max_samples"),
                    help="dimension-RRT sample cap")
-    p.add_argument("--duration", type=positive_float, default=20.0, help="seconds of target motion")
+    p.add_argument("--duration", type=positive_float, default=20.0, help=f"seconds of target motion (duration x rate <= {MAX_TRACK_SAMPLES})")
     p.add_argument("--rate", type=positive_float, default=10.0, help="target samples per second")
-    p.add_argument("--seed", type=int, default=1, help="OMPL / planner seed (>= 1)")
+    p.add_argument("--seed", type=seed, default=1, help="OMPL / planner seed, 1..2^32-1 (default 1)")
     p.add_argument("--json", action="store_true")
-    p.add_argument("-o", "--output", help="write the trajectory as CSV")
+    p.add_argument("-o", "--output", help="write the trajectory as CSV (a new file; --force to replace one)")
+    add_force_arg(p)
     add_model_args(p)
     p.set_defaults(func=cmd_track)

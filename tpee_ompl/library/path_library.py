@@ -322,9 +322,10 @@ class PathLibrary:
     def __len__(self) -> int:
         return sum(len(pd.starts) for pd in self.pairs.values())
     # ------------------------------------------------------------------ persistence
-    def save(self, path: str | Path) -> Path:
-        """Write the library to one ``.npz`` file (:func:`tpee_ompl.library.storage.write_library`)."""
-        return write_library(self, path)
+    def save(self, path: str | Path, *, force: bool = True) -> Path:
+        """Write the library to one ``.npz`` file, atomically (:func:`tpee_ompl.library.storage.write_library`);
+        with ``force=False`` an existing file is refused (:class:`~tpee_ompl.files.OutputExistsError`)."""
+        return write_library(self, path, force=force)
 
     @classmethod
     def load(cls, path: str | Path, robot: WearerArm, plan: Plan | None = None) -> PathLibrary:

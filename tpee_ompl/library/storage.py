@@ -9,6 +9,7 @@ The DMPs' response profiles are recomputed on reading (:meth:`tpee_ompl.library.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import zipfile
 from dataclasses import asdict
@@ -17,26 +18,46 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..files import OutputExistsError, atomic_path
+from ..model.sectors import SECTOR_PAIRS
 from ..model.wearer_arm import WearerArm
+from ..validation import check_int
 from .demos import N_FAKE_TIME_STEPS, PairDemos
 from .dmp import DMP, DMPOptions
 
 if TYPE_CHECKING:
     from .path_library import PathLibrary
 
-__all__ = ["FORMAT_VERSION", "LibraryFileError", "read_library", "write_library"]
+__all__ = ["FORMAT_VERSION", "MAX_CANDIDATES", "MAX_PER_STEP", "LibraryFileError", "read_library", "write_library"]
 
 FORMAT_VERSION = 2
 """Version of the ``.npz`` layout written by :func:`write_library` (2: per-demo planning margins)."""
 
 
 class LibraryFileError(ValueError):
-    """A library file that cannot be used: truncated, wrong format version, or another model."""
+    """A library file that cannot be used: truncated, wrong format version, another model, or a malformed
+    field or array (the message names it)."""
 
 
-def write_library(library: PathLibrary, path: str | Path) -> Path:
-    """Write ``library`` to one ``.npz`` file (format :data:`FORMAT_VERSION`, model hash included); returns the path."""
+MAX_PER_STEP = 10_000
+"""Largest ``per_step`` a file may give (the DMPs' time grid has 6 x per_step + 1 steps)."""
+MAX_CANDIDATES = 10_000
+"""Largest ``n_candidates`` a file may give."""
+_META_KEYS = frozenset({"format_version", "model_hash", "per_step", "n_candidates", "options", "pairs", "build_stats",
+                        "build_params", "query_stride"})
+_PAIR_ARRAYS = ("starts", "goals", "waypoints", "margins", "fwd_weights", "fwd_scaled", "rev_weights", "rev_scaled")
+
+
+def write_library(library: PathLibrary, path: str | Path, *, force: bool = True) -> Path:
+    """Write ``library`` to one ``.npz`` file (format :data:`FORMAT_VERSION`, model hash included); returns the path.
+
+    The file is written atomically (:func:`tpee_ompl.files.atomic_path`): an interrupted write leaves
+    the old file (or none), never a truncated one.  With ``force=False`` an existing file raises
+    :class:`~tpee_ompl.files.OutputExistsError` and is left unchanged.
+    """
     path = Path(path)
+    if path.exists() and not force:
+        raise OutputExistsError(f"path library {path} exists; pass --force to replace it")
     meta = {
         "format_version": FORMAT_VERSION,
         "model_hash": library.robot.model_hash,
@@ -57,20 +78,91 @@ def write_library(library: PathLibrary, path: str | Path) -> Path:
         for name, dmps in (("fwd", pd.forward), ("rev", pd.reverse)):
             arrays[p + name + "_weights"] = np.array([d.weights for d in dmps]).reshape(len(dmps), 2, n_basis)
             arrays[p + name + "_scaled"] = np.array([d.scaled for d in dmps], dtype=bool).reshape(len(dmps), 2)
-    with open(path, "wb") as fh:
+    with atomic_path(path, force=force) as tmp, open(tmp, "wb") as fh:
         np.savez_compressed(fh, **arrays)
     return path
 
 
+def _check_meta(meta: Any, path: Path) -> dict[str, Any]:
+    """The library settings of the ``meta`` record, every field checked; LibraryFileError naming the field."""
+    def bad(field_: str, why: str) -> LibraryFileError:
+        return LibraryFileError(f"path library {path}: meta field {field_!r} {why}")
+
+    if not isinstance(meta, dict):
+        raise LibraryFileError(f"path library {path}: meta must be a JSON object, got {type(meta).__name__}")
+    unknown = sorted(set(meta) - _META_KEYS)
+    if unknown:
+        raise bad(unknown[0], f"is unknown (the fields are {', '.join(sorted(_META_KEYS))})")
+    for name, top in (("per_step", MAX_PER_STEP), ("n_candidates", MAX_CANDIDATES), ("query_stride", None)):
+        if name == "query_stride" and name not in meta:
+            continue
+        try:
+            check_int(name, meta.get(name), minimum=1, maximum=top)
+        except ValueError as exc:
+            raise bad(name, f"is invalid: {exc}") from None
+    options = meta.get("options")
+    fields = {f.name for f in dataclasses.fields(DMPOptions)}
+    if not isinstance(options, dict):
+        raise bad("options", f"must be a JSON object of DMP options, got {options!r}")
+    unknown = sorted(set(options) - fields)
+    if unknown:
+        raise bad("options", f"has an unknown DMP option {unknown[0]!r} (known: {', '.join(sorted(fields))})")
+    try:
+        dmp_options = DMPOptions(**options)
+    except (TypeError, ValueError) as exc:
+        raise bad("options", f"is invalid: {exc}") from None
+    pairs = meta.get("pairs")
+    if not isinstance(pairs, list) or not all(
+            isinstance(p, list) and len(p) == 2 and all(type(v) is int for v in p) and tuple(p) in SECTOR_PAIRS
+            for p in pairs):
+        raise bad("pairs", f"must be a list of [i, j] sector pairs, i != j in 1..4, got {pairs!r}"[:300])
+    if len({tuple(p) for p in pairs}) != len(pairs):
+        raise bad("pairs", f"lists a pair twice: {pairs!r}")
+    for name in ("build_stats", "build_params"):
+        if not isinstance(meta.get(name), (dict, type(None))):
+            raise bad(name, f"must be a JSON object, got {type(meta.get(name)).__name__}")
+    return {"per_step": meta["per_step"], "options": dmp_options, "n_candidates": meta["n_candidates"],
+            "build_stats": meta.get("build_stats"), "query_stride": meta.get("query_stride", 10),
+            "build_params": meta.get("build_params"), "pairs": [tuple(p) for p in pairs]}
+
+
+def _pair_arrays(arrays: dict[str, np.ndarray], i: int, j: int, n_basis: int, path: Path) -> dict[str, np.ndarray]:
+    """Pair (i, j)'s arrays, shapes, dtypes and values checked; LibraryFileError naming the array."""
+    p = f"p{i}{j}_"
+    missing = [p + n for n in _PAIR_ARRAYS if p + n not in arrays]
+    if missing:
+        raise LibraryFileError(f"path library {path}: array {missing[0]!r} is missing")
+    a = {n: arrays[p + n] for n in _PAIR_ARRAYS}
+    m = a["starts"].shape[0] if a["starts"].ndim else -1
+    shapes = {"starts": (m, 4), "goals": (m, 4), "waypoints": (m, N_FAKE_TIME_STEPS, 4), "margins": (m,),
+              "fwd_weights": (m, 2, n_basis), "rev_weights": (m, 2, n_basis), "fwd_scaled": (m, 2), "rev_scaled": (m, 2)}
+    for name, shape in shapes.items():
+        x = a[name]
+        if x.shape != shape:
+            raise LibraryFileError(f"path library {path}: array {p + name!r} has shape {x.shape}, expected {shape}")
+        if name.endswith("_scaled"):
+            if x.dtype != bool:
+                raise LibraryFileError(f"path library {path}: array {p + name!r} must be booleans, got {x.dtype}")
+            continue
+        if x.dtype.kind != "f":
+            raise LibraryFileError(f"path library {path}: array {p + name!r} must be floats, got {x.dtype}")
+        if name != "margins" and not np.all(np.isfinite(x)):
+            raise LibraryFileError(f"path library {path}: array {p + name!r} holds NaN or inf")
+    return a
+
+
 def read_library(path: str | Path, robot: WearerArm) -> tuple[dict[tuple[int, int], PairDemos], dict[str, Any]]:
     """The demos per pair and the library's settings (``PathLibrary`` keyword arguments) of a file written by :func:`write_library`.
+
+    Every field of the metadata and every array is checked (type, shape, finite values) before use.
 
     Raises
     ------
     FileNotFoundError
         If there is no such file.
     LibraryFileError
-        If the file is damaged, has another format version, or was built for another model.
+        If the file is damaged, has another format version, was built for another model, or a field
+        or array is malformed (the message names it).
     """
     path = Path(path)
     try:
@@ -82,36 +174,33 @@ def read_library(path: str | Path, robot: WearerArm) -> tuple[dict[tuple[int, in
         raise LibraryFileError(f"path library {path} is unreadable (truncated or not a library file): {exc}") from exc
     try:
         meta = json.loads(str(arrays["meta"]))
-    except (KeyError, json.JSONDecodeError) as exc:
+    except (KeyError, json.JSONDecodeError, RecursionError) as exc:
         raise LibraryFileError(f"path library {path} has no valid metadata: {exc}") from exc
-    if meta.get("format_version") != FORMAT_VERSION:
+    version = meta.get("format_version") if isinstance(meta, dict) else None
+    if isinstance(meta, dict) and (type(version) is not int or version != FORMAT_VERSION):
         raise LibraryFileError(
-            f"path library {path} has format version {meta.get('format_version')!r}; "
+            f"path library {path} has format version {version!r}; "
             f"this code reads version {FORMAT_VERSION}: rebuild the library"
         )
-    if meta.get("model_hash") != robot.model_hash:
+    if isinstance(meta, dict) and meta.get("model_hash") != robot.model_hash:
         raise LibraryFileError(
             f"path library {path} was built for model {meta.get('model_hash')!r}, but the robot is "
             f"model {robot.model_hash!r}: rebuild the library for this URDF/SRDF"
         )
-    options = DMPOptions(**meta["options"])
-    per_step = int(meta["per_step"])
+    settings = _check_meta(meta, path)
+    options, per_step = settings["options"], settings["per_step"]
     n_steps = (N_FAKE_TIME_STEPS - 1) * per_step + 1
+    n_basis = options.basis_count(n_steps)
     data: dict[tuple[int, int], PairDemos] = {}
-    try:
-        for i, j in meta["pairs"]:
-            p = f"p{i}{j}_"
-            pd = PairDemos(arrays[p + "starts"], arrays[p + "goals"], arrays[p + "waypoints"], arrays[p + "margins"])
-            if not (len(pd.starts) == len(pd.goals) == len(pd.waypoints) == len(pd.margins)):
-                raise ValueError(f"pair {i}->{j}: starts, goals, waypoints and margins differ in length")
-            for W, fw, fs, rw, rs in zip(pd.waypoints, arrays[p + "fwd_weights"], arrays[p + "fwd_scaled"],
-                                         arrays[p + "rev_weights"], arrays[p + "rev_scaled"], strict=True):
+    for i, j in settings.pop("pairs"):
+        a = _pair_arrays(arrays, i, j, n_basis, path)
+        pd = PairDemos(a["starts"], a["goals"], a["waypoints"], a["margins"])
+        try:
+            for W, fw, fs, rw, rs in zip(pd.waypoints, a["fwd_weights"], a["fwd_scaled"], a["rev_weights"],
+                                         a["rev_scaled"], strict=True):
                 pd.forward.append(DMP.from_weights(fw, W[0, 2:], W[-1, 2:], fs, n_steps, options))
                 pd.reverse.append(DMP.from_weights(rw, W[-1, 2:], W[0, 2:], rs, n_steps, options))
-            data[(int(i), int(j))] = pd
-    except (KeyError, ValueError) as exc:
-        raise LibraryFileError(f"path library {path} is inconsistent: {exc}") from exc
-    settings = {"per_step": per_step, "options": options, "n_candidates": int(meta["n_candidates"]),
-                "build_stats": meta.get("build_stats"), "query_stride": int(meta.get("query_stride", 10)),
-                "build_params": meta.get("build_params")}
+        except ValueError as exc:
+            raise LibraryFileError(f"path library {path} is inconsistent: pair {i}->{j}: {exc}") from exc
+        data[(i, j)] = pd
     return data, settings

@@ -25,6 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..files import atomic_write_text
 from ..resources import query_set_path
 from .sectors import check_sector, cross_sector_trajectory
 from .wearer_arm import WearerArm
@@ -42,6 +43,10 @@ __all__ = [
 log = logging.getLogger(__name__)
 
 FORMAT_VERSION = 1
+
+
+class QuerySetError(ValueError):
+    """A query set file that cannot be used: not JSON, wrong format_version, bad entries, other model."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -93,9 +98,32 @@ class Query:
 
     @classmethod
     def from_dict(cls, d: dict) -> Query:
-        """Inverse of :meth:`to_dict`."""
-        return cls(int(d["id"]), int(d["from_sector"]), int(d["to_sector"]),
-                   d["target_a"], d["target_b"], d["start"], d["goal"])
+        """Inverse of :meth:`to_dict`, with strict JSON types: integers for ``id`` and the sectors, lists
+        of numbers for the vectors (a string, a boolean or a missing or unknown field raises
+        :class:`QuerySetError` naming the field; nothing is coerced)."""
+        if not isinstance(d, dict):
+            raise QuerySetError(f"a query must be a JSON object, got {type(d).__name__}")
+        missing = [k for k in _QUERY_FIELDS if k not in d]
+        if missing:
+            raise QuerySetError(f"field {missing[0]!r} is missing")
+        unknown = sorted(k for k in d if k not in _QUERY_FIELDS)
+        if unknown:
+            raise QuerySetError(f"field {unknown[0]!r} is unknown (the fields are {', '.join(_QUERY_FIELDS)})")
+        for name in ("id", "from_sector", "to_sector"):
+            if type(d[name]) is not int:
+                raise QuerySetError(f"field {name!r} must be an integer, got {d[name]!r}")
+        for name, n in _QUERY_VECTORS.items():
+            v = d[name]
+            if not isinstance(v, list) or len(v) != n or not all(type(x) in (int, float) for x in v):
+                raise QuerySetError(f"field {name!r} must be a list of {n} numbers, got {v!r}"[:300])
+        try:
+            return cls(d["id"], d["from_sector"], d["to_sector"], d["target_a"], d["target_b"], d["start"], d["goal"])
+        except ValueError as exc:
+            raise QuerySetError(str(exc)) from None
+
+
+_QUERY_VECTORS = {"target_a": 3, "target_b": 3, "start": 4, "goal": 4}
+_QUERY_FIELDS = ("id", "from_sector", "to_sector", *_QUERY_VECTORS)
 
 
 def straight_motion(start: np.ndarray, goal: np.ndarray, i: int, j: int) -> np.ndarray:
@@ -121,18 +149,13 @@ def save_queries(
     model_hash: str,
     extra: dict | None = None,
 ) -> Path:
-    """Write a versioned JSON query set: format_version, name, seed, model_hash, queries (+ extra keys)."""
+    """Write a versioned JSON query set: format_version, name, seed, model_hash, queries (+ extra keys).
+
+    Written atomically (:func:`tpee_ompl.files.atomic_write_text`); an existing file is replaced."""
     doc = {"format_version": FORMAT_VERSION, "name": name, "seed": seed, "model_hash": model_hash}
     doc.update(extra or {})
     doc["queries"] = [q.to_dict() for q in queries]
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(json.dumps(doc, indent=1) + "\n")
-    return path
-
-
-class QuerySetError(ValueError):
-    """A query set file that cannot be used: not JSON, wrong format_version, bad entries, other model."""
+    return atomic_write_text(path, json.dumps(doc, indent=1) + "\n")
 
 
 def load_query_set(name_or_path: str | os.PathLike, robot: WearerArm | None = None) -> tuple[list[Query], dict]:
@@ -146,7 +169,7 @@ def load_query_set(name_or_path: str | os.PathLike, robot: WearerArm | None = No
         raise FileNotFoundError(f"query set {str(name_or_path)!r} not found (looked at {p})")
     try:
         doc = json.loads(p.read_text(encoding="utf-8"))
-    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+    except (UnicodeDecodeError, json.JSONDecodeError, RecursionError) as exc:
         raise QuerySetError(f"{p}: not a JSON query set (truncated or corrupt?): {exc}") from exc
     if not isinstance(doc, dict):
         raise QuerySetError(f"{p}: expected a JSON object at the top level, got {type(doc).__name__}")
@@ -159,12 +182,13 @@ def load_query_set(name_or_path: str | os.PathLike, robot: WearerArm | None = No
     queries = []
     for k, d in enumerate(entries):
         try:
-            if not isinstance(d, dict):
-                raise ValueError(f"expected an object, got {type(d).__name__}")
             queries.append(Query.from_dict(d))
-        except (KeyError, TypeError, ValueError) as exc:
-            raise QuerySetError(f"{p}: query {k} is malformed: {exc!r}") from exc
+        except ValueError as exc:
+            raise QuerySetError(f"{p}: query {k} is malformed: {exc}") from exc
     header = {k: v for k, v in doc.items() if k != "queries"}
+    ids = [q.id for q in queries]
+    if len(set(ids)) != len(ids):
+        raise QuerySetError(f"{p}: query id {next(i for i in ids if ids.count(i) > 1)} appears twice")
     if robot is not None and header.get("model_hash") != robot.model_hash:
         raise QuerySetError(
             f"{p}: made for model_hash {header.get('model_hash')!r}, but the robot's is {robot.model_hash!r} "

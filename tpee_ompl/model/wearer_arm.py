@@ -317,8 +317,11 @@ class WearerArm:
         """:meth:`is_valid` for nq plain floats (an OMPL state's values), without the input checks.
 
         The per-state OMPL checker calls this ~10^5 times per plan.  NaN fails the limit test, so a
-        non-finite value is still reported invalid rather than passed to Pinocchio.
+        non-finite value is still reported invalid rather than passed to Pinocchio.  Another number of
+        values than ``nq`` raises ValueError naming it (one ``len``: the only check added to the hot path).
         """
+        if len(values) != self.nq:
+            raise ValueError(f"is_valid_values needs {self.nq} values (DOF1..DOF{self.nq}), got {len(values)}")
         for v, lo, hi in zip(values, self._lower_list, self._upper_list):
             if not lo <= v <= hi:
                 return False

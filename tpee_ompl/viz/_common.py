@@ -66,12 +66,17 @@ def clip_segment(a: np.ndarray, b: np.ndarray, lo: np.ndarray, hi: np.ndarray) -
 
 # ---------------------------------------------------------------------------- argument checks
 def check_target(target: Any) -> np.ndarray | None:
-    """None, or the target as 3 finite floats (metres); ValueError otherwise."""
+    """None, or the target as 3 finite floats (metres) within the model's MAX_TARGET_DISTANCE; ValueError otherwise."""
+    from ..model.wearer_arm import MAX_TARGET_DISTANCE
+    from ..validation import as_float_array
+
     if target is None:
         return None
-    t = np.asarray(target, dtype=float)
+    t = as_float_array(target, "target")
     if t.shape != (3,) or not np.all(np.isfinite(t)):
         raise ValueError(f"target must be 3 finite numbers (x, y, z in metres), got {target!r}")
+    if np.max(np.abs(t)) > MAX_TARGET_DISTANCE:
+        raise ValueError(f"target {t} is farther than MAX_TARGET_DISTANCE = {MAX_TARGET_DISTANCE:g} m")
     return t
 
 
@@ -93,8 +98,26 @@ def output_path(out_path: str | os.PathLike) -> Path:
     return out
 
 
+def image_suffixes() -> tuple[str, ...]:
+    """The file suffixes a figure can be written as (``.png``, ``.pdf``, ``.svg``, ...: matplotlib's)."""
+    from matplotlib.backend_bases import FigureCanvasBase
+
+    common = (".png", ".pdf", ".svg", ".jpg")
+    others = sorted("." + k for k in FigureCanvasBase.get_supported_filetypes() if "." + k not in common)
+    return (*common, *others)
+
+
 def write_figure(fig: Figure, out: Path, dpi: int, **savefig_kwargs: Any) -> Path:
-    """Save ``fig`` to ``out`` (format from the suffix), log it, and return ``out``."""
-    fig.savefig(out, dpi=dpi, **savefig_kwargs)
+    """Save ``fig`` to exactly ``out`` (format from its suffix), atomically; log it and return ``out``.
+
+    A name without a known image suffix is refused (matplotlib would add ``.png`` and write another
+    file than the one named); an existing file is replaced in one step, never left half-written.
+    """
+    from ..files import atomic_path
+
+    if out.suffix.lower() not in image_suffixes():
+        raise ValueError(f"figure file {out}: give a name ending in an image suffix ({', '.join(image_suffixes()[:4])}, ...)")
+    with atomic_path(out) as tmp:
+        fig.savefig(tmp, dpi=dpi, format=out.suffix[1:].lower(), **savefig_kwargs)
     log.info("wrote %s", out)
     return out
