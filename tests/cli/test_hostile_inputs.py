@@ -24,6 +24,8 @@ from helpers.hostile_files import (
     QUERY_DEFECTS,
 )
 
+pytestmark = pytest.mark.slow  # ~30 s of subprocesses; CI and `make test` run it
+
 SG = ["--start", *map(str, START), "--goal", *map(str, GOAL)]
 """A valid --start/--goal (sector 1 preset -> sector 4 preset)."""
 IN_COLLISION = ["-0.085", "0.299", "-0.799", "-1.202"]
