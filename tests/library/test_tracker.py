@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from tpee_ompl.library.tracker import Tracker, make_default_planner
+from tpee_ompl.planning.paths import motion_is_valid
 from tpee_ompl.model.pointing import aim_errors
 from tpee_ompl.model.queries import straight_motion
 from tpee_ompl.model.sectors import posture_sector, sector_origin
@@ -105,11 +106,21 @@ def test_blind_area_target_triggers_a_posture_change(robot, planner):
     _assert_safe_and_aimed(robot, result)
 
 
-def test_default_planner_returns_straight_motion_when_it_is_free(robot, planner):
+def test_default_planner_without_a_library_returns_straight_motion_when_it_is_free(robot):
+    planner = make_default_planner(robot, timeout=2.0, seed=1, library=None)
     start = np.r_[np.deg2rad([-50.0, 160.0]), 0.0, 0.0]
     goal = np.r_[np.deg2rad([50.0, 160.0]), 0.0, 0.0]
     w = planner(start, goal, 1, 2)
     np.testing.assert_array_equal(w, straight_motion(start, goal, 1, 2))
+
+
+def test_default_planner_answers_cross_sector_motions_with_the_library_pipeline(robot, planner):
+    from tpee_ompl.model.queries import load_queries
+
+    for q in load_queries("planning_necessary")[::30]:  # straight motions collide: a plain planner would need RRTConnect
+        w = planner(q.start, q.goal, q.from_sector, q.to_sector)
+        assert np.allclose(w[0], q.start) and np.allclose(w[-1], q.goal)
+        assert motion_is_valid(robot, w, min(0.01, robot.max_joint_step()))
 
 
 def test_tracker_rejects_a_colliding_planner_path(robot):

@@ -221,7 +221,7 @@ def cmd_track(args: argparse.Namespace) -> int:
                        f"at most {MAX_TRACK_SAMPLES} are tracked")
     if args.output:
         check_output(args.output, "--output", args.force)
-    if args.planner == "library":
+    if args.planner in ("default", "library"):
         check_input_file(args.library, "--library", "path library")
     robot = load_robot(args)
     if args.planner == "dimension-rrt":
@@ -238,7 +238,7 @@ def cmd_track(args: argparse.Namespace) -> int:
         lib = PathLibrary.load(args.library, robot, plan=dimension_rrt_planner(robot, max_samples=args.samples))
         planner = lib.as_planner()
     else:
-        planner = make_default_planner(robot, seed=args.seed)
+        planner = make_default_planner(robot, seed=args.seed, library=args.library)
     stream = _scripted_targets(args.script, args.duration, args.rate)
     result = Tracker(robot, planner).run(stream)
     kinds = ("aim", "cross-sector", "blind-area", "unreachable")
@@ -290,9 +290,10 @@ def register(sub: argparse._SubParsersAction, fmt: type) -> None:
                                    "  tpee-ompl track --script jump --planner dimension-rrt -o traj.csv")
     p.add_argument("--script", choices=("circle", "jitter", "jump"), default="circle")
     p.add_argument("--planner", choices=("default", "dimension-rrt", "library"), default="default",
-                   help="cross-sector planner: default (Table 3 straight motion, else RRTConnect), dimension-rrt, library")
+                   help="cross-sector planner: default (LibraryDimensionRRT for 0.05 s, then Table 3's straight "
+                        "motion, else RRTConnect), dimension-rrt, library (PathLibrary.query alone)")
     p.add_argument("--library", default=str(default_library_path()),
-                   help="path library file (with --planner library; default: the packaged one)")
+                   help="path library file (default and library planners; default: the packaged one)")
     p.add_argument("--samples", type=positive_int, default=default_of(dimension_rrt_planner, "max_samples"),
                    help="dimension-RRT sample cap")
     p.add_argument("--duration", type=positive_float, default=20.0, help=f"seconds of target motion (duration x rate <= {MAX_TRACK_SAMPLES})")

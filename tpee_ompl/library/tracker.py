@@ -17,6 +17,7 @@ from __future__ import annotations
 import itertools
 import logging
 import math
+import os
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 
@@ -26,7 +27,8 @@ from ..model.pointing import AimingError, PointingGeometry, aim_batch, check_tar
 from ..model.sectors import SECTORS, check_sector, in_pointing_sector, posture_preset, posture_sector
 from ..model.wearer_arm import WearerArm
 from ..planning.paths import MIN_JOINT_STEP, motion_is_valid, motion_states
-from ..validation import as_float_array, check_number
+from ..validation import as_float_array, check_number, check_seed
+from .path_library import PathLibrary
 
 __all__ = [
     "Planner",
@@ -259,12 +261,24 @@ class Tracker:
         )
 
 
-def make_default_planner(robot: WearerArm, *, timeout: float = 2.0, seed: int | None = 0) -> Planner:
-    """A simple cross-sector planner: Table 3's straight motion when collision-free, else OMPL RRTConnect.
+def make_default_planner(
+    robot: WearerArm,
+    *,
+    timeout: float = 2.0,
+    seed: int | None = 1,
+    library: PathLibrary | str | os.PathLike | None = "default",
+    library_time: float = 0.05,
+) -> Planner:
+    """The tracker's cross-sector planner: the paper's pipeline, with plain fallbacks.
 
-    The straight motion is :func:`tpee_ompl.model.queries.straight_motion` (sector to itself: a straight
-    joint motion).  RRTConnect runs on :func:`tpee_ompl.planning.setup.make_simple_setup` for at most
-    ``timeout`` seconds and its path is simplified; raises RuntimeError if it finds none.
+    A cross-sector motion goes to :class:`~tpee_ompl.library.planner.LibraryDimensionRRT` (the DMP
+    library's validated path, refined by dimension-RRT) for ``library_time`` seconds; ``library`` is
+    the packaged default library (``"default"``), a file, a loaded :class:`PathLibrary`, or None to
+    skip this step.  Otherwise, and for same-sector re-aims: Table 3's straight motion
+    (:func:`tpee_ompl.model.queries.straight_motion`; within a sector a straight joint motion) when
+    collision-free, else OMPL RRTConnect on :func:`tpee_ompl.planning.setup.make_simple_setup` for
+    at most ``timeout`` seconds, simplified.  Every path is checked at the tracker's default step
+    (0.01 rad, or the robot's motion step if smaller); raises RuntimeError if none is found.
     """
     from ompl import geometric as og
     from ompl import util as ou
@@ -272,13 +286,26 @@ def make_default_planner(robot: WearerArm, *, timeout: float = 2.0, seed: int | 
     from ..model.queries import straight_motion
     from ..planning.paths import path_to_array
     from ..planning.setup import make_simple_setup
+    from .planner import LibraryDimensionRRT
 
     ou.setLogLevel(ou.LOG_WARN)
     if seed is not None:
-        ou.RNG.setSeed(int(seed))
+        ou.RNG.setSeed(check_seed("seed", seed))  # once per process: later calls only warn
     step = min(0.01, robot.max_joint_step())
+    lib: PathLibrary | None = None
+    if isinstance(library, PathLibrary):
+        lib = library
+    elif library is not None:
+        from ..resources import default_library_path
+
+        lib = PathLibrary.load(default_library_path() if library == "default" else library, robot)
 
     def plan(start: np.ndarray, goal: np.ndarray, i: int, j: int) -> np.ndarray:
+        if i != j and lib is not None:
+            ss = make_simple_setup(robot, start, goal, joint_step=step)
+            ss.setPlanner(LibraryDimensionRRT(ss.getSpaceInformation(), lib, i, j, seed=seed))
+            if ss.solve(library_time) and ss.haveExactSolutionPath():
+                return path_to_array(ss.getSolutionPath(), robot.nq)
         w = straight_motion(start, goal, i, j) if i != j else np.array([start, goal], dtype=float)
         if motion_is_valid(robot, w, step):
             return w
