@@ -26,6 +26,7 @@ from ompl import base as ob
 from ompl import geometric as og
 
 from ..planning.paths import path_to_array
+from .config import KNOWN_PLANNERS
 
 __all__ = [
     "PLANNER_FACTORIES",
@@ -68,7 +69,7 @@ def _dimension_rrt(si, ctx: PlannerContext):
 
 PLANNER_FACTORIES: dict[str, PlannerFactory] = {
     "DimensionRRT": _dimension_rrt,
-    **{n: _native(n) for n in ("RRTstar", "InformedRRTstar", "RRTConnect", "AORRTC", "BITstar", "RRT", "PRMstar")},
+    **{n: _native(n) for n in KNOWN_PLANNERS if n != "DimensionRRT"},
 }
 """Planner name -> factory ``(si, PlannerContext) -> ob.Planner``.  A name ``module:function`` is
 imported instead (so worker processes can build planners defined elsewhere, e.g. test stand-ins)."""
@@ -80,7 +81,13 @@ def planner_factory(name: str) -> PlannerFactory:
         return PLANNER_FACTORIES[name]
     if ":" in name:
         mod, _, attr = name.partition(":")
-        return getattr(importlib.import_module(mod), attr)
+        try:
+            fn = getattr(importlib.import_module(mod), attr)
+        except (ImportError, AttributeError) as exc:
+            raise ValueError(f"planner {name!r}: cannot import {attr} from {mod} ({exc})") from None
+        if not callable(fn):
+            raise ValueError(f"planner {name!r}: {attr} is not a factory function")
+        return fn
     raise ValueError(f"unknown planner {name!r}: choose from {sorted(PLANNER_FACTORIES)} or give module:function")
 
 
