@@ -212,3 +212,8 @@ def make_self_killer(si, ctx: PlannerContext):
             (folder / f"killed-{os.getpid()}").write_text(str(ctx.max_samples))
             os.kill(os.getpid(), signal.SIGKILL)
     return StandInPlanner(si, max_samples=ctx.max_samples, seed=ctx.seed)
+
+
+def make_broken_factory(si, ctx: PlannerContext):
+    """A planner factory that raises (its query's task fails in the worker: a runtime failure, not bad input)."""
+    raise RuntimeError("this planner factory always fails")

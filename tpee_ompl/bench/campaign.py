@@ -128,9 +128,17 @@ def prepare_campaign(config: CampaignConfig) -> CampaignPlan:
     from .planners import planner_factory
 
     _check_out_folder(config.out)
-    for name in (*config.iteration_planners, *config.anytime_planners):
-        planner_factory(name)
-    set_name, queries = query_rows(config.queries, default_robot())
+    for field_name in ("iteration_planners", "anytime_planners"):
+        for name in getattr(config, field_name):
+            try:
+                planner_factory(name)
+            except ValueError as exc:
+                raise ValueError(f"{field_name}: {exc}") from None
+    try:
+        set_name, queries = query_rows(config.queries, default_robot())
+    except (OSError, ValueError) as exc:  # missing, unreadable, not a query set, made for another model
+        msg = str(exc).removeprefix(f"{config.queries}: ")
+        raise ValueError(f"queries {config.queries}: {msg}") from None
     queries = stratified_subset(queries, config.max_queries)
     if not queries:
         raise ValueError(f"query set {config.queries!r} has no queries")
@@ -357,7 +365,7 @@ def _failure_entry(meta: dict, log_dir: Path, res: dict) -> dict:
     k = int(res["qpos"])
     q = meta["query_data"][k]
     missing = [n for n in (log_name(q, k, s) for s in experiment_specs(meta["config"], k)) if not (log_dir / n).is_file()]
-    log.error("query %s (position %d) lost after %d attempts (%s): %d experiment(s) have no log",
+    log.info("query %s (position %d) lost after %d attempts (%s): %d experiment(s) have no log",
               q["id"], k, res.get("attempts", 1), res["failed"], len(missing))
     return {"qpos": k, "query_id": q["id"], "reason": res["failed"], "attempts": res.get("attempts", 1),
             "missing_logs": missing, "utc": utc_now()}

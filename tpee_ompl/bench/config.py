@@ -109,7 +109,7 @@ class CampaignConfig:
         caps = tuple(check_int("sample_caps", n, minimum=1) for n in self.sample_caps)
         budgets = tuple(check_number("anytime_budgets", b, low=0, low_open=True) for b in self.anytime_budgets)
         if not caps and not budgets:
-            raise ValueError("nothing to run: give sample caps or anytime budgets")
+            raise ValueError("nothing to run: sample_caps and anytime_budgets are both empty")
         for field_name, names in (("iteration_planners", self.iteration_planners),
                                   ("anytime_planners", self.anytime_planners)):
             for n in names:

@@ -24,6 +24,7 @@ from dataclasses import dataclass
 
 from ompl import base as ob
 from ompl import geometric as og
+from ompl import util as ou
 
 from ..planning.paths import path_to_array
 from .config import KNOWN_PLANNERS
@@ -104,10 +105,14 @@ def planner_settings(p) -> dict[str, str]:
     """A planner's settings as text: its ``settings()`` (Python planners) or parsed ``printSettings()``."""
     if hasattr(p, "settings"):
         return {str(k): str(v) for k, v in p.settings().items()}
+    level = ou.getLogLevel()
+    ou.setLogLevel(ou.LOG_ERROR)  # printSettings reads BIT*'s deprecated options, each getter warns; errors still show
     try:
         return _parse_settings(p.printSettings())
     except Exception:  # noqa: BLE001 (bindings differ per planner)
         return {}
+    finally:
+        ou.setLogLevel(level)
 
 
 class RecordingPlanner(ob.Planner):

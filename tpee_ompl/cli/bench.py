@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import logging
+import re
 import sys
 from collections.abc import Sequence
 from pathlib import Path
@@ -62,7 +63,9 @@ def _user_message(exc: BaseException) -> str:
     msg = " ".join(str(exc).split())
     for field_name, option in _OPTION_OF.items():
         if msg.startswith(field_name + " ") or msg.startswith(field_name + ":"):
-            return option + msg[len(field_name):]
+            msg = option + msg[len(field_name):]
+        elif "_" in field_name:
+            msg = re.sub(rf"\b{field_name}\b", option, msg)
     return msg
 
 
@@ -102,6 +105,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     g.add_argument("--scheduler", metavar="tcp://HOST:PORT", default=None, help="same as --dask tcp://HOST:PORT")
     g.add_argument("--dask-workers", type=positive_int, default=2, help="workers of --dask local (default: %(default)s)")
     g.add_argument("--retries", type=_count, default=2, help="Dask retries of a task that raises (default: %(default)s)")
+    p.set_defaults(bench_prog=p.prog)
     p.add_argument("--resume", metavar="DIR", default=None,
                    help="finish an interrupted campaign in DIR: run only its missing experiments (configuration "
                         "from DIR/campaign.json; the other campaign options are ignored)")
@@ -158,6 +162,7 @@ def run(args: argparse.Namespace) -> int:
     from ..bench.executors import make_executor
 
     logging.basicConfig(level=logging.INFO, format="%(message)s")
+    prog = getattr(args, "bench_prog", "bench")
     try:
         if args.resume:
             load_campaign(args.resume)
@@ -168,7 +173,7 @@ def run(args: argparse.Namespace) -> int:
         executor = make_executor(args.workers, dask=args.scheduler or args.dask, dask_workers=args.dask_workers,
                                  retries=args.retries)
     except (ValueError, FileNotFoundError, ImportError) as exc:
-        print(f"bench: error: {_user_message(exc)}", file=sys.stderr)
+        print(f"{prog}: error: {_user_message(exc)}", file=sys.stderr)
         return 2
     try:
         if args.resume:
@@ -177,10 +182,10 @@ def run(args: argparse.Namespace) -> int:
         else:
             result = run_campaign(config, executor=executor, progress_bar=not args.no_progress, plan=plan)
     except KeyboardInterrupt:  # a second Ctrl-C while the database was built
-        print("bench: interrupted; finished logs are kept: finish the campaign with --resume DIR", file=sys.stderr)
+        print(f"{prog}: interrupted; finished logs are kept: finish the campaign with --resume DIR", file=sys.stderr)
         return 130
     except Exception as exc:  # noqa: BLE001 (a runtime failure: one line, no traceback)
-        print(f"bench: error: {type(exc).__name__}: {_user_message(exc)}", file=sys.stderr)
+        print(f"{prog}: error: {type(exc).__name__}: {_user_message(exc)}", file=sys.stderr)
         return 1
     _print_result(result)
     if result.interrupted:
@@ -191,7 +196,7 @@ def run(args: argparse.Namespace) -> int:
         lost = "; ".join(f"query {f['query_id']} ({f['reason']}, {len(f['missing_logs'])} experiment(s))"
                          for f in result.failed_tasks)
         bad = ", ".join(p.name for p in result.skipped_logs)
-        print(f"bench: error: campaign finished incomplete: {len(result.failed_tasks)} query(ies) lost"
+        print(f"{prog}: error: campaign finished incomplete: {len(result.failed_tasks)} query(ies) lost"
               + (f": {lost}" if lost else "") + (f"; unreadable logs: {bad}" if bad else "")
               + f"; run them again with --resume {result.directory}", file=sys.stderr)
         return 1
