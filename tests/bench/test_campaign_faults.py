@@ -16,6 +16,7 @@ from ompl import base as ob
 from ompl import util as ou
 
 from tpee_ompl.bench.campaign import resume_campaign, run_campaign
+from tpee_ompl.bench.database import build_database
 from tpee_ompl.cli.bench import main
 
 TESTS = Path(__file__).resolve().parents[1]
@@ -65,22 +66,51 @@ def test_benchmark_aborted_by_a_python_callback_records_failed_runs_and_restores
     assert all("motion validator exploded" in next(iter(t["errors"].values())) for t in tasks)
 
 
-def test_corrupt_log_is_reported_by_name_and_skipped(query_file, tmp_path, caplog):
+def _experiment_names(db: Path) -> list[str]:
+    con = sqlite3.connect(db)
+    try:
+        return [r[0] for r in con.execute("SELECT name FROM experiments")]
+    finally:
+        con.close()
+
+
+def test_resume_moves_truncated_and_corrupt_logs_aside_and_runs_their_experiments_again(query_file, tmp_path, caplog):
+    cfg = tiny_config(query_file, tmp_path, sample_caps=(20, 40), anytime_budgets=(), max_queries=2)
+    res = run_campaign(cfg, report=False, progress_bar=False)
+    assert len(res.logs) == 4
+    truncated, corrupt = res.logs[0], res.logs[3]
+    cut = truncated.read_text()[: len(truncated.read_text()) // 3]
+    truncated.write_text(cut)
+    garbled = corrupt.read_text().replace("\n2 planners\n", "\ntwo planners\n")
+    assert garbled != corrupt.read_text()
+    corrupt.write_text(garbled)
+    (res.directory / "logs" / "q009_garbage.log").write_text("not an OMPL log\n")  # no experiment of the campaign
+
+    again = resume_campaign(res.directory, report=True, progress_bar=False)
+
+    broken = res.directory / "logs" / "broken"
+    assert sorted(p.name for p in again.broken_logs) == sorted([truncated.name, corrupt.name, "q009_garbage.log"])
+    assert (broken / truncated.name).read_text() == cut and (broken / corrupt.name).read_text() == garbled  # kept
+    assert truncated.name in caplog.text and corrupt.name in caplog.text
+    assert again.skipped_logs == [] and not again.failed_tasks
+    assert sorted(p.name for p in again.logs) == sorted(p.name for p in res.logs)  # both re-ran, nothing else
+    names = _experiment_names(again.database)
+    assert len(names) == len(set(names)) == 4  # every experiment exactly once
+    tasks = [json.loads(line) for line in (res.directory / "tasks.jsonl").read_text().splitlines()]
+    assert sorted(n for t in tasks[2:] for n in t["logs"]) == sorted([truncated.name, corrupt.name])
+    meta = json.loads((res.directory / "campaign.json").read_text())
+    assert sorted(b["log"] for b in meta["broken_logs"]) == sorted([truncated.name, corrupt.name, "q009_garbage.log"])
+    assert meta["interrupted"] is False and meta["finished_experiments"] == 4
+
+
+def test_database_build_skips_a_corrupt_log_by_name(query_file, tmp_path, caplog):
     cfg = tiny_config(query_file, tmp_path, sample_caps=(20, 40), anytime_budgets=(), max_queries=1)
     res = run_campaign(cfg, report=False, progress_bar=False)
     bad = res.logs[0]
-    text = bad.read_text()
-    bad.write_text(text[: len(text) // 3])
-    (res.directory / "logs" / "q009_garbage.log").write_text("not an OMPL log\n")
-    again = resume_campaign(res.directory, report=True, progress_bar=False)
-    assert sorted(p.name for p in again.skipped_logs) == sorted([bad.name, "q009_garbage.log"])
-    assert bad.name in caplog.text
-    con = sqlite3.connect(again.database)
-    assert con.execute("SELECT COUNT(*) FROM experiments").fetchone()[0] == 1
-    con.close()
-    meta = json.loads((res.directory / "campaign.json").read_text())
-    assert bad.name in meta["corrupt_logs"]
-    assert bad.read_text() == text[: len(text) // 3]  # reported, not deleted or rewritten
+    bad.write_text(bad.read_text()[:200])
+    db, skipped = build_database(res.logs, tmp_path / "again.db")
+    assert skipped == [bad] and bad.name in caplog.text
+    assert len(_experiment_names(db)) == 1
 
 
 def _launch(query_file: Path, out: Path) -> subprocess.Popen:
@@ -131,7 +161,7 @@ def test_signal_keeps_finished_runs_never_half_writes_the_db_and_resume_complete
         con.close()
     else:
         assert not db.exists()
-    assert main(["--resume", str(directory), "--workers", "0", "--no-progress"]) == 0
+    assert main(["--resume", str(directory), "--workers", "1", "--no-progress"]) == 0
     logs = {p.name: p.read_bytes() for p in (directory / "logs").glob("*.log")}
     assert len(logs) == meta["expected_experiments"]
     assert all(logs[name] == data for name, data in kept.items())  # finished logs untouched

@@ -22,20 +22,20 @@ def test_command_line_defaults_are_the_config_defaults():
 
 def test_options_reach_the_config():
     args = build_parser().parse_args(["--queries", "some/set.json", "--samples", "10", "20", "--anytime",
-                                      "--checkers", "discrete", "--alt-checker-samples", "10", "--workers", "0",
+                                      "--checkers", "discrete", "--alt-checker-samples", "10", "--workers", "3",
                                       "--seed", "9", "--planners", "RRTstar", "RRTConnect"])
     cfg = config_from_args(args)
     assert cfg.name == "set" and cfg.sample_caps == (10, 20) and cfg.anytime_budgets == ()
     assert cfg.checkers == ("discrete",) and cfg.alt_checker_caps == (10,)
-    assert cfg.workers == 0 and cfg.seed == 9 and cfg.iteration_planners == ("RRTstar", "RRTConnect")
+    assert cfg.workers == 3 and cfg.seed == 9 and cfg.iteration_planners == ("RRTstar", "RRTConnect")
 
 
 def test_register_adds_the_bench_subcommand_with_an_example(capsys):
     parser = argparse.ArgumentParser(prog="tpee-ompl")
     sub = parser.add_subparsers(dest="command", required=True)
     register(sub, argparse.RawDescriptionHelpFormatter)
-    args = parser.parse_args(["bench", "--samples", "30", "--workers", "0"])
-    assert args.func is run and args.samples == [30] and args.workers == 0
+    args = parser.parse_args(["bench", "--samples", "30", "--workers", "1"])
+    assert args.func is run and args.samples == [30] and args.workers == 1
     with pytest.raises(SystemExit) as exc:
         parser.parse_args(["bench", "--help"])
     assert exc.value.code == 0
@@ -56,5 +56,5 @@ def test_missing_dask_gives_a_clear_error(monkeypatch, capsys, tmp_path):
 
 
 def test_resume_of_a_folder_without_campaign_is_a_clear_error(capsys, tmp_path):
-    assert main(["--resume", str(tmp_path), "--workers", "0", "--no-progress"]) == 2
+    assert main(["--resume", str(tmp_path), "--workers", "1", "--no-progress"]) == 2
     assert "campaign.json" in capsys.readouterr().err

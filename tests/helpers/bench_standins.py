@@ -193,3 +193,27 @@ def tiny_config(query_file: Path, out: Path, **kw) -> CampaignConfig:
                 workers=0, seed=3, out=str(out))
     base.update(kw)
     return CampaignConfig(**base)
+
+
+SELF_KILL_ENV = "TPEE_TEST_SELF_KILL"
+"""Environment variable of :func:`make_self_killer`: JSON ``{"dir", "query_id", "cap", "times"}``."""
+
+
+def make_self_killer(si, ctx: PlannerContext):
+    """SIGKILL this worker process (like a segfault or the OOM killer) in one experiment; else a stand-in.
+
+    The experiment is query ``query_id`` at cap ``cap``; the process dies the first ``times`` times
+    it gets there, counted by one file ``killed-<pid>`` per death in ``dir``.
+    """
+    spec = json.loads(os.environ[SELF_KILL_ENV])
+    folder = Path(spec["dir"])
+    if ctx.query["id"] == spec["query_id"] and ctx.max_samples == spec["cap"]:
+        if len(list(folder.glob("killed-*"))) < int(spec["times"]):
+            (folder / f"killed-{os.getpid()}").write_text(str(ctx.max_samples))
+            os.kill(os.getpid(), signal.SIGKILL)
+    return StandInPlanner(si, max_samples=ctx.max_samples, seed=ctx.seed)
+
+
+def make_broken_factory(si, ctx: PlannerContext):
+    """A planner factory that raises (its query's task fails in the worker: a runtime failure, not bad input)."""
+    raise RuntimeError("this planner factory always fails")

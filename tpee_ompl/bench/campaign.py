@@ -33,26 +33,28 @@ from collections.abc import Callable
 from pathlib import Path
 
 from .config import CampaignConfig, CampaignResult
-from .database import build_database
+from .database import build_database, set_aside_broken_logs
 from .experiment import experiment_specs, log_name, run_query_task
-from .results import make_results_dir, package_versions, utc_now, write_json, write_new_file
+from .results import append_json_line, make_results_dir, package_versions, utc_now, write_json, write_new_file
 
-__all__ = ["query_rows", "resume_campaign", "run_campaign", "stratified_subset"]
+__all__ = ["CampaignPlan", "load_campaign", "prepare_campaign", "query_rows", "resume_campaign", "run_campaign",
+           "stratified_subset"]
 
 log = logging.getLogger(__name__)
 
 
 # --------------------------------------------------------------------------- queries
-def query_rows(name_or_path: str) -> tuple[str, list[dict]]:
+def query_rows(name_or_path: str, robot=None) -> tuple[str, list[dict]]:
     """The query set's name and its queries as plain (picklable, JSON-able) dicts.
 
     Each row: ``id``, ``from_sector``, ``to_sector``, ``start``, ``goal`` (lists of floats).  The set
-    is read by :func:`tpee_ompl.model.queries.load_query_set` (a packaged name or a JSON file); its
-    name is the file's ``name`` field, else the file's stem.
+    is read by :func:`tpee_ompl.model.queries.load_query_set` (a packaged name or a JSON file; with
+    ``robot``, a set made for another model is refused); its name is the file's ``name`` field,
+    else the file's stem.
     """
     from ..model.queries import load_query_set
 
-    queries, header = load_query_set(name_or_path)
+    queries, header = load_query_set(name_or_path, robot)
     rows = [
         {
             "id": q.id,
@@ -63,7 +65,8 @@ def query_rows(name_or_path: str) -> tuple[str, list[dict]]:
         }
         for q in queries
     ]
-    return header.get("name", Path(name_or_path).stem), rows
+    name = header.get("name")
+    return name if isinstance(name, str) and name else Path(name_or_path).stem, rows
 
 
 def stratified_subset(queries: list[dict], k: int | None) -> list[dict]:
@@ -72,6 +75,9 @@ def stratified_subset(queries: list[dict], k: int | None) -> list[dict]:
     The first k of a set ordered pair by pair would cover only a few pairs; round-robin keeps every
     pair represented (24 of the 120 planning-necessary queries = 2 per ordered pair).
     """
+    from ..validation import check_int
+
+    k = check_int("max_queries", k, minimum=1, optional=True)
     groups: dict[tuple[int, int], list[dict]] = {}
     for q in queries:
         groups.setdefault((q["from_sector"], q["to_sector"]), []).append(q)
@@ -102,6 +108,60 @@ def _sigterm_as_keyboard_interrupt():
         signal.signal(signal.SIGTERM, previous)
 
 
+@dataclasses.dataclass(frozen=True)
+class CampaignPlan:
+    """A checked campaign, ready to run: the query set's name and the queries it will use."""
+
+    config: CampaignConfig
+    query_set: str
+    queries: list[dict]
+
+
+def prepare_campaign(config: CampaignConfig) -> CampaignPlan:
+    """Check everything a campaign needs before anything is created; raise ValueError/FileNotFoundError if not.
+
+    The query set loads and was made for this model (``model_hash``), every planner factory
+    imports, query k's seed ``seed + k`` stays in OMPL's range, and ``out`` can hold a new folder.
+    """
+    from ..model.wearer_arm import default_robot
+    from ..validation import MAX_SEED
+    from .planners import planner_factory
+
+    _check_out_folder(config.out)
+    for field_name in ("iteration_planners", "anytime_planners"):
+        for name in getattr(config, field_name):
+            try:
+                planner_factory(name)
+            except ValueError as exc:
+                raise ValueError(f"{field_name}: {exc}") from None
+    try:
+        set_name, queries = query_rows(config.queries, default_robot())
+    except (OSError, ValueError) as exc:  # missing, unreadable, not a query set, made for another model
+        msg = str(exc).removeprefix(f"{config.queries}: ")
+        raise ValueError(f"queries {config.queries}: {msg}") from None
+    queries = stratified_subset(queries, config.max_queries)
+    if not queries:
+        raise ValueError(f"query set {config.queries!r} has no queries")
+    if config.seed + len(queries) - 1 > MAX_SEED:
+        raise ValueError(f"seed {config.seed}: query k uses seed + k, which must stay <= {MAX_SEED} "
+                         f"for {len(queries)} queries")
+    return CampaignPlan(config, set_name, queries)
+
+
+def _check_out_folder(out: str) -> None:
+    """``out`` is (or can become) a writable folder; nothing is created."""
+    p = Path(out)
+    if p.exists() and not p.is_dir():
+        raise ValueError(f"out {out}: is a file, not a folder")
+    for parent in (p, *p.parents):
+        if parent.exists():
+            if not parent.is_dir():
+                raise ValueError(f"out {out}: {parent} is a file, not a folder")
+            if not os.access(parent, os.W_OK | os.X_OK):
+                raise ValueError(f"out {out}: folder {parent} is not writable")
+            return
+
+
 def run_campaign(
     config: CampaignConfig,
     *,
@@ -109,30 +169,33 @@ def run_campaign(
     report: bool = True,
     progress_bar: bool = True,
     executor=None,
+    plan: CampaignPlan | None = None,
 ) -> CampaignResult:
     """Run a campaign into a new timestamped folder, build the DB, the report and the plots.
 
-    ``executor`` (:mod:`tpee_ompl.bench.executors`) runs the per-query tasks; default: a local spawn
-    pool of ``config.workers`` processes (0 = this process).  ``on_task_done`` is called in this
-    process with each finished query's log paths.  Ctrl-C or SIGTERM (or a KeyboardInterrupt from
-    ``on_task_done``) stops the campaign: finished logs are kept, the database is still built from
-    them, and :func:`resume_campaign` runs the rest later.
+    The campaign is checked first (:func:`prepare_campaign`, or the given ``plan``): a bad one
+    raises before anything is created.  ``executor`` (:mod:`tpee_ompl.bench.executors`) runs the
+    per-query tasks; default: a local pool of ``config.workers`` processes (0 = this process).
+    ``on_task_done`` is called in this process with each finished query's log paths.  Ctrl-C or
+    SIGTERM (or a KeyboardInterrupt from ``on_task_done``) stops the campaign: finished logs are
+    kept, the database is still built from them, and :func:`resume_campaign` runs the rest later.
+    A query whose worker died twice is listed in ``CampaignResult.failed_tasks``.
     """
+    plan = plan if plan is not None else prepare_campaign(config)
+    if plan.config != config:
+        raise ValueError("plan was prepared for another configuration")
     with _sigterm_as_keyboard_interrupt():
-        return _run_campaign(config, on_task_done, report, progress_bar, executor)
+        return _run_campaign(plan, on_task_done, report, progress_bar, executor)
 
 
-def _run_campaign(config: CampaignConfig, on_task_done, report: bool, progress_bar: bool, executor) -> CampaignResult:
-    set_name, queries = query_rows(config.queries)
-    queries = stratified_subset(queries, config.max_queries)
-    if not queries:
-        raise ValueError(f"query set {config.queries!r} has no queries")
+def _run_campaign(plan: CampaignPlan, on_task_done, report: bool, progress_bar: bool, executor) -> CampaignResult:
+    config, queries = plan.config, plan.queries
     directory = make_results_dir(config.out, config.name)
     (directory / "logs").mkdir()
     cfg = dataclasses.asdict(config)
     meta = {
         "config": cfg,
-        "query_set": set_name,
+        "query_set": plan.query_set,
         "queries": [q["id"] for q in queries],
         "query_data": queries,
         "expected_experiments": sum(len(experiment_specs(cfg, k)) for k in range(len(queries))),
@@ -149,6 +212,29 @@ def _run_campaign(config: CampaignConfig, on_task_done, report: bool, progress_b
     return _execute(directory, meta, executor, on_task_done, report, progress_bar)
 
 
+def load_campaign(directory: str | os.PathLike) -> dict:
+    """The ``campaign.json`` of a campaign folder, checked for resuming; ValueError naming what is wrong."""
+    directory = Path(directory)
+    if not directory.is_dir():
+        raise ValueError(f"resume {directory}: not a folder")
+    path = directory / "campaign.json"
+    if not path.is_file():
+        raise ValueError(f"resume {directory}: not a campaign folder (no campaign.json there)")
+    try:
+        meta = json.loads(path.read_text())
+    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise ValueError(f"resume {directory}: campaign.json is not JSON ({exc})") from None
+    if not isinstance(meta, dict) or not all(k in meta for k in ("config", "query_set", "expected_experiments")):
+        raise ValueError(f"resume {directory}: campaign.json is not a campaign's (no config/query_set)")
+    if "query_data" not in meta:
+        raise ValueError(f"resume {directory}: written by an older version (no query_data): cannot resume")
+    try:
+        CampaignConfig(**{k: tuple(v) if isinstance(v, list) else v for k, v in meta["config"].items()})
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"resume {directory}: campaign.json has a bad config ({exc})") from None
+    return meta
+
+
 def resume_campaign(
     directory: str | os.PathLike,
     *,
@@ -160,27 +246,58 @@ def resume_campaign(
 ) -> CampaignResult:
     """Run only the experiments of an interrupted campaign that have no log yet, into its folder.
 
-    Finished logs are never touched; the database and report are rebuilt from all logs.  The
+    Finished logs are kept; a log that OMPL's reader cannot read (truncated, corrupt) is moved to
+    ``logs/broken/`` and its experiment runs again.  The database and report are rebuilt from all logs.  The
     configuration and queries come from the folder's ``campaign.json``; ``workers`` overrides the
     pool size.  A query resumed part-way runs its missing experiments in a fresh process seeded
     as before, so they are valid runs but (OMPL's RNG stream being shared by the experiments of a
     query) not bit-identical to an uninterrupted campaign.
     """
     directory = Path(directory)
-    meta = json.loads((directory / "campaign.json").read_text())
-    if "query_data" not in meta:
-        raise ValueError(f"{directory} was written by an older version (no query_data): cannot resume")
+    meta = load_campaign(directory)
     if workers is not None:
-        meta["config"]["workers"] = int(workers)
+        from ..validation import check_int
+
+        meta["config"]["workers"] = check_int("workers", workers, minimum=0)
     meta.setdefault("resumed_utc", []).append(utc_now())
     (directory / "logs").mkdir(exist_ok=True)
     return _execute(directory, meta, executor, on_task_done, report, progress_bar)
+
+
+def task_time_limit(cfg: dict, specs: list[dict]) -> float:
+    """A query task's safety time limit (s): twice the sum of its runs' time limits, plus 300 s.
+
+    Only a hung worker reaches it (each run is stopped by OMPL at its own limit); the executor then
+    kills the worker and treats the task as lost.
+    """
+    total = 0.0
+    for s in specs:
+        planners = cfg["iteration_planners"] if s["comparison"] == "iterations" else cfg["anytime_planners"]
+        limit = float(cfg["max_time"]) if s["cap"] is not None else float(s["budget"])
+        total += len(planners) * int(cfg["runs"]) * limit
+    return 2.0 * total + 300.0
+
+
+def _tasks(meta: dict, log_dir: Path, done_names: set[str], n_threads, shared_fs: bool) -> list[dict]:
+    """One task per query that still has experiments without a log."""
+    cfg = meta["config"]
+    tasks = []
+    for k, q in enumerate(meta["query_data"]):
+        specs = [s for s in experiment_specs(cfg, k) if log_name(q, k, s) not in done_names]
+        if specs:
+            tasks.append({"config": cfg, "query": q, "qpos": k, "query_set": meta["query_set"],
+                          "seed": cfg["seed"] + k, "specs": specs, "n_threads": n_threads,
+                          "log_dir": str(log_dir) if shared_fs else None, "time_limit_s": task_time_limit(cfg, specs),
+                          "sys_path": [p for p in sys.path if p]})
+    return tasks
 
 
 def _execute(directory: Path, meta: dict, executor, on_task_done, report: bool, progress_bar: bool) -> CampaignResult:
     cfg = meta["config"]
     log_dir = directory / "logs"
     interrupted = False
+    failed: list[dict] = []
+    broken: list[tuple[Path, str]] = []
     t0 = time.perf_counter()
     with _sigterm_as_keyboard_interrupt():
         try:
@@ -190,19 +307,17 @@ def _execute(directory: Path, meta: dict, executor, on_task_done, report: bool, 
 
             for part in log_dir.glob("*.part"):  # left by a process killed while writing
                 part.unlink()
+            broken = set_aside_broken_logs(log_dir)
+            if broken:
+                meta.setdefault("broken_logs", []).extend(
+                    {"log": p.name, "moved_to": str(p.relative_to(directory)), "reason": r, "utc": utc_now()}
+                    for p, r in broken)
             done_names = {p.name for p in log_dir.glob("*.log")}
             executor = executor if executor is not None else make_executor(int(cfg["workers"]))
             in_process = not getattr(executor, "fresh_process_per_task", True)
             shared_fs = getattr(executor, "shares_filesystem", True)
             n_threads = None if in_process or int(cfg["workers"]) == 1 and shared_fs else 1
-            tasks = []
-            for k, q in enumerate(meta["query_data"]):
-                specs = [s for s in experiment_specs(cfg, k) if log_name(q, k, s) not in done_names]
-                if specs:
-                    tasks.append({"config": cfg, "query": q, "qpos": k, "query_set": meta["query_set"],
-                                  "seed": cfg["seed"] + k, "specs": specs, "n_threads": n_threads,
-                                  "log_dir": str(log_dir) if shared_fs else None,
-                                  "sys_path": [p for p in sys.path if p]})
+            tasks = _tasks(meta, log_dir, done_names, n_threads, shared_fs)
             fn = run_query_task if shared_fs else run_task_in_subprocess
             meta["executor"] = executor.description
             log.info("campaign %s: %d queries, %d experiments (%d to run) on %s", directory, len(meta["query_data"]),
@@ -210,6 +325,8 @@ def _execute(directory: Path, meta: dict, executor, on_task_done, report: bool, 
             with tqdm(total=len(tasks), desc=f"{cfg['name']} queries", unit="query", disable=not progress_bar) as bar:
                 for res in executor.run(fn, tasks):
                     written = _store_task_result(directory, res)
+                    if res.get("failed"):
+                        failed.append(_failure_entry(meta, log_dir, res))
                     bar.update(1)
                     if on_task_done:
                         on_task_done(written)
@@ -223,9 +340,13 @@ def _execute(directory: Path, meta: dict, executor, on_task_done, report: bool, 
         for part in log_dir.glob("*.part"):
             part.unlink()
         logs = sorted(log_dir.glob("*.log"))
-        meta.update({"finished_utc": utc_now(), "interrupted": interrupted,
+        lost_attempts = list(getattr(executor, "lost", []) or [])
+        if lost_attempts:
+            meta.setdefault("lost_attempts", []).extend({**a, "utc": utc_now()} for a in lost_attempts)
+        meta.update({"finished_utc": utc_now(), "interrupted": interrupted, "failed_tasks": failed,
                      "finished_experiments": len(logs), "wall_time_s": time.perf_counter() - t0})
-        result = CampaignResult(directory=directory, logs=logs, database=None, interrupted=interrupted)
+        result = CampaignResult(directory=directory, logs=logs, database=None, interrupted=interrupted,
+                                failed_tasks=failed, broken_logs=[p for p, _ in broken])
         if logs:
             result.database, result.skipped_logs = build_database(logs, directory / "benchmark.db")
             meta["corrupt_logs"] = [p.name for p in result.skipped_logs]
@@ -239,8 +360,19 @@ def _execute(directory: Path, meta: dict, executor, on_task_done, report: bool, 
     return result
 
 
+def _failure_entry(meta: dict, log_dir: Path, res: dict) -> dict:
+    """``campaign.json``'s record of a query the executor could not finish: reason and the logs it lacks."""
+    k = int(res["qpos"])
+    q = meta["query_data"][k]
+    missing = [n for n in (log_name(q, k, s) for s in experiment_specs(meta["config"], k)) if not (log_dir / n).is_file()]
+    log.info("query %s (position %d) lost after %d attempts (%s): %d experiment(s) have no log",
+              q["id"], k, res.get("attempts", 1), res["failed"], len(missing))
+    return {"qpos": k, "query_id": q["id"], "reason": res["failed"], "attempts": res.get("attempts", 1),
+            "missing_logs": missing, "utc": utc_now()}
+
+
 def _store_task_result(directory: Path, res: dict) -> list[str]:
-    """Write a task's logs into the campaign folder (never over a different existing log)."""
+    """Write a task's logs into the campaign folder (never over a different existing log); add its ``tasks.jsonl`` line."""
     log_dir = directory / "logs"
     written = []
     for fname, text in res["logs"].items():
@@ -249,9 +381,8 @@ def _store_task_result(directory: Path, res: dict) -> list[str]:
             log.warning("%s exists with other content: kept the existing log", target.name)
         written.append(str(target))
     line = {k: res.get(k) for k in ("qpos", "query_id", "pid", "host", "elapsed", "errors")}
+    if res.get("failed"):
+        line.update(failed=res["failed"], attempts=res.get("attempts"))
     line["logs"] = sorted(res["logs"])
-    with open(directory / "tasks.jsonl", "a") as f:
-        f.write(json.dumps(line) + "\n")
+    append_json_line(directory / "tasks.jsonl", line)
     return written
-
-

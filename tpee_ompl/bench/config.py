@@ -7,7 +7,6 @@ The command line takes its defaults from :class:`CampaignConfig`'s fields (one s
 
 from __future__ import annotations
 
-import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -19,7 +18,9 @@ __all__ = [
     "CampaignConfig",
     "CampaignResult",
     "ITERATION_PLANNERS",
+    "KNOWN_PLANNERS",
     "PROGRESS_PROPERTIES",
+    "check_planner_name",
     "default_workers",
 ]
 
@@ -37,10 +38,27 @@ CLI_PLANNER_NAMES: dict[str, str] = {
 The planners of :data:`ANYTIME_PLANNERS`, in the same order."""
 ANYTIME_PLANNERS: tuple[str, ...] = tuple(CLI_PLANNER_NAMES.values())
 """Planners of the time-matched comparison (every planner the command line knows)."""
+KNOWN_PLANNERS: tuple[str, ...] = (*ANYTIME_PLANNERS, "RRT", "PRMstar")
+"""Every built-in planner name (:data:`tpee_ompl.bench.planners.PLANNER_FACTORIES`); ``module:function`` names a factory elsewhere."""
 CHECKERS = ("batched", "discrete")
 """Motion validators: one batched Pinocchio call per motion, or OMPL's DiscreteMotionValidator."""
 PROGRESS_PROPERTIES = ["best cost REAL", "iterations INTEGER", "time REAL"]  # sorted, as OMPL's map
 """Columns of the ``progress`` table (name and SQL type, as OMPL's log writes them)."""
+
+
+def check_planner_name(name: object, what: str = "planner") -> str:
+    """``name`` if it is a built-in planner (:data:`KNOWN_PLANNERS`) or a ``module:function`` factory name.
+
+    Whether ``module:function`` imports is checked before a campaign starts
+    (:func:`tpee_ompl.bench.campaign.prepare_campaign`).
+    """
+    if isinstance(name, str) and name in KNOWN_PLANNERS:
+        return name
+    if isinstance(name, str) and ":" in name:
+        mod, _, attr = name.partition(":")
+        if mod and attr.isidentifier() and all(part.isidentifier() for part in mod.split(".")):
+            return name
+    raise ValueError(f"unknown {what} {name!r}: choose from {', '.join(KNOWN_PLANNERS)} or give module:function")
 
 
 def default_workers() -> int:
@@ -83,19 +101,43 @@ class CampaignConfig:
     """OMPL's default; ``solution_length`` stays the raw length either way."""
 
     def __post_init__(self) -> None:
-        if not self.sample_caps and not self.anytime_budgets:
-            raise ValueError("nothing to run: give sample caps or anytime budgets")
-        if any(int(n) < 1 for n in self.sample_caps):
-            raise ValueError(f"sample caps must be >= 1, got {self.sample_caps}")
-        if any(not (b > 0 and math.isfinite(b)) for b in self.anytime_budgets):
-            raise ValueError(f"anytime budgets must be finite and > 0, got {self.anytime_budgets}")
+        from ..validation import check_bool, check_int, check_name, check_number, check_seed
+
+        check_name("name", self.name)
+        check_name("queries", self.queries)
+        check_name("out", self.out)
+        caps = tuple(check_int("sample_caps", n, minimum=1) for n in self.sample_caps)
+        budgets = tuple(check_number("anytime_budgets", b, low=0, low_open=True) for b in self.anytime_budgets)
+        if not caps and not budgets:
+            raise ValueError("nothing to run: sample_caps and anytime_budgets are both empty")
+        for field_name, names in (("iteration_planners", self.iteration_planners),
+                                  ("anytime_planners", self.anytime_planners)):
+            for n in names:
+                check_planner_name(n, f"{field_name} entry")
+            if len(set(names)) != len(names):
+                raise ValueError(f"{field_name} names a planner twice: {list(names)}")
+        if caps and not self.iteration_planners:
+            raise ValueError("iteration_planners: give at least one planner for the sample caps")
+        if budgets and not self.anytime_planners:
+            raise ValueError("anytime_planners: give at least one planner for the anytime budgets")
         for c in self.checkers:
             if c not in CHECKERS:
                 raise ValueError(f"unknown motion validator {c!r}: choose from {CHECKERS}")
-        if self.sample_caps and not self.checkers:
+        if caps and not self.checkers:
             raise ValueError("give at least one motion validator")
-        if self.workers < 0 or self.runs < 1:
-            raise ValueError("workers must be >= 0 and runs >= 1")
+        check_int("alt_checker_queries", self.alt_checker_queries, minimum=0, optional=True)
+        if self.alt_checker_caps is not None:
+            if not self.alt_checker_caps:
+                raise ValueError("alt_checker_caps must be None or at least one cap")
+            for n in self.alt_checker_caps:
+                check_int("alt_checker_caps", n, minimum=1)
+        check_int("anytime_queries", self.anytime_queries, minimum=0, optional=True)
+        check_int("max_queries", self.max_queries, minimum=1, optional=True)
+        check_int("runs", self.runs, minimum=1)
+        check_int("workers", self.workers, minimum=0)
+        check_seed("seed", self.seed)
+        check_number("max_time", self.max_time, low=0, low_open=True)
+        check_bool("simplify", self.simplify)
 
 
 @dataclass
@@ -109,4 +151,8 @@ class CampaignResult:
     report: dict = field(default_factory=dict)
     skipped_logs: list[Path] = field(default_factory=list)
     """Corrupt logs left out of the database (reported by name)."""
+    failed_tasks: list[dict] = field(default_factory=list)
+    """Queries whose worker died twice (or raised): ``qpos``, ``query_id``, ``reason``, ``attempts``, ``missing_logs``."""
+    broken_logs: list[Path] = field(default_factory=list)
+    """Logs found unreadable at resume, moved to ``logs/broken/`` and run again."""
     plots: list[Path] = field(default_factory=list)

@@ -30,7 +30,8 @@ from .config import PROGRESS_PROPERTIES
 from .planners import planner_settings
 from .results import format_value
 
-__all__ = ["build_database", "failed_run_properties", "pad_aborted_runs", "patch_recorded_data"]
+__all__ = ["build_database", "check_log", "failed_run_properties", "pad_aborted_runs", "patch_recorded_data",
+           "set_aside_broken_logs"]
 
 log = logging.getLogger(__name__)
 
@@ -97,38 +98,67 @@ def _dedupe_times(progress: Sequence[tuple[float, float, int]]) -> list[tuple[fl
     return sorted(out.values())
 
 
+def check_log(path: os.PathLike) -> str | None:
+    """Why the OMPL ``.log`` at ``path`` is unreadable (truncated, corrupt), or None when OMPL's reader takes it.
+
+    The log is parsed with ``ompl.tools.readBenchmarkLog`` into an in-memory database, the way
+    :func:`build_database` reads it.
+    """
+    try:
+        with contextlib.redirect_stdout(io.StringIO()), _eof_guard(ot.readBenchmarkLog):  # it prints per planner
+            if not Path(path).read_text().rstrip().endswith("\n."):  # every planner block ends with "."
+                raise ValueError("truncated (no final '.')")
+            ot.readBenchmarkLog(":memory:", [str(path)], False)
+    except Exception as exc:  # noqa: BLE001 (any parse error: the file is corrupt)
+        return f"{type(exc).__name__}: {exc}"
+    return None
+
+
+def set_aside_broken_logs(log_dir: os.PathLike) -> list[tuple[Path, str]]:
+    """Move every unreadable ``*.log`` of ``log_dir`` to ``log_dir/broken/`` (never deleted); return (new path, reason)."""
+    log_dir = Path(log_dir)
+    moved = []
+    for p in sorted(log_dir.glob("*.log")):
+        reason = check_log(p)
+        if reason is None:
+            continue
+        broken = log_dir / "broken"
+        broken.mkdir(exist_ok=True)
+        target = broken / p.name
+        k = 1
+        while target.exists():
+            target, k = broken / f"{p.stem}.{k}{p.suffix}", k + 1
+        os.replace(p, target)
+        log.warning("log %s is unreadable (%s): moved aside to %s", p.name, reason, target)
+        moved.append((target, reason))
+    return moved
+
+
 def build_database(logs: Sequence[os.PathLike], db_path: os.PathLike) -> tuple[Path | None, list[Path]]:
     """Build a Planner Arena SQLite database from OMPL ``.log`` files (ompl_benchmark_statistics).
 
-    Each log is first parsed on its own (into an in-memory database); a log that fails is reported
-    by name and skipped.  The database is written to ``<db>.part`` and renamed over ``db_path``
-    only when complete, so an interruption never leaves a half-written database.  Returns the
-    database (None when no log was readable) and the skipped logs.
+    Each log is first checked on its own (:func:`check_log`); a log that fails is reported by name
+    and skipped.  The database is written to a temporary file beside ``db_path`` and moved over it
+    only when complete (:func:`tpee_ompl.files.atomic_path`), so an interruption never leaves a
+    half-written database.  Returns the database (None when no log was readable) and the skipped logs.
     """
+    from ..files import atomic_path
+
     db_path = Path(db_path)
     good, bad = [], []
-    buf = io.StringIO()
-    with contextlib.redirect_stdout(buf), _eof_guard(ot.readBenchmarkLog):  # it prints a line per file and planner
-        for p in logs:
-            try:
-                if not Path(p).read_text().rstrip().endswith("\n."):  # every planner block ends with "."
-                    raise ValueError("truncated (no final '.')")
-                ot.readBenchmarkLog(":memory:", [str(p)], False)
-                good.append(Path(p))
-            except Exception as exc:  # noqa: BLE001 (any parse error: the file is corrupt)
-                log.error("skipping corrupt log %s: %r", Path(p).name, exc)
-                bad.append(Path(p))
+    for p in logs:
+        reason = check_log(p)
+        if reason is None:
+            good.append(Path(p))
+        else:
+            log.error("skipping corrupt log %s: %s", Path(p).name, reason)
+            bad.append(Path(p))
     if not good:
         return None, bad
-    tmp = db_path.with_name(db_path.name + ".part")
-    tmp.unlink(missing_ok=True)
-    try:
-        with contextlib.redirect_stdout(buf):
-            ot.readBenchmarkLog(str(tmp), [str(p) for p in good], False)
-            ot.computeViews(str(tmp), False)
-        os.replace(tmp, db_path)
-    finally:
-        tmp.unlink(missing_ok=True)
+    with atomic_path(db_path) as tmp, contextlib.redirect_stdout(io.StringIO()):
+        tmp.unlink()  # readBenchmarkLog creates the database itself
+        ot.readBenchmarkLog(str(tmp), [str(p) for p in good], False)
+        ot.computeViews(str(tmp), False)
     return db_path, bad
 
 

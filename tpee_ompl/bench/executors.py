@@ -5,14 +5,17 @@ in a **fresh process** so that ``ompl.util.RNG.setSeed`` (which works once per p
 task the same seed whichever machine runs it.  The executors differ only in who starts that process:
 
 * :class:`InProcessExecutor`: this process, one task after the other (tests; OMPL seeded once).
-* :class:`ProcessPoolExecutor`: ``multiprocessing`` spawn pool, ``maxtasksperchild=1`` (default).
+* :class:`ProcessPoolExecutor` (default): one fresh spawned process per task, ``workers`` at a time;
+  a task whose process dies (SIGKILL, segfault, OOM killer) or outlives its time limit is run
+  once more in a fresh process, then yielded as a failure (:func:`task_failure`): nothing hangs.
 * :class:`DaskExecutor`: one Dask task per query on a ``distributed`` cluster (an existing
   scheduler ``tcp://host:port`` or a :class:`distributed.LocalCluster`); each Dask task runs the
   query in a fresh Python subprocess (:func:`run_task_in_subprocess`) and returns its OMPL logs as
   text plus per-run extras, so workers need no shared filesystem.  A worker that dies mid-task has
   its task rescheduled by the scheduler; ``retries`` covers tasks that raise.
 
-Every executor yields each task's result (a plain dict) exactly once, in completion order.
+Every executor yields each task's result (a plain dict) exactly once, in completion order; a task
+it could not finish is yielded as :func:`task_failure` (a dict with ``failed``, the reason).
 """
 
 from __future__ import annotations
@@ -26,7 +29,11 @@ import signal
 import subprocess
 import sys
 import tempfile
+import time
+from collections import deque
 from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass
+from multiprocessing.connection import Connection, wait
 from pathlib import Path
 from typing import Protocol
 
@@ -38,6 +45,7 @@ __all__ = [
     "ProcessPoolExecutor",
     "make_executor",
     "run_task_in_subprocess",
+    "task_failure",
 ]
 
 log = logging.getLogger(__name__)
@@ -77,39 +85,144 @@ class InProcessExecutor:
         pass
 
 
-def _pool_init() -> None:
-    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C goes to the parent, which terminates us
+def _child_main(fn: TaskFn, task: dict, conn) -> None:
+    """A pool child: run ``fn(task)`` and send ``("ok", result)`` or ``("error", message)`` to the parent."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C goes to the parent, which ends us
+    _die_with_parent()
+    try:
+        msg = ("ok", fn(task))
+    except BaseException as exc:  # noqa: BLE001 (reported to the parent, which records the task as failed)
+        msg = ("error", f"{type(exc).__name__}: {exc}")
+    try:
+        conn.send(msg)
+    finally:
+        conn.close()
+
+
+def _death_reason(exitcode: int | None) -> str:
+    if exitcode is not None and exitcode < 0:
+        try:
+            return f"worker killed by {signal.Signals(-exitcode).name}"
+        except ValueError:
+            return f"worker killed by signal {-exitcode}"
+    return f"worker exited with status {exitcode} without a result"
+
+
+def task_failure(task: dict, reason: str, attempts: int) -> dict:
+    """What an executor yields for a task it could not finish: ``failed`` (the reason) and ``attempts``."""
+    query = task.get("query") or {}
+    return {"failed": reason, "attempts": int(attempts), "qpos": task.get("qpos"), "query_id": query.get("id"),
+            "logs": {}, "extras": {}, "errors": {}}
+
+
+@dataclass
+class _Running:
+    proc: mp.process.BaseProcess
+    conn: Connection
+    task: dict
+    attempt: int
+    deadline: float | None
+    message: tuple | None = None
 
 
 class ProcessPoolExecutor:
-    """A spawn pool with one fresh process per task (``maxtasksperchild=1``)."""
+    """One fresh spawned process per task, at most ``workers`` at a time, watched until it ends.
+
+    A task whose process dies without a result (SIGKILL, segfault, OOM killer) or outlives the
+    task's ``time_limit_s`` (then it is killed) is *lost*: it is run once more in a fresh process
+    (``lost_task_retries``), then yielded as a failure (:func:`task_failure`): the campaign lists it
+    with the reason and goes on.  A task that raises is a failure at once (it would raise again).
+    Every wait is bounded: the monitor wakes at least every ``poll`` seconds.
+    """
 
     fresh_process_per_task = True
     shares_filesystem = True
 
-    def __init__(self, workers: int) -> None:
-        if workers < 1:
-            raise ValueError(f"workers must be >= 1, got {workers}")
-        self.workers = int(workers)
+    def __init__(self, workers: int, lost_task_retries: int = 1, poll: float = 1.0) -> None:
+        from ..validation import check_int
+
+        self.workers = check_int("workers", workers, minimum=1)
+        self.lost_task_retries = check_int("lost_task_retries", lost_task_retries, minimum=0)
+        self.poll = float(poll)
         self.description = f"local process pool ({self.workers} workers)"
-        self._pool = None
+        self.lost: list[dict] = []
+        """One entry per lost attempt: ``qpos``, ``attempt``, ``reason``, ``pid``."""
+        self._running: list[_Running] = []
+
+    def _start(self, ctx, fn: TaskFn, task: dict, attempt: int) -> None:
+        recv, send = ctx.Pipe(duplex=False)
+        proc = ctx.Process(target=_child_main, args=(fn, task, send), daemon=True)
+        proc.start()
+        send.close()  # the child holds the only write end: EOF when it dies
+        limit = task.get("time_limit_s")
+        self._running.append(_Running(proc, recv, task, attempt,
+                                      None if limit is None else time.monotonic() + float(limit)))
 
     def run(self, fn: TaskFn, tasks: Sequence[dict]) -> Iterator[dict]:  # noqa: D102
         ctx = mp.get_context("spawn")
-        self._pool = ctx.Pool(processes=self.workers, maxtasksperchild=1, initializer=_pool_init)
-        yield from self._pool.imap_unordered(fn, tasks)
-        self._pool.close()
-        self._pool.join()
-        self._pool = None
+        queue = deque((t, 1) for t in tasks)
+        try:
+            while queue or self._running:
+                while queue and len(self._running) < self.workers:
+                    self._start(ctx, fn, *queue.popleft())
+                now = time.monotonic()
+                deadlines = [r.deadline - now for r in self._running if r.deadline is not None]
+                timeout = max(0.0, min([self.poll, *deadlines]))
+                wait([r.conn for r in self._running] + [r.proc.sentinel for r in self._running], timeout)
+                for r in list(self._running):
+                    out = self._check(r)
+                    if out is None:
+                        continue
+                    self._running.remove(r)
+                    if out.get("lost"):
+                        reason = out["lost"]
+                        self.lost.append({"qpos": r.task.get("qpos"), "attempt": r.attempt, "reason": reason,
+                                          "pid": r.proc.pid})
+                        if r.attempt <= self.lost_task_retries:
+                            log.warning("task %s lost (%s): running it again in a fresh process",
+                                        r.task.get("qpos"), reason)
+                            queue.appendleft((r.task, r.attempt + 1))
+                            continue
+                        log.error("task %s lost again (%s): recorded as failed", r.task.get("qpos"), reason)
+                        out = task_failure(r.task, reason, r.attempt)
+                    yield out
+        finally:
+            self.shutdown(cancel=True)
+
+    def _check(self, r: _Running) -> dict | None:
+        """The finished task's result, ``{"lost": reason}``, a failure, or None while it runs."""
+        if r.message is None and r.conn.poll():
+            try:
+                r.message = r.conn.recv()
+            except (EOFError, OSError):
+                r.message = ("lost", None)
+        if r.message is not None and r.message[0] != "lost":
+            r.proc.join(timeout=30)
+            if r.proc.is_alive():
+                r.proc.kill()
+                r.proc.join(timeout=5)
+            r.conn.close()
+            kind, value = r.message
+            return value if kind == "ok" else task_failure(r.task, value, r.attempt)
+        timed_out = r.deadline is not None and time.monotonic() > r.deadline
+        if r.proc.is_alive() and not timed_out and r.message is None:
+            return None
+        if r.proc.is_alive():
+            r.proc.kill()
+        r.proc.join(timeout=5)
+        r.conn.close()
+        reason = (f"no result within its time limit ({r.task.get('time_limit_s'):g} s): killed" if timed_out
+                  else _death_reason(r.proc.exitcode))
+        return {"lost": reason}
 
     def shutdown(self, cancel: bool = False) -> None:  # noqa: D102
-        if self._pool is not None:
-            if cancel:
-                self._pool.terminate()
-            else:
-                self._pool.close()
-            self._pool.join()
-            self._pool = None
+        for r in self._running:
+            if r.proc.is_alive():
+                r.proc.kill()
+        for r in self._running:
+            r.proc.join(timeout=5)
+            r.conn.close()
+        self._running = []
 
 
 # --------------------------------------------------------------------------- fresh subprocess per task
@@ -217,8 +330,14 @@ class DaskExecutor:
             self.client.submit(fn, t, key=f"tpee-task-{tag}-{k}", pure=False, retries=self.retries)
             for k, t in enumerate(tasks)
         ]
+        task_of = {fut.key: t for fut, t in zip(self._futures, tasks)}
         for fut in as_completed(self._futures):
-            yield fut.result()
+            try:
+                res = fut.result()
+            except Exception as exc:  # noqa: BLE001 (raised after its retries, or KilledWorker: recorded as failed)
+                log.error("Dask task %s failed: %s", fut.key, exc)
+                res = task_failure(task_of[fut.key], f"{type(exc).__name__}: {exc}", self.retries + 1)
+            yield res
             fut.release()
 
     def shutdown(self, cancel: bool = False) -> None:  # noqa: D102

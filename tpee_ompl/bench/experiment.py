@@ -100,7 +100,9 @@ def run_query_task(task: dict) -> dict:
     :class:`~tpee_ompl.bench.config.CampaignConfig`), ``query`` (dict), ``qpos`` (position in the
     set), ``query_set``, ``seed``, ``n_threads``, optionally ``specs`` (the experiments to run;
     default all) and ``log_dir``.  With ``log_dir`` each log is also written there as soon as its
-    experiment ends (atomically, never over an existing file), so an interrupted campaign keeps it.
+    experiment ends (atomically, never over an existing file), so an interrupted campaign keeps it,
+    and an experiment whose log is already there is skipped (a retried task runs only what its
+    dead predecessor did not finish).
 
     Returns (JSON-able): ``qpos``, ``query_id``, ``logs`` ({file name: log text}), ``extras``
     ({file name: {planner: [per-run properties]}}), ``errors``, ``pid``, ``host``, ``elapsed``.
@@ -118,6 +120,8 @@ def run_query_task(task: dict) -> dict:
                  "pid": os.getpid(), "host": socket.gethostname()}
     for spec in specs:
         fname = log_name(query, qpos, spec)
+        if log_dir is not None and (log_dir / fname).is_file():
+            continue  # written by an earlier attempt of this task whose worker died
         text, extras, error = _run_experiment(robot, cfg, task, spec)
         out["logs"][fname], out["extras"][fname] = text, extras
         if error:

@@ -24,8 +24,10 @@ from dataclasses import dataclass
 
 from ompl import base as ob
 from ompl import geometric as og
+from ompl import util as ou
 
 from ..planning.paths import path_to_array
+from .config import KNOWN_PLANNERS
 
 __all__ = [
     "PLANNER_FACTORIES",
@@ -68,7 +70,7 @@ def _dimension_rrt(si, ctx: PlannerContext):
 
 PLANNER_FACTORIES: dict[str, PlannerFactory] = {
     "DimensionRRT": _dimension_rrt,
-    **{n: _native(n) for n in ("RRTstar", "InformedRRTstar", "RRTConnect", "AORRTC", "BITstar", "RRT", "PRMstar")},
+    **{n: _native(n) for n in KNOWN_PLANNERS if n != "DimensionRRT"},
 }
 """Planner name -> factory ``(si, PlannerContext) -> ob.Planner``.  A name ``module:function`` is
 imported instead (so worker processes can build planners defined elsewhere, e.g. test stand-ins)."""
@@ -80,7 +82,13 @@ def planner_factory(name: str) -> PlannerFactory:
         return PLANNER_FACTORIES[name]
     if ":" in name:
         mod, _, attr = name.partition(":")
-        return getattr(importlib.import_module(mod), attr)
+        try:
+            fn = getattr(importlib.import_module(mod), attr)
+        except (ImportError, AttributeError) as exc:
+            raise ValueError(f"planner {name!r}: cannot import {attr} from {mod} ({exc})") from None
+        if not callable(fn):
+            raise ValueError(f"planner {name!r}: {attr} is not a factory function")
+        return fn
     raise ValueError(f"unknown planner {name!r}: choose from {sorted(PLANNER_FACTORIES)} or give module:function")
 
 
@@ -97,10 +105,14 @@ def planner_settings(p) -> dict[str, str]:
     """A planner's settings as text: its ``settings()`` (Python planners) or parsed ``printSettings()``."""
     if hasattr(p, "settings"):
         return {str(k): str(v) for k, v in p.settings().items()}
+    level = ou.getLogLevel()
+    ou.setLogLevel(ou.LOG_ERROR)  # printSettings reads BIT*'s deprecated options, each getter warns; errors still show
     try:
         return _parse_settings(p.printSettings())
     except Exception:  # noqa: BLE001 (bindings differ per planner)
         return {}
+    finally:
+        ou.setLogLevel(level)
 
 
 class RecordingPlanner(ob.Planner):

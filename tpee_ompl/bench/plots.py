@@ -16,6 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..files import atomic_path
+
 __all__ = ["make_plots"]
 
 
@@ -62,7 +64,7 @@ def make_plots(db_path: str | Path, directory: str | Path, planner: str | None =
             ax.legend(fontsize=7)
             fig.tight_layout()
             p = directory / f"fig15_ratios_{chk}.png"
-            fig.savefig(p, dpi=120)
+            _save(fig, p)
             plt.close(fig)
             out.append(p)
         for col, label, fname in (("time", "time (s)", "box_time.png"), ("solution_length", "raw path length (rad)", "box_length.png")):
@@ -82,7 +84,7 @@ def make_plots(db_path: str | Path, directory: str | Path, planner: str | None =
             ax.set_title(f"Iteration-matched runs: {label} of successful runs")
             fig.tight_layout()
             p = directory / fname
-            fig.savefig(p, dpi=120)
+            _save(fig, p)
             plt.close(fig)
             out.append(p)
     any_runs = [r for r in runs if r["comparison"] == "anytime"]
@@ -108,7 +110,7 @@ def make_plots(db_path: str | Path, directory: str | Path, planner: str | None =
         ax2.legend(fontsize=7)
         fig.tight_layout()
         p = directory / "anytime_cost.png"
-        fig.savefig(p, dpi=120)
+        _save(fig, p)
         plt.close(fig)
         out.append(p)
     return out
@@ -146,3 +148,9 @@ def _progress_median(db_path, planner: str):
     med = np.median(np.array(vals), axis=0)
     med[~np.isfinite(med)] = np.nan
     return grid, med
+
+
+def _save(fig, path: Path) -> None:
+    """Save ``fig`` as PNG at ``path`` atomically (a temporary file, then ``os.replace``)."""
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=120, format="png")

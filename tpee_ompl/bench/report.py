@@ -20,6 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..files import atomic_path, atomic_write_text
+
 __all__ = [
     "PAPER_TABLE4",
     "RATIO_METRICS",
@@ -256,12 +258,26 @@ def _markdown(ratios: list[dict], succ: list[dict], quality: list[dict], anytime
 
 
 def _write_csv(path: Path, rows: list[dict]) -> None:
-    with open(path, "w", newline="") as f:
-        if not rows:
-            return
-        w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
-        w.writeheader()
-        w.writerows(rows)
+    with atomic_path(path) as tmp, open(tmp, "w", newline="") as f:
+        if rows:
+            w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
+            w.writeheader()
+            w.writerows(rows)
+
+
+def _lost_queries(expected: dict | None) -> str:
+    """Markdown list of the queries a campaign could not finish (worker died twice, task raised)."""
+    failed = (expected or {}).get("failed_tasks") or []
+    if not failed:
+        return ""
+    lines = ["", "## Lost queries", "",
+             "These queries' missing experiments have no rows (nothing is invented for them); "
+             "`--resume` runs them again.", "", "| query position | query id | attempts | reason | missing logs |",
+             "|---|---|---|---|---|"]
+    for f in failed:
+        lines.append(f"| {f.get('qpos')} | {f.get('query_id')} | {f.get('attempts')} | {f.get('reason')} "
+                     f"| {len(f.get('missing_logs') or [])} |")
+    return "\n".join(lines) + "\n"
 
 
 def write_report(db_path: str | Path, directory: str | Path, expected: dict | None = None,
@@ -283,9 +299,9 @@ def write_report(db_path: str | Path, directory: str | Path, expected: dict | No
     succ = success_table(runs, expected)
     quality = length_quality_table(runs)
     anytime = anytime_table(runs)
-    text = _markdown(ratios, succ, quality, anytime, planner, reference, headline)
+    text = _markdown(ratios, succ, quality, anytime, planner, reference, headline) + _lost_queries(expected)
     paths = {"markdown": directory / "report.md", "csv": directory / "table4.csv"}
-    paths["markdown"].write_text(text)
+    atomic_write_text(paths["markdown"], text)
     _write_csv(paths["csv"], ratios)
     for name, rows in (("success", succ), ("length_quality", quality), ("anytime", anytime)):
         paths[name] = directory / f"{name}.csv"

@@ -3,7 +3,7 @@
 * :func:`make_results_dir`: a new ``<out>/<UTC timestamp>_<name>/`` campaign folder.
 * :func:`new_output_stem`: a free file stem for scripts writing ``<stem>.csv`` / ``<stem>.json``.
 * :func:`write_new_file`: atomic, never over an existing file (concurrent writers race safely).
-* :func:`write_json`: atomic replace (a campaign's own ``campaign.json``).
+* :func:`write_json`: atomic replace (a campaign's own ``campaign.json``); :func:`append_json_line` (``tasks.jsonl``).
 * :func:`package_versions`, :func:`format_value`: what the logs and metadata record, as text.
 """
 
@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 
 __all__ = [
+    "append_json_line",
     "format_value",
     "make_results_dir",
     "new_output_stem",
@@ -92,10 +93,21 @@ def write_new_file(target: Path, text: str) -> bool:
 
 
 def write_json(path: Path, data: dict) -> None:
-    """Write ``data`` as indented JSON, replacing ``path`` atomically (through ``<path>.part``)."""
-    tmp = path.with_name(path.name + ".part")
-    tmp.write_text(json.dumps(data, indent=2))
-    os.replace(tmp, path)
+    """Write ``data`` as indented JSON, replacing ``path`` atomically (:func:`tpee_ompl.files.atomic_write_text`).
+
+    Non-finite floats are refused (``NaN`` is not JSON).
+    """
+    from ..files import atomic_write_text
+
+    atomic_write_text(path, json.dumps(data, indent=2, allow_nan=False))
+
+
+def append_json_line(path: Path, data: dict) -> None:
+    """Add ``data`` as one JSON line to ``path``; the file is rewritten atomically (never half a line)."""
+    from ..files import atomic_write_text
+
+    old = Path(path).read_text() if Path(path).is_file() else ""
+    atomic_write_text(path, old + json.dumps(data, allow_nan=False) + "\n")
 
 
 def package_versions() -> dict[str, str]:

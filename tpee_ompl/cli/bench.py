@@ -11,12 +11,13 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import logging
+import re
 import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-from ..bench.config import CHECKERS, CampaignConfig
-from ._common import Parser
+from ..bench.config import CHECKERS, CampaignConfig, check_planner_name
+from ._common import Parser, positive_float, positive_int, seed
 
 __all__ = ["DESCRIPTION", "EXAMPLE", "add_arguments", "build_parser", "config_from_args", "main", "register", "run"]
 
@@ -31,33 +32,70 @@ def _default(name: str):
     return list(v) if isinstance(v, tuple) else v
 
 
+def _planner(text: str) -> str:
+    """argparse type: a planner name (:func:`~tpee_ompl.bench.config.check_planner_name`)."""
+    try:
+        return check_planner_name(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+def _count(text: str) -> int:
+    """argparse type: an int >= 0 (a count where 0 means none)."""
+    from ..validation import check_int
+
+    try:
+        return check_int("value", int(text), minimum=0)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(f"must be an integer >= 0: {text}") from exc
+
+
+_OPTION_OF = {"sample_caps": "--samples", "anytime_budgets": "--anytime", "iteration_planners": "--planners",
+              "anytime_planners": "--anytime-planners", "alt_checker_queries": "--alt-checker-queries",
+              "alt_checker_caps": "--alt-checker-samples", "anytime_queries": "--anytime-queries",
+              "max_queries": "--max-queries", "max_time": "--max-time", "queries": "--queries", "name": "--name",
+              "runs": "--runs", "workers": "--workers", "seed": "--seed", "out": "--out", "resume": "--resume"}
+""":class:`CampaignConfig` field -> option, to name the option in a refusal."""
+
+
+def _user_message(exc: BaseException) -> str:
+    """``exc`` as one line, naming the command-line option instead of the configuration field."""
+    msg = " ".join(str(exc).split())
+    for field_name, option in _OPTION_OF.items():
+        if msg.startswith(field_name + " ") or msg.startswith(field_name + ":"):
+            msg = option + msg[len(field_name):]
+        elif "_" in field_name:
+            msg = re.sub(rf"\b{field_name}\b", option, msg)
+    return msg
+
+
 def add_arguments(p: argparse.ArgumentParser) -> None:
     """Add the campaign, executor and resume options to ``p``."""
     p.add_argument("--queries", default=_default("queries"), help="query-set name or JSON file (default: %(default)s)")
     p.add_argument("--name", default=None, help="results folder suffix (default: the query-set name)")
-    p.add_argument("--samples", type=int, nargs="*", default=_default("sample_caps"),
+    p.add_argument("--samples", type=positive_int, nargs="*", default=_default("sample_caps"),
                    help="sample/iteration caps of the Table-4 comparison (default: %(default)s); none to skip")
-    p.add_argument("--anytime", type=float, nargs="*", default=_default("anytime_budgets"),
+    p.add_argument("--anytime", type=positive_float, nargs="*", default=_default("anytime_budgets"),
                    help="time budgets (s) of the anytime comparison (default: %(default)s); none to skip")
-    p.add_argument("--planners", nargs="+", default=_default("iteration_planners"),
+    p.add_argument("--planners", type=_planner, nargs="+", default=_default("iteration_planners"),
                    help="iteration-matched planners; the first is compared with the second (default: %(default)s)")
-    p.add_argument("--anytime-planners", nargs="+", default=_default("anytime_planners"), help="(default: %(default)s)")
+    p.add_argument("--anytime-planners", type=_planner, nargs="+", default=_default("anytime_planners"), help="(default: %(default)s)")
     p.add_argument("--checkers", nargs="+", default=_default("checkers"), choices=CHECKERS,
                    help="motion validators; the first is the headline (default: %(default)s)")
-    p.add_argument("--alt-checker-queries", type=int, default=_default("alt_checker_queries"),
+    p.add_argument("--alt-checker-queries", type=_count, default=_default("alt_checker_queries"),
                    help="run the non-headline validators on the first k queries only (default: all)")
-    p.add_argument("--alt-checker-samples", type=int, nargs="+", default=_default("alt_checker_caps"),
+    p.add_argument("--alt-checker-samples", type=positive_int, nargs="+", default=_default("alt_checker_caps"),
                    help="caps for the non-headline validators (default: all --samples)")
-    p.add_argument("--anytime-queries", type=int, default=_default("anytime_queries"),
+    p.add_argument("--anytime-queries", type=_count, default=_default("anytime_queries"),
                    help="anytime comparison on the first k queries only")
-    p.add_argument("--max-queries", type=int, default=_default("max_queries"),
+    p.add_argument("--max-queries", type=positive_int, default=_default("max_queries"),
                    help="use N queries, round-robin over the ordered sector pairs")
-    p.add_argument("--runs", type=int, default=_default("runs"), help="runs per planner per experiment (default: %(default)s)")
-    p.add_argument("--workers", type=int, default=_default("workers"),
-                   help="worker processes, one fresh process per query; 0 = in this process (default: %(default)s)")
-    p.add_argument("--seed", type=int, default=_default("seed"),
-                   help="campaign seed; query k's process uses seed + k (default: %(default)s)")
-    p.add_argument("--max-time", type=float, default=_default("max_time"), help="safety limit per iteration-capped run, s")
+    p.add_argument("--runs", type=positive_int, default=_default("runs"), help="runs per planner per experiment (default: %(default)s)")
+    p.add_argument("--workers", type=positive_int, default=_default("workers"),
+                   help="worker processes, one fresh process per query (default: %(default)s)")
+    p.add_argument("--seed", type=seed, default=_default("seed"),
+                   help="campaign seed in [1, 2**32-1]; query k's process uses seed + k (default: %(default)s)")
+    p.add_argument("--max-time", type=positive_float, default=_default("max_time"), help="safety limit per iteration-capped run, s")
     p.add_argument("--out", default=_default("out"), help="parent folder of the timestamped results folder")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     g = p.add_argument_group("executor (default: local process pool of --workers)")
@@ -65,8 +103,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="run the queries as Dask tasks: 'local' starts a LocalCluster here, an address uses that "
                         "scheduler (needs the dask extra: pip install 'tpee_ompl[dask]')")
     g.add_argument("--scheduler", metavar="tcp://HOST:PORT", default=None, help="same as --dask tcp://HOST:PORT")
-    g.add_argument("--dask-workers", type=int, default=2, help="workers of --dask local (default: %(default)s)")
-    g.add_argument("--retries", type=int, default=2, help="Dask retries of a task that raises (default: %(default)s)")
+    g.add_argument("--dask-workers", type=positive_int, default=2, help="workers of --dask local (default: %(default)s)")
+    g.add_argument("--retries", type=_count, default=2, help="Dask retries of a task that raises (default: %(default)s)")
+    p.set_defaults(bench_prog=p.prog)
     p.add_argument("--resume", metavar="DIR", default=None,
                    help="finish an interrupted campaign in DIR: run only its missing experiments (configuration "
                         "from DIR/campaign.json; the other campaign options are ignored)")
@@ -115,30 +154,57 @@ def config_from_args(args: argparse.Namespace) -> CampaignConfig:
 def run(args: argparse.Namespace) -> int:
     """Run (or ``--resume``) a campaign from parsed arguments; print the ratio table and where the files are.
 
-    Returns the exit code: 0, 2 for a bad configuration (one line on stderr), 130 when interrupted.
+    Everything is checked before anything is created.  Returns the exit code: 0; 2 for bad input
+    (one line on stderr naming the option or file); 1 when the campaign failed at run time or
+    finished with lost queries (listed; ``--resume`` runs them); 130 when interrupted.
     """
-    from ..bench.campaign import resume_campaign, run_campaign
+    from ..bench.campaign import load_campaign, prepare_campaign, resume_campaign, run_campaign
     from ..bench.executors import make_executor
 
     logging.basicConfig(level=logging.INFO, format="%(message)s")
+    prog = getattr(args, "bench_prog", "bench")
     try:
-        config = config_from_args(args)
-        if args.resume and not (Path(args.resume) / "campaign.json").is_file():
-            raise ValueError(f"--resume {args.resume}: no campaign.json there")
-        executor = make_executor(config.workers, dask=args.scheduler or args.dask, dask_workers=args.dask_workers,
+        if args.resume:
+            load_campaign(args.resume)
+            config = plan = None
+        else:
+            config = config_from_args(args)
+            plan = prepare_campaign(config)
+        executor = make_executor(args.workers, dask=args.scheduler or args.dask, dask_workers=args.dask_workers,
                                  retries=args.retries)
-    except (ValueError, ImportError) as exc:
-        print(f"error: {exc}", file=sys.stderr)
+    except (ValueError, FileNotFoundError, ImportError) as exc:
+        print(f"{prog}: error: {_user_message(exc)}", file=sys.stderr)
         return 2
     try:
         if args.resume:
-            result = resume_campaign(args.resume, executor=executor, workers=config.workers,
+            result = resume_campaign(args.resume, executor=executor, workers=args.workers,
                                      progress_bar=not args.no_progress)
         else:
-            result = run_campaign(config, executor=executor, progress_bar=not args.no_progress)
+            result = run_campaign(config, executor=executor, progress_bar=not args.no_progress, plan=plan)
     except KeyboardInterrupt:  # a second Ctrl-C while the database was built
-        print("interrupted; finished logs are kept: finish the campaign with --resume DIR", file=sys.stderr)
+        print(f"{prog}: interrupted; finished logs are kept: finish the campaign with --resume DIR", file=sys.stderr)
         return 130
+    except Exception as exc:  # noqa: BLE001 (a runtime failure: one line, no traceback)
+        print(f"{prog}: error: {type(exc).__name__}: {_user_message(exc)}", file=sys.stderr)
+        return 1
+    _print_result(result)
+    if result.interrupted:
+        print("campaign was interrupted: the database holds the finished experiments only; "
+              f"finish it with --resume {result.directory}")
+        return 130
+    if result.failed_tasks or result.skipped_logs:
+        lost = "; ".join(f"query {f['query_id']} ({f['reason']}, {len(f['missing_logs'])} experiment(s))"
+                         for f in result.failed_tasks)
+        bad = ", ".join(p.name for p in result.skipped_logs)
+        print(f"{prog}: error: campaign finished incomplete: {len(result.failed_tasks)} query(ies) lost"
+              + (f": {lost}" if lost else "") + (f"; unreadable logs: {bad}" if bad else "")
+              + f"; run them again with --resume {result.directory}", file=sys.stderr)
+        return 1
+    return 0
+
+
+def _print_result(result) -> None:
+    """Where the campaign's files are, and the report's ratio table."""
     if result.report.get("markdown_text"):
         print(result.report["markdown_text"])
     print(f"results: {result.directory}")
@@ -147,13 +213,9 @@ def run(args: argparse.Namespace) -> int:
         print(f"report: {result.report.get('markdown')}  {result.report.get('csv')}")
     if result.plots:
         print(f"plots: {result.directory / 'plots'} ({len(result.plots)} PNG)")
-    if result.skipped_logs:
-        print(f"skipped {len(result.skipped_logs)} corrupt log(s): " + ", ".join(p.name for p in result.skipped_logs))
-    if result.interrupted:
-        print("campaign was interrupted: the database holds the finished experiments only; "
-              f"finish it with --resume {result.directory}")
-        return 130
-    return 0
+    if result.broken_logs:
+        print(f"re-ran {len(result.broken_logs)} unreadable log(s), kept in {result.directory / 'logs' / 'broken'}: "
+              + ", ".join(p.name for p in result.broken_logs))
 
 
 def main(argv: Sequence[str] | None = None) -> int:
