@@ -28,13 +28,17 @@ ITERATION_PLANNERS = ("DimensionRRT", "RRTstar")
 """Planners of the iteration-matched (Table 4) comparison: dimension-RRT first, the reference second."""
 CLI_PLANNER_NAMES: dict[str, str] = {
     "dimension-rrt": "DimensionRRT",
+    "library": "LibraryDimensionRRT",
     "rrtstar": "RRTstar",
     "informedrrtstar": "InformedRRTstar",
     "rrtconnect": "RRTConnect",
+    "rrtconnect-simplify": "RRTConnectSimplify",
     "aorrtc": "AORRTC",
     "bitstar": "BITstar",
 }
-"""``tpee-ompl plan --planner`` name -> benchmark planner name (= OMPL class name; dimension-RRT is ours).
+"""``tpee-ompl plan --planner`` name -> benchmark planner name (= OMPL class name, but for this package's
+DimensionRRT, LibraryDimensionRRT (the DMP library refined by dimension-RRT) and RRTConnectSimplify
+(RRTConnect followed by OMPL's PathSimplifier, its simplification in its time)).
 The planners of :data:`ANYTIME_PLANNERS`, in the same order."""
 ANYTIME_PLANNERS: tuple[str, ...] = tuple(CLI_PLANNER_NAMES.values())
 """Planners of the time-matched comparison (every planner the command line knows)."""

@@ -68,9 +68,38 @@ def _dimension_rrt(si, ctx: PlannerContext):
     return tpee_dimension_rrt(si, int(q["from_sector"]), int(q["to_sector"]), max_samples=ctx.max_samples, seed=ctx.seed)
 
 
-PLANNER_FACTORIES: dict[str, PlannerFactory] = {
+_LIBRARIES: dict[str, object] = {}
+"""The default path library, loaded once per process (by model hash) for LibraryDimensionRRT."""
+
+
+def _library_dimension_rrt(si, ctx: PlannerContext):
+    from ..library import LibraryDimensionRRT, PathLibrary
+    from ..model.wearer_arm import default_robot
+    from ..resources import default_library_path
+
+    robot = getattr(si.getStateValidityChecker(), "robot", None) or default_robot()
+    lib = _LIBRARIES.get(robot.model_hash)
+    if lib is None:
+        lib = _LIBRARIES[robot.model_hash] = PathLibrary.load(default_library_path(), robot)
+    q = ctx.query
+    return LibraryDimensionRRT(si, lib, int(q["from_sector"]), int(q["to_sector"]), max_samples=ctx.max_samples,
+                               seed=ctx.seed)
+
+
+def _rrtconnect_simplify(si, ctx: PlannerContext):
+    from ..planning.simplified import SimplifiedPlanner
+
+    return SimplifiedPlanner(si, og.RRTConnect(si))
+
+
+_OURS: dict[str, PlannerFactory] = {
     "DimensionRRT": _dimension_rrt,
-    **{n: _native(n) for n in KNOWN_PLANNERS if n != "DimensionRRT"},
+    "LibraryDimensionRRT": _library_dimension_rrt,
+    "RRTConnectSimplify": _rrtconnect_simplify,
+}
+PLANNER_FACTORIES: dict[str, PlannerFactory] = {
+    **_OURS,
+    **{n: _native(n) for n in KNOWN_PLANNERS if n not in _OURS},
 }
 """Planner name -> factory ``(si, PlannerContext) -> ob.Planner``.  A name ``module:function`` is
 imported instead (so worker processes can build planners defined elsewhere, e.g. test stand-ins)."""

@@ -47,21 +47,21 @@ PLANNERS = CLI_PLANNER_NAMES
 
 # ---------------------------------------------------------------------------------------- plan
 def _make_planner(name: str, si: Any, from_sector: int, to_sector: int, samples: int | None, seed: int):
-    """Planner instance and a termination-condition factory for it."""
+    """Planner instance (built like the benchmark's, :mod:`tpee_ompl.bench.planners`) and a
+    termination-condition factory for a sample cap, if any."""
     from ompl import base as ob
-    from ompl import geometric as og
 
-    if name == "dimension-rrt":
-        from ..planning.tpee import tpee_dimension_rrt
+    from ..bench.planners import PlannerContext, planner_factory
 
-        planner = tpee_dimension_rrt(si, from_sector, to_sector, max_samples=samples, seed=seed)
+    capped_by_samples = name in ("dimension-rrt", "library")  # our planners take the cap themselves
+    ctx = PlannerContext(query={"from_sector": from_sector, "to_sector": to_sector},
+                         max_samples=samples if capped_by_samples else None, seed=seed)
+    planner = planner_factory(PLANNERS[name])(si, ctx)
+    if samples is None or capped_by_samples:
         return planner, None
-    planner = getattr(og, PLANNERS[name])(si)
-    if samples is not None:
-        if not hasattr(planner, "numIterations"):
-            raise CliError(f"--samples needs a planner that counts iterations; {name} does not (use --time)")
-        return planner, lambda: ob.PlannerTerminationCondition(lambda: planner.numIterations() >= samples)
-    return planner, None
+    if not hasattr(planner, "numIterations"):
+        raise CliError(f"--samples needs a planner that counts iterations; {name} does not (use --time)")
+    return planner, lambda: ob.PlannerTerminationCondition(lambda: planner.numIterations() >= samples)
 
 
 def check_plan_args(args: argparse.Namespace) -> None:
@@ -155,7 +155,9 @@ def add_plan_args(p: argparse.ArgumentParser, required: bool = False) -> None:
     p.add_argument("--from", dest="from_sector", type=sector, required=required, default=1,
                    help="start posture sector (1-4)")
     p.add_argument("--to", dest="to_sector", type=sector, required=required, default=4, help="goal posture sector (1-4)")
-    p.add_argument("--planner", choices=tuple(PLANNERS), default="dimension-rrt")
+    p.add_argument("--planner", choices=tuple(PLANNERS), default="library",
+                   help="library: the DMP path library's validated path, refined by dimension-RRT (default); "
+                        "rrtconnect-simplify: RRTConnect + OMPL's PathSimplifier; the others: OMPL's planners")
     p.add_argument("--time", type=seconds, default=5.0, help="time limit in seconds, at most a day (default 5)")
     p.add_argument("--samples", type=positive_int, default=None, help="sample / iteration cap")
     p.add_argument("--seed", type=seed, default=1, help="OMPL / planner seed, 1..2^32-1 (default 1)")
