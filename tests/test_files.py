@@ -53,3 +53,15 @@ def test_bad_seeds_are_refused_naming_the_argument(seed):
 
 def test_seed_range_ends_are_accepted():
     assert check_seed("seed", 1) == 1 and check_seed("seed", MAX_SEED) == MAX_SEED
+
+
+def test_atomic_files_get_the_mode_a_plain_open_gives(tmp_path):
+    import os
+
+    mask = os.umask(0o022)
+    try:
+        atomic_write_text(tmp_path / "r.csv", "x")
+        (tmp_path / "plain.csv").write_text("x")
+    finally:
+        os.umask(mask)
+    assert (tmp_path / "r.csv").stat().st_mode & 0o777 == (tmp_path / "plain.csv").stat().st_mode & 0o777 == 0o644

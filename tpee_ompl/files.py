@@ -14,7 +14,7 @@ import tempfile
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
-__all__ = ["OutputExistsError", "atomic_path", "atomic_path_with_suffix", "atomic_write", "atomic_write_bytes", "atomic_write_text",
+__all__ = ["OutputExistsError", "atomic_path", "atomic_write", "atomic_write_bytes", "atomic_write_text",
            "check_output_path"]
 
 
@@ -48,45 +48,32 @@ def check_output_path(path: str | os.PathLike, *, force: bool = False, what: str
     return p
 
 
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
 @contextlib.contextmanager
-def atomic_path(path: str | os.PathLike, *, force: bool = True, suffix: str | None = None) -> Iterator[Path]:
+def atomic_path(path: str | os.PathLike, *, force: bool = True, suffix_last: bool = False) -> Iterator[Path]:
     """A temporary path beside ``path`` to write to; on success it replaces ``path`` in one step.
 
     On an exception (or KeyboardInterrupt) the temporary file is removed and ``path`` is unchanged.
-    ``suffix`` (default: ``path``'s own) keeps writers that choose a format by file name happy.
+    The file gets the mode a plain ``open`` would give (0666 less the umask), not ``mkstemp``'s 0600.
+    ``suffix_last`` ends the temporary name with ``path``'s suffix (``.m.gif.XXXX.part.gif``) for
+    writers that choose the format by the file name and cannot be told otherwise (Pillow, ffmpeg).
     With ``force=False`` an existing ``path`` raises :class:`OutputExistsError` before anything is written.
     """
     target = Path(path)
     if target.exists() and not force:
         raise OutputExistsError(f"{target} exists; pass --force to replace it")
     target.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp_name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=(target.suffix if suffix is None else suffix) + ".part",
-                                    dir=target.parent)
+    suffix = ".part" + target.suffix if suffix_last else target.suffix + ".part"
+    fd, tmp_name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=suffix, dir=target.parent)
     os.close(fd)
     tmp = Path(tmp_name)
     try:
-        yield tmp
-        with open(tmp, "rb+") as f:
-            os.fsync(f.fileno())
-        os.replace(tmp, target)
-    finally:
-        with contextlib.suppress(FileNotFoundError):
-            tmp.unlink()
-
-
-@contextlib.contextmanager
-def atomic_path_with_suffix(path: str | os.PathLike, *, force: bool = True) -> Iterator[Path]:
-    """:func:`atomic_path` for writers that choose the format by the file name's suffix and cannot be
-    told otherwise (Pillow's GIF writer, ffmpeg): the temporary file ends with ``path``'s own suffix
-    (``.m.gif.XXXX.part.gif``)."""
-    target = Path(path)
-    if target.exists() and not force:
-        raise OutputExistsError(f"{target} exists; pass --force to replace it")
-    target.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp_name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".part" + target.suffix, dir=target.parent)
-    os.close(fd)
-    tmp = Path(tmp_name)
-    try:
+        os.chmod(tmp, 0o666 & ~_umask())
         yield tmp
         with open(tmp, "rb+") as f:
             os.fsync(f.fileno())

@@ -118,3 +118,16 @@ def test_not_a_library_is_refused(robot):
     ss = make_simple_setup(robot)
     with pytest.raises(ValueError, match="PathLibrary"):
         LibraryDimensionRRT(ss.getSpaceInformation(), object())
+
+
+def test_a_query_near_the_joint_limits_keeps_its_library_path(robot):
+    """The closest demonstration's DMP seed leaves the joint limits here; it is clipped, never a crash."""
+    from tpee_ompl.resources import default_library_path
+
+    lib = PathLibrary.load(default_library_path(), robot)
+    start = np.array([-0.87266463, 2.7925268, -3.3, 0.28628166])
+    goal = np.array([0.87266463, 2.7925268, -3.3, 0.37504947])
+    ss, planner, status = _solve(robot, lib, start, goal, max_samples=100, seed=1)
+    assert status == ob.PlannerStatus.EXACT_SOLUTION
+    assert planner.last_run_stats()["library_outcome"] in ("dmp", "repaired", "straight", "planned")
+    assert path_passes_motion_checks(ss.getSpaceInformation(), ss.getSolutionPath())

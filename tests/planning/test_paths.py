@@ -172,3 +172,27 @@ def test_path_length_and_resampling_keep_the_geometry() -> None:
     assert path_length(R) == pytest.approx(9.0)
     with pytest.raises(ValueError, match="per_step"):
         resample_waypoints(W, per_step=0)
+
+
+@pytest.mark.parametrize("factor", [1, 4])
+@pytest.mark.parametrize("segments", [None, [0, 2]])
+def test_batched_whole_path_check_agrees_with_checkmotion_segment_by_segment(robot, factor, segments):
+    from tpee_ompl.planning.setup import make_simple_setup
+
+    ss = make_simple_setup(robot)
+    si = ss.getSpaceInformation()
+    si.getStateSpace().setValidSegmentCountFactor(factor)
+    si.setup()
+    rng = np.random.default_rng(factor)
+    verdicts = set()
+    for _ in range(40):
+        W = rng.uniform(robot.lower, robot.upper, (4, 4))
+        W = W[[robot.is_valid(w) for w in W]]
+        if len(W) < 4:
+            continue
+        states = [set_state(si.allocState(), w) for w in W]
+        ks = range(len(W) - 1) if segments is None else segments
+        expected = all(si.checkMotion(states[k], states[k + 1]) for k in ks)
+        assert path_passes_motion_checks(si, W, segments=segments) == expected
+        verdicts.add(expected)
+    assert verdicts == {True, False}  # both verdicts were compared

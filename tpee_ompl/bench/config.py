@@ -44,6 +44,8 @@ ANYTIME_PLANNERS: tuple[str, ...] = tuple(CLI_PLANNER_NAMES.values())
 """Planners of the time-matched comparison (every planner the command line knows)."""
 KNOWN_PLANNERS: tuple[str, ...] = (*ANYTIME_PLANNERS, "RRT", "PRMstar")
 """Every built-in planner name (:data:`tpee_ompl.bench.planners.PLANNER_FACTORIES`); ``module:function`` names a factory elsewhere."""
+NOT_ITERATION_CAPPED: tuple[str, ...] = ("RRTConnectSimplify",)
+"""Planners that cannot be stopped at a sample count, so they never join the iteration-matched comparison."""
 CHECKERS = ("batched", "discrete")
 """Motion validators: one batched Pinocchio call per motion, or OMPL's DiscreteMotionValidator."""
 PROGRESS_PROPERTIES = ["best cost REAL", "iterations INTEGER", "time REAL"]  # sorted, as OMPL's map
@@ -120,6 +122,10 @@ class CampaignConfig:
                 check_planner_name(n, f"{field_name} entry")
             if len(set(names)) != len(names):
                 raise ValueError(f"{field_name} names a planner twice: {list(names)}")
+        for n in self.iteration_planners:
+            if n in NOT_ITERATION_CAPPED:
+                raise ValueError(f"iteration_planners: {n} cannot be stopped at a sample count (RRTConnect counts no "
+                                 "iterations); compare it in the anytime comparison")
         if caps and not self.iteration_planners:
             raise ValueError("iteration_planners: give at least one planner for the sample caps")
         if budgets and not self.anytime_planners:

@@ -163,6 +163,8 @@ class LibraryDimensionRRT(PythonPlanner):
                     have_exact = True
                     break
             seed = lib.generate(start, goal, i, j, int(order[0]), stride=lib.per_step)
+            # near the joint limits a DMP seed can leave them; it is only a head start: clip it
+            seed = np.clip(seed, lib.robot.lower, lib.robot.upper)
         if not have_exact:  # Table 3's straight motion: often free when the library's paths are not
             path = array_to_path(si, straight_motion(start, goal, i, j))
             if path_passes_motion_checks(si, path):
@@ -187,12 +189,14 @@ class LibraryDimensionRRT(PythonPlanner):
         status = inner.solve(ptc)
         s = inner.last_run_stats()
         stats.update(samples=s["samples"], iterations=s["iterations"], collision_checks=s["collision_checks"])
+        posted = s["best_cost"]  # what the inner planner added to the problem definition
         for t, cost, samples in s["progress"]:
-            if math.isfinite(cost) and cost < stats["best_cost"]:
+            if math.isfinite(cost) and posted <= cost < stats["best_cost"]:
                 if stats["first_solution_time"] is None:
                     stats["first_solution_time"] = t_inner + t
                 stats["best_cost"] = cost
                 progress.append((t_inner + t, cost, samples))
+        stats["best_cost"] = min(stats["best_cost"], posted)
         progress.append((time.perf_counter() - t0, stats["best_cost"], stats["samples"]))
         if have_exact or status == ob.PlannerStatus.EXACT_SOLUTION:
             return planner_status(ob.PlannerStatus.EXACT_SOLUTION)

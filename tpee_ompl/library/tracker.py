@@ -309,7 +309,7 @@ def make_default_planner(
         w = straight_motion(start, goal, i, j) if i != j else np.array([start, goal], dtype=float)
         if motion_is_valid(robot, w, step):
             return w
-        ss = make_simple_setup(robot, start, goal)
+        ss = make_simple_setup(robot, start, goal, joint_step=step)
         ss.setPlanner(og.RRTConnect(ss.getSpaceInformation()))
         if not ss.solve(timeout) or not ss.haveExactSolutionPath():
             raise RuntimeError(f"RRTConnect found no path {i}->{j} in {timeout} s")

@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..files import atomic_path_with_suffix
+from ..files import atomic_path
 from ._common import check_target, check_waypoints, clip_segment, draw_floor, new_axes, output_path, set_view
 from .meshes import arm_polygons, scene_mesh
 from .style import DEFAULT_AZIM, DEFAULT_ELEV, LOS_BLOCKED, LOS_CLEAR
@@ -162,7 +162,7 @@ def animate_path(
         txt.set_color("k" if valid[i] else LOS_BLOCKED)
 
     output_path(out)
-    with atomic_path_with_suffix(out) as tmp, writer.saving(fig, str(tmp), dpi):
+    with atomic_path(out, suffix_last=True) as tmp, writer.saving(fig, str(tmp), dpi):
         for i in range(frames):
             draw(i)
             writer.grab_frame()
