@@ -72,6 +72,16 @@ def test_smoke_campaign_fills_the_database(query_file, tmp_path):
     assert n_prog > 0
     settings = con.execute("SELECT settings FROM plannerConfigs WHERE name='geometric_StandIn'").fetchone()[0]
     assert "planner.kind" in settings and "iteration_cap" in settings
+    # one configuration per planner and cap, shared by every query (Planner Arena groups runs by it)
+    configs = con.execute("SELECT name, COUNT(*) FROM plannerConfigs GROUP BY name").fetchall()
+    experiments = con.execute("SELECT COUNT(*) FROM experiments").fetchone()[0]
+    assert experiments > 2 and all(n <= 3 for _, n in configs), configs  # <= one per cap and the anytime run
+    assert not any("projection.cellsize" in s or "planner.seed" in s
+                   for (s,) in con.execute("SELECT settings FROM plannerConfigs"))
+    # OMPL's graph columns are filled for a native planner run through the recording wrapper
+    graph = con.execute("SELECT MAX(runs.graph_states), MAX(runs.graph_motions) FROM runs JOIN plannerConfigs "
+                        "ON runs.plannerid = plannerConfigs.id WHERE plannerConfigs.name='geometric_RRTstar'").fetchone()
+    assert graph[0] > 0 and graph[1] > 0
     params = con.execute("SELECT query_id, from_sector, to_sector, query_set FROM experiments").fetchall()
     assert ("0", 1, 2, "tiny") in params
     con.close()

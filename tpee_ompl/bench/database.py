@@ -64,6 +64,17 @@ def pad_aborted_runs(bench, records: dict, run_count: int, error: str) -> None:
         pl.runs = runs
 
 
+PER_QUERY_SETTINGS = ("seed", "pair")
+"""Planner settings that change from query to query (the process seed, the sector pair).  Kept out of
+the planner's configuration, so Planner Arena groups one planner's runs across queries: the seeds are
+in the ``experiments`` table (``process_seed``) and the pair in its query columns."""
+
+
+SAMPLED_SPACE_SETTINGS = ("projection.cellsize",)
+"""OMPL's recorded space settings estimated by random sampling at each set-up (the default projection's
+cell sizes): they differ from experiment to experiment and would split one planner's configuration."""
+
+
 def patch_recorded_data(bench, wrappers: dict, records: dict, cap: int | None) -> None:
     """Write the post-run records into the recorded experiment data (in place, before saving).
 
@@ -76,7 +87,15 @@ def patch_recorded_data(bench, wrappers: dict, records: dict, cap: int | None) -
         for run, rec in zip(pl.runs, recs):
             for k, v in rec["props"].items():
                 run[k] = format_value(v)
-        for k, v in planner_settings(wrappers[name].inner).items():
+        settings = planner_settings(wrappers[name].inner)
+        for k in PER_QUERY_SETTINGS:  # per query, not per planner: in the experiments table and the runs
+            settings.pop(k, None)
+        common = ot.RunProperties()
+        for k, v in pl.common.to_dict().items():
+            if not k.startswith(SAMPLED_SPACE_SETTINGS):
+                common[k] = v
+        pl.common = common
+        for k, v in settings.items():
             pl.common[f"planner.{k}"] = v
         pl.common["iteration_cap"] = str(cap) if cap is not None else "none"
         pl.common["wrapper"] = "RecordingPlanner"

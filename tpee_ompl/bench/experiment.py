@@ -241,6 +241,9 @@ def _run_experiment(robot, cfg: dict, task: dict, spec: dict) -> tuple[str, dict
             "reaches_goal INTEGER": 0,
             "planner_error INTEGER": int(rec["error"] is not None),
         }
+        if rec.get("graph_states") is not None:  # OMPL's own columns, which it cannot fill through the wrapper
+            props["graph states INTEGER"] = rec["graph_states"]
+            props["graph motions INTEGER"] = rec["graph_motions"]
         props.update(_path_properties(si, rec, start, goal))
         return {"props": props, "progress": rec["progress"]}
 

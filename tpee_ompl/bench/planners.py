@@ -226,8 +226,21 @@ class RecordingPlanner(ob.Planner):
         waypoints = None
         if error is None and pdef.hasSolution():
             waypoints = path_to_array(pdef.getSolutionPath(), 4)
-        self.last = {"waypoints": waypoints, "error": error, **self._run_stats(elapsed, progress, has_cost)}
+        self.last = {"waypoints": waypoints, "error": error, **self._run_stats(elapsed, progress, has_cost),
+                     **self._graph_size()}
         return status
+
+    def _graph_size(self) -> dict:
+        """The inner planner's graph: OMPL asks the wrapper (a Python planner) for planner data, which it
+        cannot forward (a Python ``getPlannerData`` override aborts), so the counts are read here."""
+        if hasattr(self.inner, "last_run_stats"):  # our Python planners keep no OMPL graph
+            return {"graph_states": None, "graph_motions": None}
+        try:
+            pd = ob.PlannerData(self.getSpaceInformation())
+            self.inner.getPlannerData(pd)
+            return {"graph_states": int(pd.numVertices()), "graph_motions": int(pd.numEdges())}
+        except Exception:  # noqa: BLE001 (a planner without planner data)
+            return {"graph_states": None, "graph_motions": None}
 
     def _run_stats(self, elapsed: float, progress: list, has_cost: bool) -> dict:
         """Iterations, samples, best cost, first-solution time and progress of the run that just ended."""
