@@ -29,6 +29,7 @@ __all__ = [
     "DEFAULT_SRDF",
     "DEFAULT_URDF",
     "WearerArm",
+    "check_target_point",
     "default_robot",
 ]
 
@@ -62,11 +63,12 @@ def _as_config_batch(Q: np.ndarray, nq: int) -> np.ndarray:
     return Q
 
 
-def _check_finite_target(target: object) -> np.ndarray:
-    """Return target as a (3,) float array within MAX_TARGET_DISTANCE, or raise ValueError naming it."""
+def check_target_point(target: object) -> np.ndarray:
+    """Return target as a (3,) float array (metres, world frame) within MAX_TARGET_DISTANCE, or raise
+    ValueError naming it (the one check of a target point; aiming adds its own, geometric ones)."""
     t = as_float_array(target, "target")
     if t.shape != (3,) or not np.all(np.isfinite(t)):
-        raise ValueError(f"target must be 3 finite numbers, got {target!r}")
+        raise ValueError(f"target must be 3 finite numbers (x, y, z in metres), got {target!r}")
     if np.max(np.abs(t)) > MAX_TARGET_DISTANCE:
         raise ValueError(f"target {t} is farther than MAX_TARGET_DISTANCE = {MAX_TARGET_DISTANCE:g} m")
     return t
@@ -355,7 +357,7 @@ class WearerArm:
 
     def line_of_sight_clear(self, q: np.ndarray, target: np.ndarray) -> bool:
         """True if the segment muzzle -> target touches neither the wearer nor the arm's boom."""
-        target = _check_finite_target(target)
+        target = check_target_point(target)
         p, _ = self.muzzle(q)
         d = target - p
         length = float(np.linalg.norm(d))

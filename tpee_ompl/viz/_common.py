@@ -67,17 +67,9 @@ def clip_segment(a: np.ndarray, b: np.ndarray, lo: np.ndarray, hi: np.ndarray) -
 # ---------------------------------------------------------------------------- argument checks
 def check_target(target: Any) -> np.ndarray | None:
     """None, or the target as 3 finite floats (metres) within the model's MAX_TARGET_DISTANCE; ValueError otherwise."""
-    from ..model.wearer_arm import MAX_TARGET_DISTANCE
-    from ..validation import as_float_array
+    from ..model.wearer_arm import check_target_point
 
-    if target is None:
-        return None
-    t = as_float_array(target, "target")
-    if t.shape != (3,) or not np.all(np.isfinite(t)):
-        raise ValueError(f"target must be 3 finite numbers (x, y, z in metres), got {target!r}")
-    if np.max(np.abs(t)) > MAX_TARGET_DISTANCE:
-        raise ValueError(f"target {t} is farther than MAX_TARGET_DISTANCE = {MAX_TARGET_DISTANCE:g} m")
-    return t
+    return None if target is None else check_target_point(target)
 
 
 def check_waypoints(robot: WearerArm, waypoints: Any) -> np.ndarray:
