@@ -18,6 +18,7 @@ from tpee_ompl.examples.planar_arm import make_planar_arm_setup
 from tpee_ompl.examples.tpee_queries import cross_sector_query
 from tpee_ompl.model.sectors import SECTOR_PAIRS
 from tpee_ompl.planning.setup import make_simple_setup
+from tpee_ompl.model.queries import load_queries
 from tpee_ompl.planning.paths import path_passes_motion_checks, path_to_array, set_state
 from tpee_ompl.model.wearer_arm import WearerArm
 
@@ -207,3 +208,18 @@ def test_settings_and_stats_shape(robot: WearerArm) -> None:
     assert set(planner.last_run_stats()) == {
         "samples", "collision_checks", "first_solution_time", "best_cost", "iterations", "progress", "solutions_posted"
     }
+
+
+def test_stall_samples_stop_a_converged_run_before_its_cap(robot: WearerArm) -> None:
+    q = load_queries("planning_necessary")[0]
+    ss = make_simple_setup(robot, q.start, q.goal)
+    planner = tpee_dimension_rrt(ss.getSpaceInformation(), q.from_sector, q.to_sector, max_samples=20000, seed=3,
+                                 stall_samples=200)
+    ss.setPlanner(planner)
+    assert ss.solve(60.0) == ob.PlannerStatus.EXACT_SOLUTION
+    stats = planner.last_run_stats()
+    improvements = [n for (_, c0, _), (_, c1, n) in zip(stats["progress"], stats["progress"][1:]) if c1 < c0]
+    assert stats["samples"] < 20000
+    assert stats["samples"] == max(improvements, default=0) + 200  # exactly `stall` samples after the last gain
+    with pytest.raises(ValueError, match="stall_samples"):
+        tpee_dimension_rrt(ss.getSpaceInformation(), 1, 2, stall_samples=0)

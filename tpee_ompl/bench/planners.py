@@ -48,6 +48,9 @@ class PlannerContext:
     query: dict
     max_samples: int | None
     seed: int
+    stall_samples: int | None = None
+    """Our planners stop after this many samples without a shorter path (None: the paper's behaviour,
+    as in every campaign; ``tpee-ompl plan`` sets it so a converged run does not idle to its time limit)."""
 
 
 PlannerFactory = Callable[[ob.SpaceInformation, PlannerContext], ob.Planner]
@@ -65,7 +68,8 @@ def _dimension_rrt(si, ctx: PlannerContext):
     from ..planning.tpee import tpee_dimension_rrt
 
     q = ctx.query
-    return tpee_dimension_rrt(si, int(q["from_sector"]), int(q["to_sector"]), max_samples=ctx.max_samples, seed=ctx.seed)
+    return tpee_dimension_rrt(si, int(q["from_sector"]), int(q["to_sector"]), max_samples=ctx.max_samples, seed=ctx.seed,
+                              stall_samples=ctx.stall_samples)
 
 
 _LIBRARIES: dict[str, object] = {}
@@ -83,7 +87,7 @@ def _library_dimension_rrt(si, ctx: PlannerContext):
         lib = _LIBRARIES[robot.model_hash] = PathLibrary.load(default_library_path(), robot)
     q = ctx.query
     return LibraryDimensionRRT(si, lib, int(q["from_sector"]), int(q["to_sector"]), max_samples=ctx.max_samples,
-                               seed=ctx.seed)
+                               seed=ctx.seed, stall_samples=ctx.stall_samples)
 
 
 def _rrtconnect_simplify(si, ctx: PlannerContext):

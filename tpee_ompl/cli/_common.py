@@ -27,6 +27,7 @@ __all__ = [
     "MAX_COUNT",
     "MAX_SECONDS",
     "CliError",
+    "count",
     "Parser",
     "add_force_arg",
     "angle",
@@ -102,6 +103,14 @@ def positive_int(text: str) -> int:
     v = _int(text)
     if not 0 < v <= MAX_COUNT:
         raise argparse.ArgumentTypeError(f"must be a positive integer <= {MAX_COUNT:.0e}: {text}")
+    return v
+
+
+def count(text: str) -> int:
+    """argparse type: an int in [0, :data:`MAX_COUNT`] (0 meaning "off" where the option says so)."""
+    v = _int(text)
+    if not 0 <= v <= MAX_COUNT:
+        raise argparse.ArgumentTypeError(f"must be an integer in [0, {MAX_COUNT:.0e}]: {text}")
     return v
 
 

@@ -15,12 +15,13 @@ from ..resources import default_library_path
 from ._common import (
     CliError,
     add_force_arg,
-    angle,
     add_model_args,
+    angle,
     argument,
     check_input_file,
     check_model_args,
     check_output,
+    count,
     default_of,
     finite,
     index,
@@ -41,12 +42,16 @@ __all__ = ["MAX_TRACK_SAMPLES", "PLANNERS", "add_plan_args", "check_plan_args", 
 MAX_TRACK_SAMPLES = 100_000
 """Most target samples ``track`` accepts (``--duration`` x ``--rate``): more is refused before any work."""
 
+DEFAULT_STALL = 1000
+"""``plan --stall``: samples without a shorter path after which dimension-RRT counts as converged."""
+
 PLANNERS = CLI_PLANNER_NAMES
 """``--planner`` choices: CLI name -> planner class name (``ompl.geometric.<name>``; DimensionRRT is this package's)."""
 
 
 # ---------------------------------------------------------------------------------------- plan
-def _make_planner(name: str, si: Any, from_sector: int, to_sector: int, samples: int | None, seed: int):
+def _make_planner(name: str, si: Any, from_sector: int, to_sector: int, samples: int | None, seed: int,
+                  stall: int | None = None):
     """Planner instance (built like the benchmark's, :mod:`tpee_ompl.bench.planners`) and a
     termination-condition factory for a sample cap, if any."""
     from ompl import base as ob
@@ -55,7 +60,7 @@ def _make_planner(name: str, si: Any, from_sector: int, to_sector: int, samples:
 
     capped_by_samples = name in ("dimension-rrt", "library")  # our planners take the cap themselves
     ctx = PlannerContext(query={"from_sector": from_sector, "to_sector": to_sector},
-                         max_samples=samples if capped_by_samples else None, seed=seed)
+                         max_samples=samples if capped_by_samples else None, seed=seed, stall_samples=stall or None)
     planner = planner_factory(PLANNERS[name])(si, ctx)
     if samples is None or capped_by_samples:
         return planner, None
@@ -116,7 +121,8 @@ def plan_motion(args: argparse.Namespace) -> tuple[dict, WearerArm]:
     else:
         ss = make_simple_setup(robot, start, goal)
     si = ss.getSpaceInformation()
-    planner, ptc_factory = _make_planner(args.planner, si, args.from_sector, args.to_sector, args.samples, args.seed)
+    planner, ptc_factory = _make_planner(args.planner, si, args.from_sector, args.to_sector, args.samples, args.seed,
+                                         args.stall)
     ss.setPlanner(planner)
     checks0 = robot.collision_checks
     if ptc_factory is not None:
@@ -160,6 +166,9 @@ def add_plan_args(p: argparse.ArgumentParser, required: bool = False) -> None:
                         "rrtconnect-simplify: RRTConnect + OMPL's PathSimplifier; the others: OMPL's planners")
     p.add_argument("--time", type=seconds, default=5.0, help="time limit in seconds, at most a day (default 5)")
     p.add_argument("--samples", type=positive_int, default=None, help="sample / iteration cap")
+    p.add_argument("--stall", type=count, default=DEFAULT_STALL,
+                   help="library / dimension-rrt: stop after this many samples without a shorter path, before --time "
+                        f"(0: use the whole --time; default {DEFAULT_STALL})")
     p.add_argument("--seed", type=seed, default=1, help="OMPL / planner seed, 1..2^32-1 (default 1)")
     p.add_argument("--queries", default="planning_necessary",
                    help="query set name or JSON file (made for the loaded model: its model_hash must match)")

@@ -106,6 +106,9 @@ class DimensionRRTOptions:
         Planner name (``geometric_<name>`` in a Benchmark database).
     batch : bool
         Use the checker's batched ``are_valid`` when it has one (default True).
+    stall_samples : int, optional
+        Stop once a valid path exists and this many samples in a row brought no shorter one (None,
+        the default: run until the termination condition or ``max_samples``, as the paper does).
     """
 
     groups: Sequence[Sequence[int]] | None = None
@@ -117,6 +120,7 @@ class DimensionRRTOptions:
     range_: float | Sequence[float] | None = None
     name: str = "DimensionRRT"
     batch: bool = True
+    stall_samples: int | None = None
 
     def __post_init__(self) -> None:
         check_name("name", self.name)
@@ -126,6 +130,7 @@ class DimensionRRTOptions:
         set_("narrow_after", check_int("narrow_after", self.narrow_after, minimum=0))
         set_("narrowing", check_number("narrowing", self.narrowing, low=0.0, high=1.0, low_open=True))
         set_("batch", check_bool("batch", self.batch))
+        set_("stall_samples", check_int("stall_samples", self.stall_samples, minimum=1, optional=True))
         if self.range_ is not None:
             try:
                 arr = np.asarray(self.range_, dtype=float)
@@ -280,6 +285,7 @@ class DimensionRRT(PythonPlanner):
             "narrowing": str(self.narrowing),
             "range": str([round(float(v), 6) for v in self.range_]),
             "batch": str(self.batch),
+            "stall_samples": str(self.options.stall_samples),
             "initial_waypoints": "none" if self._initial is None else "set",
         }
 
@@ -334,13 +340,16 @@ class DimensionRRT(PythonPlanner):
         if search.valid:
             poster.offer(search.W, search.cost, time.perf_counter())
         record(time.perf_counter())
+        stall, improved_at = self.options.stall_samples, 0
         while not poster.satisfied and not ptc() and (cap is None or search.samples < cap):
+            if stall is not None and math.isfinite(poster.found_cost) and search.samples - improved_at >= stall:
+                break  # converged: nothing shorter in the last ``stall`` samples
             accepted = search.iterate()
             now = time.perf_counter()
             if accepted and search.valid and search.cost < poster.found_cost:
                 poster.offer(search.W, search.cost, now)
                 record(now)
-                last_log = now
+                last_log, improved_at = now, search.samples
                 continue
             if now - last_log >= _PROGRESS_PERIOD:
                 record(now)
