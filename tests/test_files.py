@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from tpee_ompl.files import OutputExistsError, atomic_path, atomic_write_text, check_output_path
+from tpee_ompl.files import OutputExistsError, atomic_path, atomic_write_text, check_output_path, write_new_file
 from tpee_ompl.validation import MAX_SEED, check_seed
 
 
@@ -65,3 +65,10 @@ def test_atomic_files_get_the_mode_a_plain_open_gives(tmp_path):
     finally:
         os.umask(mask)
     assert (tmp_path / "r.csv").stat().st_mode & 0o777 == (tmp_path / "plain.csv").stat().st_mode & 0o777 == 0o644
+
+
+def test_write_new_file_never_overwrites(tmp_path):
+    target = tmp_path / "a.log"
+    assert write_new_file(target, "first")
+    assert not write_new_file(target, "second")
+    assert target.read_text() == "first" and [p.name for p in tmp_path.iterdir()] == ["a.log"]

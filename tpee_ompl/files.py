@@ -1,8 +1,9 @@
 """Writing files safely: atomically (a crash never leaves half a file) and never over an existing one unless asked.
 
 Every file the project writes (libraries, databases, campaign files, figures) goes through
-:func:`atomic_write`: the data go to a temporary file in the target's folder, are flushed to disk, then
-``os.replace`` puts them in place in one step.  :func:`check_output_path` is called before any work
+:func:`atomic_path` / :func:`atomic_write`, or :func:`write_new_file` for a file that must not exist
+yet: the data go to a temporary file in the target's folder, are flushed to disk, then ``os.replace``
+(or a hard link) puts them in place in one step.  :func:`check_output_path` is called before any work
 starts, so a refused target costs nothing and leaves nothing behind.
 """
 
@@ -11,10 +12,12 @@ from __future__ import annotations
 import contextlib
 import os
 import tempfile
+import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
 __all__ = ["OutputExistsError", "atomic_path", "atomic_write", "atomic_write_bytes", "atomic_write_text",
+           "write_new_file",
            "check_output_path"]
 
 
@@ -98,3 +101,25 @@ def atomic_write_bytes(path: str | os.PathLike, data: bytes, *, force: bool = Tr
 def atomic_write_text(path: str | os.PathLike, text: str, *, force: bool = True) -> Path:
     """Write ``text`` (UTF-8) to ``path`` atomically."""
     return atomic_write(path, lambda tmp: tmp.write_text(text, encoding="utf-8"), force=force)
+
+
+def write_new_file(target: str | os.PathLike, text: str) -> bool:
+    """Write ``text`` to ``target`` atomically and never over an existing file.
+
+    The text goes to a unique ``.part`` file first, then is hard-linked to ``target`` (which fails
+    if ``target`` exists, even when two processes race, unlike a check before :func:`atomic_path`).
+    Returns False when ``target`` existed.
+    """
+    target = Path(target)
+    tmp = target.with_name(f"{target.name}.{os.getpid()}.{time.monotonic_ns()}.part")
+    with open(tmp, "w") as f:
+        f.write(text)
+        f.flush()
+        os.fsync(f.fileno())
+    try:
+        os.link(tmp, target)
+        return True
+    except FileExistsError:
+        return False
+    finally:
+        tmp.unlink()

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from tpee_ompl.bench.results import format_value, make_results_dir, new_output_stem, write_new_file
+from tpee_ompl.bench.results import format_value, make_results_dir, new_output_stem
 
 
 def test_existing_results_get_a_new_timestamped_stem(tmp_path) -> None:
@@ -15,13 +15,6 @@ def test_existing_results_get_a_new_timestamped_stem(tmp_path) -> None:
     third = new_output_stem(stem)
     assert third not in (stem, second)
     assert stem.with_suffix(".json").read_text() == "{}"
-
-
-def test_write_new_file_never_overwrites(tmp_path):
-    target = tmp_path / "a.log"
-    assert write_new_file(target, "first")
-    assert not write_new_file(target, "second")
-    assert target.read_text() == "first" and [p.name for p in tmp_path.iterdir()] == ["a.log"]
 
 
 def test_results_dirs_are_always_new(tmp_path):

@@ -35,7 +35,8 @@ from pathlib import Path
 from .config import CampaignConfig, CampaignResult
 from .database import build_database, set_aside_broken_logs
 from .experiment import experiment_specs, log_name, run_query_task
-from .results import append_json_line, make_results_dir, package_versions, utc_now, write_json, write_new_file
+from ..files import write_new_file
+from .results import append_json_line, make_results_dir, package_versions, utc_now, write_json
 
 __all__ = ["CampaignPlan", "load_campaign", "prepare_campaign", "query_rows", "resume_campaign", "run_campaign",
            "stratified_subset"]

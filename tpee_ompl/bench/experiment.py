@@ -32,7 +32,8 @@ from ompl import util as ou
 from ..planning.paths import path_length, path_passes_motion_checks
 from .database import failed_run_properties, pad_aborted_runs, patch_recorded_data
 from .planners import PlannerContext, RecordingPlanner, planner_factory
-from .results import format_value, write_new_file
+from ..files import write_new_file
+from .results import format_value
 
 __all__ = ["experiment_specs", "group_lengths", "log_name", "run_query_task"]
 

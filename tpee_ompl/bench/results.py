@@ -2,7 +2,6 @@
 
 * :func:`make_results_dir`: a new ``<out>/<UTC timestamp>_<name>/`` campaign folder.
 * :func:`new_output_stem`: a free file stem for scripts writing ``<stem>.csv`` / ``<stem>.json``.
-* :func:`write_new_file`: atomic, never over an existing file (concurrent writers race safely).
 * :func:`write_json`: atomic replace (a campaign's own ``campaign.json``); :func:`append_json_line` (``tasks.jsonl``).
 * :func:`package_versions`, :func:`format_value`: what the logs and metadata record, as text.
 """
@@ -14,7 +13,6 @@ import json
 import math
 import os
 import platform
-import time
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -28,7 +26,6 @@ __all__ = [
     "package_versions",
     "utc_now",
     "write_json",
-    "write_new_file",
 ]
 
 
@@ -69,27 +66,6 @@ def new_output_stem(stem: str | os.PathLike, suffixes: Sequence[str] = (".csv", 
         if not any(cand.with_name(cand.name + s).exists() for s in suffixes):
             return cand
     raise RuntimeError(f"no free output name for {stem}")
-
-
-def write_new_file(target: Path, text: str) -> bool:
-    """Write ``text`` to ``target`` atomically and never over an existing file.
-
-    The text goes to a unique ``.part`` file first, then is hard-linked to ``target`` (which fails
-    if ``target`` exists, even when two processes race).  Returns False when ``target`` existed.
-    """
-    target = Path(target)
-    tmp = target.with_name(f"{target.name}.{os.getpid()}.{time.monotonic_ns()}.part")
-    with open(tmp, "w") as f:
-        f.write(text)
-        f.flush()
-        os.fsync(f.fileno())
-    try:
-        os.link(tmp, target)
-        return True
-    except FileExistsError:
-        return False
-    finally:
-        tmp.unlink()
 
 
 def write_json(path: Path, data: dict) -> None:

@@ -98,28 +98,27 @@ def _int(text: str) -> int:
         raise argparse.ArgumentTypeError(f"not an integer: {text!r}") from None
 
 
+def _int_in(text: str, low: int, high: int | None, message: str) -> int:
+    """``text`` as an int in [low, high] (no upper end when ``high`` is None), else ``message``."""
+    v = _int(text)
+    if v < low or (high is not None and v > high):
+        raise argparse.ArgumentTypeError(f"{message}: {text}")
+    return v
+
+
 def positive_int(text: str) -> int:
     """argparse type: an int in [1, :data:`MAX_COUNT`]."""
-    v = _int(text)
-    if not 0 < v <= MAX_COUNT:
-        raise argparse.ArgumentTypeError(f"must be a positive integer <= {MAX_COUNT:.0e}: {text}")
-    return v
+    return _int_in(text, 1, MAX_COUNT, f"must be a positive integer <= {MAX_COUNT:.0e}")
 
 
 def count(text: str) -> int:
     """argparse type: an int in [0, :data:`MAX_COUNT`] (0 meaning "off" where the option says so)."""
-    v = _int(text)
-    if not 0 <= v <= MAX_COUNT:
-        raise argparse.ArgumentTypeError(f"must be an integer in [0, {MAX_COUNT:.0e}]: {text}")
-    return v
+    return _int_in(text, 0, MAX_COUNT, f"must be an integer in [0, {MAX_COUNT:.0e}]")
 
 
 def index(text: str) -> int:
     """argparse type: an index >= 0 (a negative one is refused, not counted from the end)."""
-    v = _int(text)
-    if v < 0:
-        raise argparse.ArgumentTypeError(f"must be an index >= 0: {text}")
-    return v
+    return _int_in(text, 0, None, "must be an index >= 0")
 
 
 def angle(text: str) -> float:
@@ -164,10 +163,7 @@ def numpy_seed(text: str) -> int:
     """argparse type: a seed for numpy only (no OMPL), an integer in [0, 2**32 - 1]."""
     from ..validation import MAX_SEED
 
-    v = _int(text)
-    if not 0 <= v <= MAX_SEED:
-        raise argparse.ArgumentTypeError(f"must be an integer in [0, {MAX_SEED}]: {text}")
-    return v
+    return _int_in(text, 0, MAX_SEED, f"must be an integer in [0, {MAX_SEED}]")
 
 
 def sector(text: str) -> int:
