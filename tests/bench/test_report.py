@@ -1,12 +1,15 @@
-"""Report: per-query ratios, success counting (failures never dropped), lower-bound figures."""
+"""Report: per-query ratios, success counting (failures never dropped), lower-bound figures, anytime quality."""
 
 from __future__ import annotations
 
+import csv
 import math
 
 import pytest
 
-from tpee_ompl.bench.report import PAPER_TABLE4, length_quality_table, ratio_table, success_table, summarize
+from tpee_ompl.bench import report
+from tpee_ompl.bench.report import (PAPER_TABLE4, anytime_quality_table, best_found, length_quality_table, ratio_table,
+                                    success_table, summarize)
 
 
 def run(planner, qid, cap, time, length, l12, l34, ok=True, straight=1.0):
@@ -53,3 +56,78 @@ def test_summarize_ignores_non_finite_values_and_handles_empty_input():
     s = summarize([1.0, 2.0, 3.0, math.inf, None])
     assert s["n"] == 3 and s["median"] == 2.0 and s["q1"] == 1.5
     assert summarize([])["n"] == 0 and math.isnan(summarize([])["mean"])
+
+
+# --------------------------------------------------------------------------- anytime: first path, best found, within 5 %
+def anytime(planner, qid, length, first=None, time=1.0, budget=1.0):
+    """An anytime run; ``length=None`` is a failed run."""
+    return {**run(planner, qid, 0, time, length, None, None, ok=length is not None), "comparison": "anytime",
+            "time_budget": budget, "first_solution_time": first}
+
+
+def anytime_campaign():
+    """Queries 0-4 at budget 1 s; A, B and C (never succeeds); q4 has only C's run; q3's best is an iteration run."""
+    return [
+        anytime("A", 0, 2.0, first=0.1), anytime("B", 0, 2.1, first=0.05), anytime("C", 0, None),
+        anytime("A", 1, 3.0, first=0.3), anytime("B", 1, 3.0, first=0.15), anytime("C", 1, None),
+        anytime("A", 2, None), anytime("B", 2, 4.0, time=0.9), anytime("C", 2, None),
+        anytime("A", 3, 5.5, first=0.2), anytime("B", 3, 5.0, time=0.5), anytime("C", 3, None),
+        anytime("C", 4, None),
+        run("D", 3, 500, 1.0, 4.8, 1.0, 1.0),
+    ]
+
+
+def test_anytime_quality_counts_failures_and_missing_runs_as_not_within_and_ties_as_within():
+    t = {r["planner"]: r for r in anytime_quality_table(anytime_campaign())}
+    assert {r["queries"] for r in t.values()} == {5}
+    # A: q0 = best, q1 ties B at best, q2 failed, q3 5.5 / 4.8 > 1.05, q4 no run
+    assert (t["A"]["success"], t["A"]["runs"], t["A"]["within"]) == (3, 4, 2)
+    assert t["A"]["within_share"] == pytest.approx(2 / 5)
+    assert t["A"]["vs_best_median"] == pytest.approx(1.0) and t["A"]["vs_best_q3"] == pytest.approx((1 + 5.5 / 4.8) / 2)
+    # B: q0 exactly 1.05 x best (within), q1 tie, q2 its own best, q3 5.0 / 4.8
+    assert t["B"]["within"] == 4 and t["B"]["within_share"] == pytest.approx(4 / 5)
+    assert t["B"]["vs_best_median"] == pytest.approx((1.0 + 5.0 / 4.8) / 2)
+    # C never succeeds: no medians, nothing within
+    assert (t["C"]["success"], t["C"]["runs"]) == (0, 5) and t["C"]["within"] == 0 and t["C"]["within_share"] == 0
+    assert math.isnan(t["C"]["first_time_median"]) and math.isnan(t["C"]["vs_best_median"])
+
+
+def test_first_path_time_falls_back_to_the_run_time_and_says_how_often():
+    t = {r["planner"]: r for r in anytime_quality_table(anytime_campaign())}
+    assert t["A"]["first_time_median"] == pytest.approx(0.2) and t["A"]["first_time_from_run_time"] == 0
+    # B: recorded 0.05 and 0.15, none for q2 and q3: their run times 0.9 and 0.5 (upper bounds)
+    assert t["B"]["first_time_median"] == pytest.approx((0.15 + 0.5) / 2) and t["B"]["first_time_from_run_time"] == 2
+    assert t["A"]["first_time_at_run_end"] == t["B"]["first_time_at_run_end"] == 0
+
+
+def test_a_first_path_time_recorded_at_the_end_of_the_run_is_marked():
+    runs = [anytime("E", 0, 2.0, first=0.5, time=0.5), anytime("E", 1, 2.0, first=0.498, time=0.5),
+            anytime("E", 2, 2.0, first=0.3, time=0.5), anytime("E", 3, None, first=0.5, time=0.5)]
+    (row,) = anytime_quality_table(runs)
+    assert row["first_time_at_run_end"] == 2 and row["first_time_from_run_time"] == 0
+    assert row["first_time_median"] == pytest.approx(0.498)
+
+
+def test_within_share_averages_a_querys_runs_and_is_per_budget():
+    runs = [anytime("A", 0, 2.0), anytime("A", 0, 3.0), anytime("A", 1, 1.0),
+            anytime("A", 0, 2.0, budget=0.1), anytime("A", 1, None, budget=0.1)]
+    t = {r["budget"]: r for r in anytime_quality_table(runs)}
+    assert t[1.0]["within"] == pytest.approx(1.5) and t[1.0]["within_share"] == pytest.approx(0.75)
+    assert t[0.1]["within"] == 1 and t[0.1]["within_share"] == pytest.approx(0.5)
+
+
+def test_best_found_is_the_shortest_successful_path_of_any_planner_and_comparison():
+    assert best_found(anytime_campaign()) == {"0": 2.0, "1": 3.0, "2": 4.0, "3": 4.8}
+
+
+def test_report_has_the_anytime_quality_section_and_csv(tmp_path, monkeypatch):
+    runs = anytime_campaign()
+    monkeypatch.setattr(report, "load_runs", lambda db: runs)
+    out = report.write_report(tmp_path / "unused.db", tmp_path, planner="A", reference="B")
+    text = out["markdown_text"]
+    assert "## Anytime comparison: time to the first exact path and length against the best found" in text
+    assert "| 1 | B | 4/4 | 0.325 (2 from run time) | 1.021 [1.000, 1.044] | 4/5 (0.80) |" in text
+    assert "| 1 | C | 0/5 | – | – [–, –] | 0/5 (0.00) |" in text
+    with open(out["anytime_quality"]) as f:
+        rows = {r["planner"]: r for r in csv.DictReader(f)}
+    assert float(rows["A"]["within_share"]) == pytest.approx(0.4) and rows["A"]["queries"] == "5"

@@ -25,7 +25,10 @@ from ..files import atomic_path, atomic_write_text
 __all__ = [
     "PAPER_TABLE4",
     "RATIO_METRICS",
+    "WITHIN_BEST",
+    "anytime_quality_table",
     "anytime_table",
+    "best_found",
     "length_quality_table",
     "load_runs",
     "ratio_table",
@@ -169,17 +172,23 @@ def _setting(r: dict) -> str:
     return f"T={float(r['time_budget']):g}s"
 
 
+def best_found(runs: list[dict]) -> dict:
+    """Query id -> the shortest successful raw path (rad) any planner found for it anywhere in ``runs``."""
+    best: dict = {}
+    for r in runs:
+        if r["success"]:
+            q = r["query_id"]
+            best[q] = min(best.get(q, math.inf), float(r["solution_length"]))
+    return best
+
+
 def length_quality_table(runs: list[dict]) -> list[dict]:
     """Each planner's raw length relative to the straight start-goal segment and to the best path found.
 
     ``best`` is the shortest successful raw path any planner found for that query anywhere in the
     campaign.  Per comparison, validator, cap/budget and planner: median and quartiles.
     """
-    best: dict = {}
-    for r in runs:
-        if r["success"]:
-            q = r["query_id"]
-            best[q] = min(best.get(q, math.inf), float(r["solution_length"]))
+    best = best_found(runs)
     groups = defaultdict(list)
     for r in runs:
         groups[(r["comparison"], r["motion_validator"], _setting(r), r["planner"])].append(r)
@@ -209,6 +218,56 @@ def anytime_table(runs: list[dict]) -> list[dict]:
         s = summarize([float(r["solution_length"]) for r in rs if r["success"]])
         out.append({"budget": b, "planner": planner, "runs": len(rs), "success": s["n"], "cost_median": s["median"],
                     "cost_q1": s["q1"], "cost_q3": s["q3"]})
+    return out
+
+
+WITHIN_BEST = 1.05
+"""A path is *within 5 % of the best found* when its raw length <= ``WITHIN_BEST`` x the best found."""
+
+
+def anytime_quality_table(runs: list[dict], within: float = WITHIN_BEST) -> list[dict]:
+    """Per anytime budget and planner: success, time to the first exact path, length / best found, share within 5 %.
+
+    * ``first_time_median``: median over successful runs of ``first_solution_time``; a successful run
+      that recorded none (a native planner exposing no cost) contributes its run time, an upper bound
+      (it ended with an exact path), counted in ``first_time_from_run_time``; ``first_time_at_run_end``
+      counts the other runs whose recorded time is the end of the run (within 1 %: a planner whose
+      cost is read only after its run), also upper bounds;
+    * ``vs_best_*``: raw length / :func:`best_found` (over the whole campaign) of successful runs;
+    * ``within_share``: the mean over the budget's queries (every query of that budget's experiments, any
+      planner) of the fraction of this planner's runs on it that succeeded with length <= ``within`` x
+      best found; failed and missing runs count as not within.  ``within`` is that sum (with one run per
+      query: the number of queries within), ``queries`` the denominator.
+    """
+    best = best_found(runs)
+    anytime = [r for r in runs if r["comparison"] == "anytime"]
+    queries: dict[float, set] = defaultdict(set)
+    groups: dict[tuple, list] = defaultdict(list)
+    for r in anytime:
+        b = float(r["time_budget"])
+        queries[b].add(r["query_id"])
+        groups[(b, r["planner"])].append(r)
+    out = []
+    for (b, planner), rs in sorted(groups.items()):
+        ok = [r for r in rs if r["success"]]
+        recorded = [(float(r["first_solution_time"]), float(r["time"])) for r in ok
+                    if r["first_solution_time"] is not None and math.isfinite(float(r["first_solution_time"]))]
+        fallback = [float(r["time"]) for r in ok
+                    if r["first_solution_time"] is None or not math.isfinite(float(r["first_solution_time"]))]
+        first = summarize([t for t, _ in recorded] + fallback)
+        at_end = sum(1 for t, end in recorded if t >= end - max(0.01 * end, 1e-3))
+        bf = summarize([float(r["solution_length"]) / best[r["query_id"]] for r in ok if best.get(r["query_id"])])
+        per_query: dict = defaultdict(list)
+        for r in rs:
+            per_query[r["query_id"]].append(
+                bool(r["success"]) and float(r["solution_length"]) <= within * best[r["query_id"]])
+        n_within = sum(sum(v) / len(v) for v in per_query.values())
+        n_q = len(queries[b])
+        out.append({"budget": b, "planner": planner, "runs": len(rs), "success": len(ok), "queries": n_q,
+                    "first_time_median": first["median"], "first_time_from_run_time": len(fallback),
+                    "first_time_at_run_end": at_end,
+                    "vs_best_median": bf["median"], "vs_best_q1": bf["q1"], "vs_best_q3": bf["q3"],
+                    "within": n_within, "within_share": n_within / n_q if n_q else math.nan})
     return out
 
 
@@ -257,6 +316,35 @@ def _markdown(ratios: list[dict], succ: list[dict], quality: list[dict], anytime
     return "\n".join(lines) + "\n"
 
 
+def _anytime_quality_markdown(rows: list[dict]) -> str:
+    """The anytime section on time to the first exact path and length against the best found."""
+    if not rows:
+        return ""
+    pct = round((WITHIN_BEST - 1) * 100)
+    lines = ["", "## Anytime comparison: time to the first exact path and length against the best found", "",
+             "Success: successful runs / runs. First exact path: median over successful runs of the time the "
+             "planner first held an exact path (`first_solution_time`: the planner's own for dimension-RRT and the "
+             "library and simplifying planners; for native planners the first progress sample with a finite cost, "
+             "sampled every 0.05 s, so up to that late). Upper bounds are marked: `k from run time`, successful runs "
+             "that recorded none (RRTConnect, which stops at its first path) contribute their run time; `k at run "
+             "end`, the recorded time is the end of the run (AORRTC's cost is read only after it). "
+             "Length / best found: raw length "
+             "over the shortest successful path any planner found for that query in the campaign. "
+             f"Within {pct} %: queries whose run succeeded with length <= {WITHIN_BEST:g} x best found, over all "
+             "queries of that budget (failed or missing runs count as not within).", "",
+             "| budget (s) | planner | success / runs | first exact path, median (s) "
+             f"| length / best found, median [Q1, Q3] | within {pct} % of best found |",
+             "|---|---|---|---|---|---|"]
+    for r in rows:
+        notes = [f"{r[k]} {label}" for k, label in (("first_time_from_run_time", "from run time"),
+                                                      ("first_time_at_run_end", "at run end")) if r[k]]
+        fb = f" ({', '.join(notes)})" if notes else ""
+        lines.append(f"| {r['budget']:g} | {r['planner']} | {r['success']}/{r['runs']} | {_f(r['first_time_median'])}{fb} "
+                     f"| {_f(r['vs_best_median'])} [{_f(r['vs_best_q1'])}, {_f(r['vs_best_q3'])}] "
+                     f"| {r['within']:.3g}/{r['queries']} ({_f(r['within_share'], 2)}) |")
+    return "\n".join(lines) + "\n"
+
+
 def _write_csv(path: Path, rows: list[dict]) -> None:
     with atomic_path(path) as tmp, open(tmp, "w", newline="") as f:
         if rows:
@@ -282,7 +370,8 @@ def _lost_queries(expected: dict | None) -> str:
 
 def write_report(db_path: str | Path, directory: str | Path, expected: dict | None = None,
                  planner: str | None = None, reference: str | None = None) -> dict:
-    """Write ``report.md``, ``table4.csv``, ``success.csv``, ``length_quality.csv``, ``anytime.csv``.
+    """Write ``report.md``, ``table4.csv``, ``success.csv``, ``length_quality.csv``, ``anytime.csv``,
+    ``anytime_quality.csv``.
 
     ``planner``/``reference`` default to the campaign's first two iteration planners (or
     DimensionRRT / RRTstar).  Returns the paths and the Markdown text.
@@ -299,11 +388,14 @@ def write_report(db_path: str | Path, directory: str | Path, expected: dict | No
     succ = success_table(runs, expected)
     quality = length_quality_table(runs)
     anytime = anytime_table(runs)
-    text = _markdown(ratios, succ, quality, anytime, planner, reference, headline) + _lost_queries(expected)
+    anytime_quality = anytime_quality_table(runs)
+    text = (_markdown(ratios, succ, quality, anytime, planner, reference, headline)
+            + _anytime_quality_markdown(anytime_quality) + _lost_queries(expected))
     paths = {"markdown": directory / "report.md", "csv": directory / "table4.csv"}
     atomic_write_text(paths["markdown"], text)
     _write_csv(paths["csv"], ratios)
-    for name, rows in (("success", succ), ("length_quality", quality), ("anytime", anytime)):
+    for name, rows in (("success", succ), ("length_quality", quality), ("anytime", anytime),
+                       ("anytime_quality", anytime_quality)):
         paths[name] = directory / f"{name}.csv"
         _write_csv(paths[name], rows)
     return {**paths, "markdown_text": text, "planner": planner, "reference": reference}
