@@ -5,6 +5,9 @@
 * ``box_time.png`` / ``box_length.png``: time and raw path length per planner and sample cap.
 * ``anytime_cost.png``: median cost of successful runs vs time budget per planner, and the median
   best cost over time from the ``progress`` table.
+* ``anytime_within_best.png``: share of queries solved within 5 % of the best path found vs time
+  budget per planner (markers); dashed, where the ``progress`` table allows: the same share over
+  time inside the longest-budget runs.
 """
 
 from __future__ import annotations
@@ -113,7 +116,78 @@ def make_plots(db_path: str | Path, directory: str | Path, planner: str | None =
         _save(fig, p)
         plt.close(fig)
         out.append(p)
+        out.append(_within_best_plot(db_path, runs, directory, plt))
     return out
+
+
+def _within_best_plot(db_path, runs: list[dict], directory: Path, plt) -> Path:
+    """``anytime_within_best.png``: the report's within-5 % share per budget and planner (log time axis)."""
+    from .report import WITHIN_BEST, anytime_quality_table, best_found
+
+    rows = anytime_quality_table(runs)
+    best = best_found(runs)
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    for k, pl in enumerate(sorted({r["planner"] for r in rows})):
+        pts = sorted((r["budget"], r["within_share"]) for r in rows if r["planner"] == pl)
+        ax.plot([b for b, _ in pts], [v for _, v in pts], "o-", color=f"C{k}", label=pl)
+        t, share = _progress_within(db_path, runs, pl, best, WITHIN_BEST)
+        if t is not None:
+            ax.plot(t, share, "--", drawstyle="steps-post", color=f"C{k}", lw=1, alpha=0.6)
+    ax.set_xscale("log")
+    ax.set_ylim(-0.02, 1.02)
+    ax.set_xlabel("time budget; dashed: time in the run (s)")
+    ax.set_ylabel(f"share of queries within {round((WITHIN_BEST - 1) * 100)} % of the best found")
+    ax.set_title("markers: runs of each budget; dashed: progress inside the longest-budget runs", fontsize=9)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    p = directory / "anytime_within_best.png"
+    _save(fig, p)
+    plt.close(fig)
+    return p
+
+
+def _progress_within(db_path, runs: list[dict], planner: str, best: dict, within: float):
+    """Share of the longest budget's queries whose run's best cost is within ``within`` x best found, over time.
+
+    Only successful runs count (as in the report); a query's share is averaged over its runs. None when
+    the planner's runs have no progress rows.
+    """
+    at = [r for r in runs if r["comparison"] == "anytime"]
+    bmax = max(float(r["time_budget"]) for r in at)
+    at = [r for r in at if float(r["time_budget"]) == bmax]
+    mine = {r["id"]: r for r in at if r["planner"] == planner}
+    con = sqlite3.connect(str(db_path))
+    try:
+        pcols = {r[1] for r in con.execute("PRAGMA table_info(progress)")}
+        if not mine or not {"runid", "time", "best_cost"} <= pcols:
+            return None, None
+        marks = ",".join("?" * len(mine))
+        rows = con.execute(f"SELECT runid, time, best_cost FROM progress WHERE runid IN ({marks}) "
+                           "ORDER BY runid, time", list(mine)).fetchall()
+    finally:
+        con.close()
+    if not rows:
+        return None, None
+    series = defaultdict(list)
+    for rid, t, c in rows:
+        if t is not None:
+            series[rid].append((float(t), math.inf if c is None else float(c)))
+    per_query = defaultdict(int)
+    for r in mine.values():
+        per_query[r["query_id"]] += 1
+    times = [t for pts in series.values() for t, c in pts if t > 0 and math.isfinite(c)]
+    t_end = max([bmax] + [t for pts in series.values() for t, _ in pts])  # runs overshoot their budget a little
+    grid = np.geomspace(min(times, default=bmax / 100), t_end, 120)
+    share = np.zeros_like(grid)
+    for rid, pts in series.items():
+        r = mine[rid]
+        if not r["success"] or r["query_id"] not in best:
+            continue
+        ts, cs = np.array([p[0] for p in pts]), np.array([p[1] for p in pts])
+        idx = np.searchsorted(ts, grid, side="right") - 1
+        cost = np.where(idx >= 0, cs[np.clip(idx, 0, None)], math.inf)
+        share += (cost <= within * best[r["query_id"]]) / per_query[r["query_id"]]
+    return grid, share / len({r["query_id"] for r in at})
 
 
 def _progress_median(db_path, planner: str):
