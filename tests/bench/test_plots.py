@@ -1,4 +1,4 @@
-"""Plots: the anytime within-5 % figure from a small Planner-Arena database (sectors 0, as for a problem other than the wearer)."""
+"""Plots: the anytime within-5 % figure from a small Planner-Arena database (sectors 0, as for other problems)."""
 
 from __future__ import annotations
 

@@ -339,7 +339,8 @@ def _anytime_quality_markdown(rows: list[dict]) -> str:
         notes = [f"{r[k]} {label}" for k, label in (("first_time_from_run_time", "from run time"),
                                                       ("first_time_at_run_end", "at run end")) if r[k]]
         fb = f" ({', '.join(notes)})" if notes else ""
-        lines.append(f"| {r['budget']:g} | {r['planner']} | {r['success']}/{r['runs']} | {_f(r['first_time_median'])}{fb} "
+        lines.append(f"| {r['budget']:g} | {r['planner']} | {r['success']}/{r['runs']} "
+                     f"| {_f(r['first_time_median'])}{fb} "
                      f"| {_f(r['vs_best_median'])} [{_f(r['vs_best_q1'])}, {_f(r['vs_best_q3'])}] "
                      f"| {r['within']:.3g}/{r['queries']} ({_f(r['within_share'], 2)}) |")
     return "\n".join(lines) + "\n"
