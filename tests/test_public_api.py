@@ -14,7 +14,8 @@ def test_every_name_in_all_is_importable_from_the_top_level():
 
 def test_the_headline_names_are_exported():
     for name in ("WearerArm", "DimensionRRT", "DimensionRRTOptions", "tpee_dimension_rrt", "make_simple_setup",
-                 "PathLibrary", "Tracker", "aim", "aim_batch", "aim_checked", "load_queries"):
+                 "PathLibrary", "Tracker", "aim", "aim_batch", "aim_checked", "load_queries",
+                 "RobotChecker", "Obstacle", "panda_shelf", "RobotValidityChecker", "load_joint_query_set"):
         assert name in tpee_ompl.__all__, name
 
 

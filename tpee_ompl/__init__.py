@@ -19,7 +19,11 @@ from .library import (
     make_default_planner,
 )
 from .model.pointing import AimingError, BlindAreaError, UnreachableTargetError, aim, aim_batch, aim_checked
+from .model.joint_queries import JointQuery, load_joint_query_set
+from .model.obstacles import Obstacle
 from .model.queries import Query, QuerySetError, load_queries
+from .model.robot_checker import RobotChecker
+from .model.robots import panda_shelf
 from .model.sectors import (
     CROSS_SECTOR_TRAJECTORIES,
     POSTURE_PRESETS,
@@ -33,7 +37,13 @@ from .model.sectors import (
 from .model.wearer_arm import WearerArm, default_robot
 from .planning.dimension_rrt import DimensionRRT, DimensionRRTOptions
 from .planning.paths import array_to_path, motion_states, path_length, path_to_array
-from .planning.setup import BatchedMotionValidator, WearerValidityChecker, make_simple_setup, make_space
+from .planning.setup import (
+    BatchedMotionValidator,
+    RobotValidityChecker,
+    WearerValidityChecker,
+    make_simple_setup,
+    make_space,
+)
 from .planning.tpee import tpee_dimension_rrt
 
 __all__ = [
@@ -46,7 +56,14 @@ __all__ = [
     "make_simple_setup",
     "make_space",
     "WearerValidityChecker",
+    "RobotValidityChecker",
     "BatchedMotionValidator",
+    # any URDF robot among obstacles
+    "RobotChecker",
+    "Obstacle",
+    "panda_shelf",
+    "JointQuery",
+    "load_joint_query_set",
     # aiming, sectors, queries
     "aim",
     "aim_batch",

@@ -135,3 +135,32 @@ def test_motion_check_step_is_the_setups_joint_step(robot, joint_step):
 def test_motion_check_step_refuses_other_objects():
     with pytest.raises(ValueError, match="SimpleSetup or ob.SpaceInformation"):
         motion_check_step(0.01)
+
+
+def test_the_validity_checker_is_generic_and_keeps_its_wearer_name():
+    from tpee_ompl.planning.setup import RobotValidityChecker, WearerValidityChecker
+
+    assert WearerValidityChecker is RobotValidityChecker
+
+
+def test_make_simple_setup_plans_for_the_panda_shelf():
+    pytest.importorskip("example_robot_data", reason="install the optional 'robots' extra")
+    from ompl import geometric as og
+
+    from tpee_ompl.model.joint_queries import load_joint_query_set
+    from tpee_ompl.model.robots import panda_shelf
+
+    checker = panda_shelf(n_threads=2)
+    q = load_joint_query_set("panda_shelf", checker)[0][0]
+    ss = make_simple_setup(checker, q.start, q.goal, batched_motion_validator=True)
+    assert ss.getSpaceInformation().getStateDimension() == 7
+    assert not ss.getSpaceInformation().checkMotion(_state(ss, q.start), _state(ss, q.goal))  # straight line collides
+    ss.setPlanner(og.RRTConnect(ss.getSpaceInformation()))
+    ss.solve(0.05)  # runs through the batched validator without error, solved or not
+
+
+def _state(ss, values):
+    s = ss.getSpaceInformation().allocState()
+    for i, v in enumerate(values):
+        s[i] = float(v)
+    return s

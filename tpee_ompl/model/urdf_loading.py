@@ -1,4 +1,4 @@
-"""Reading the wearer's URDF and SRDF into Pinocchio and Coal models, refusing what would load wrongly.
+"""Reading a URDF and SRDF (the wearer's or any robot's) into Pinocchio and Coal models, refusing what would load wrongly.
 
 urdfdom drops ``<capsule>`` silently and Coal gives wrong answers for zero or non-finite sizes, so
 every ``<collision>`` element must become a geometry, every URDF cylinder becomes a Coal capsule
@@ -8,7 +8,11 @@ every ``<collision>`` element must become a geometry, every URDF cylinder become
 from __future__ import annotations
 
 import hashlib
+import math
+import numbers
+import os
 import xml.etree.ElementTree as ET
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -16,7 +20,18 @@ import coal
 import numpy as np
 import pinocchio as pin
 
-__all__ = ["ARM_JOINTS", "MUZZLE_FRAME", "LoadedModel", "ModelFiles", "bounding_radius", "load_wearer_model"]
+from .obstacles import Obstacle
+
+__all__ = [
+    "ARM_JOINTS",
+    "MUZZLE_FRAME",
+    "LoadedModel",
+    "ModelFiles",
+    "bounding_radius",
+    "is_prismatic",
+    "load_urdf_model",
+    "load_wearer_model",
+]
 
 ARM_JOINTS = ("j1", "j2", "j3", "j4")
 """Joint names in configuration order: DOF1 (about x), DOF2 (about -y), pan, tilt."""
@@ -74,14 +89,8 @@ def bounding_radius(geom: coal.CollisionGeometry) -> float:
         return float(np.linalg.norm(geom.halfSide))
     if isinstance(geom, coal.Cylinder):
         return float(np.hypot(geom.radius, geom.halfLength))
-    geom.computeLocalAABB()
-    return float(geom.aabb_radius)
-
-
-@dataclass(frozen=True)
-class _LoadedFiles:
-    urdf: Path
-    srdf: Path | None
+    geom.computeLocalAABB()  # meshes and other shapes: the AABB's sphere, which need not be centred
+    return float(np.linalg.norm(geom.aabb_center) + geom.aabb_radius)
 
 
 def load_wearer_model(urdf: Path, srdf: Path | None) -> LoadedModel:
@@ -94,53 +103,135 @@ def load_wearer_model(urdf: Path, srdf: Path | None) -> LoadedModel:
     ValueError
         A malformed file, ``<capsule>``, missing joints or frame, unsupported shapes, bad sizes or limits.
     """
-    if not urdf.is_file():
-        raise FileNotFoundError(f"URDF file not found: {urdf}")
-    text = _read_text(urdf, "URDF")
-    try:
-        root = ET.fromstring(text)
-    except ET.ParseError as exc:
-        raise ValueError(f"malformed URDF {urdf}: {exc}") from exc
-    if root.tag != "robot":
-        raise ValueError(f"malformed URDF {urdf}: root element is <{root.tag}>, expected <robot>")
-    if any(c.tag == "capsule" for c in root.iter()):
-        raise ValueError(f"URDF {urdf} uses <capsule>, which urdfdom drops silently; use <cylinder> (loaded as capsules)")
+    root = _parse_urdf(urdf)
     joints = {j.get("name"): j.get("type") for j in root.iter("joint")}
     for name in ARM_JOINTS:
         if joints.get(name) != "revolute":
             raise ValueError(f"URDF {urdf} lacks revolute joint {name!r} (found: {sorted(k for k in joints if k)})")
     if MUZZLE_FRAME not in {link.get("name") for link in root.iter("link")}:
         raise ValueError(f"URDF {urdf} lacks the {MUZZLE_FRAME!r} link")
+    loaded = load_urdf_model(urdf, srdf)
+    if tuple(loaded.model.names[1:]) != ARM_JOINTS:
+        raise ValueError(f"URDF {urdf}: moving joints must be exactly {ARM_JOINTS}, got {tuple(loaded.model.names[1:])}")
+    return loaded
+
+
+def _parse_urdf(urdf: Path) -> ET.Element:
+    if not urdf.is_file():
+        raise FileNotFoundError(f"URDF file not found: {urdf}")
+    try:
+        root = ET.fromstring(_read_text(urdf, "URDF"))
+    except ET.ParseError as exc:
+        raise ValueError(f"malformed URDF {urdf}: {exc}") from exc
+    if root.tag != "robot":
+        raise ValueError(f"malformed URDF {urdf}: root element is <{root.tag}>, expected <robot>")
+    if any(c.tag == "capsule" for c in root.iter()):
+        raise ValueError(f"URDF {urdf} uses <capsule>, which urdfdom drops silently; use <cylinder> (loaded as capsules)")
+    return root
+
+
+def load_urdf_model(
+    urdf: Path,
+    srdf: Path | None = None,
+    *,
+    package_dirs: Sequence[str | os.PathLike] = (),
+    cylinders_as_capsules: bool = True,
+    locked: Mapping[str, float] | None = None,
+    obstacles: Sequence[Obstacle] = (),
+) -> LoadedModel:
+    """Load any URDF (+ SRDF) for collision checking: every ``<collision>`` becomes a geometry.
+
+    ``locked`` joints are removed (``pin.buildReducedModel``, fixed at the given values); the
+    remaining joints must be 1-DOF (revolute or prismatic) with finite limits.  With
+    ``cylinders_as_capsules`` (default, the wearer's rule in ``urdf/README.md``) every URDF cylinder
+    becomes a Coal capsule of the same radius and length.  Obstacles go on the universe joint.
+    Collision pairs: every pair of geometries on different joints (so never obstacle-obstacle or
+    obstacle-base), minus the SRDF's disabled link pairs.  The model hash covers the URDF and SRDF
+    texts and, when given, the locked values, obstacles and a ``cylinders_as_capsules=False``.
+
+    Raises FileNotFoundError (a missing file) or ValueError (anything that would load wrongly).
+    """
+    root = _parse_urdf(urdf)
+    text = _read_text(urdf, "URDF")
     n_collision_elements = sum(1 for _ in root.iter("collision"))
     digest = hashlib.sha256(text.encode())
     if srdf is not None and srdf.is_file():
         digest.update(srdf.read_bytes())
-
+    dirs = [str(d) for d in package_dirs]
     try:
         model = pin.buildModelFromXML(text)
-        gmodel = pin.buildGeomFromUrdfString(model, text, pin.GeometryType.COLLISION)
+        gmodel = pin.buildGeomFromUrdfString(model, text, pin.GeometryType.COLLISION, package_dirs=dirs)
     except Exception as exc:  # the bindings raise RuntimeError/ValueError with C++ text
         raise ValueError(f"Pinocchio could not load URDF {urdf}: {exc}") from exc
-    if tuple(model.names[1:]) != ARM_JOINTS:
-        raise ValueError(f"URDF {urdf}: moving joints must be exactly {ARM_JOINTS}, got {tuple(model.names[1:])}")
     if gmodel.ngeoms != n_collision_elements:
         raise ValueError(
             f"URDF {urdf}: {n_collision_elements} <collision> elements but only "
             f"{gmodel.ngeoms} geometries were loaded (unsupported shape?)"
         )
-    lo, hi = model.lowerPositionLimit, model.upperPositionLimit
-    for k, name in enumerate(ARM_JOINTS):
-        if not (np.isfinite(lo[k]) and np.isfinite(hi[k]) and lo[k] < hi[k]):
-            raise ValueError(f"URDF {urdf}: joint {name!r} has limits [{lo[k]}, {hi[k]}] (need finite lower < upper)")
-    for go in gmodel.geometryObjects:  # every URDF cylinder is a capsule (urdf/README.md)
+    extra = []
+    if locked:
+        model, gmodel = _lock_joints(model, gmodel, locked, urdf)
+        extra.append("locked=" + ",".join(f"{k}={float(v)!r}" for k, v in sorted(locked.items())))
+    _check_joints(model, urdf)
+    for go in gmodel.geometryObjects:
         _check_shape_sizes(go.geometry, go.name, urdf)
-        if isinstance(go.geometry, coal.Cylinder):
+        if cylinders_as_capsules and isinstance(go.geometry, coal.Cylinder):
             go.geometry = coal.Capsule(go.geometry.radius, 2.0 * go.geometry.halfLength)
-
+    if not cylinders_as_capsules:
+        extra.append("cylinders_as_capsules=False")
+    names = {go.name for go in gmodel.geometryObjects}
+    for ob in obstacles:
+        if not isinstance(ob, Obstacle):
+            raise ValueError(f"obstacles must be Obstacle instances, got {ob!r}")
+        if ob.name in names:
+            raise ValueError(f"obstacle name {ob.name!r} is already a geometry name")
+        names.add(ob.name)
+        gmodel.addGeometryObject(pin.GeometryObject(ob.name, 0, 0, ob.placement, ob.geometry()))
+        extra.append("obstacle=" + ob.describe())
+    for e in extra:
+        digest.update(("\n" + e).encode())
     gmodel.addAllCollisionPairs()
     if srdf is not None:
         _apply_srdf(model, gmodel, srdf)
     return LoadedModel(model, gmodel, digest.hexdigest()[:16])
+
+
+def _lock_joints(model: pin.Model, gmodel: pin.GeometryModel, locked: Mapping[str, float], urdf: Path):
+    """The reduced models with ``locked`` joints fixed at their values (checked against the limits)."""
+    q = pin.neutral(model)
+    ids = []
+    for name, value in locked.items():
+        jid = model.getJointId(name) if isinstance(name, str) else model.njoints
+        if jid >= model.njoints or jid == 0:
+            raise ValueError(f"locked names unknown joint {name!r} of URDF {urdf} (joints: {list(model.names[1:])})")
+        j = model.joints[jid]
+        if j.nq != 1:
+            raise ValueError(f"locked joint {name!r} has {j.nq} position values; only 1-DOF joints can be locked")
+        if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(value):
+            raise ValueError(f"locked[{name!r}] must be a finite number, got {value!r}")
+        lo, hi = model.lowerPositionLimit[j.idx_q], model.upperPositionLimit[j.idx_q]
+        if not lo <= value <= hi:
+            raise ValueError(f"locked[{name!r}] = {value} is outside the joint limits [{lo}, {hi}]")
+        q[j.idx_q] = float(value)
+        ids.append(jid)
+    return pin.buildReducedModel(model, gmodel, sorted(ids), q)
+
+
+def _check_joints(model: pin.Model, urdf: Path) -> None:
+    """Every planned joint is 1-DOF (revolute or prismatic) with finite limits."""
+    for jid in range(1, model.njoints):
+        j, name = model.joints[jid], model.names[jid]
+        if j.nq != 1 or j.nv != 1:
+            raise ValueError(f"URDF {urdf}: joint {name!r} ({j.shortname()}) is not a 1-DOF joint with limits; "
+                             "lock it (locked={name: value})")
+        lo, hi = model.lowerPositionLimit[j.idx_q], model.upperPositionLimit[j.idx_q]
+        if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi):
+            raise ValueError(f"URDF {urdf}: joint {name!r} has limits [{lo}, {hi}] (need finite lower < upper)")
+
+
+def is_prismatic(joint: pin.JointModel) -> bool:
+    """True for a prismatic joint (its coordinate is in metres, not radians)."""
+    return joint.shortname().startswith("JointModelP")
 
 
 def _apply_srdf(model: pin.Model, gmodel: pin.GeometryModel, srdf: Path) -> None:

@@ -1,15 +1,17 @@
-"""OMPL problem set-up for the wearer + arm: state space, validity checking, motion checking.
+"""OMPL problem set-up for any :class:`RobotChecker` (the wearer + arm included): state space,
+validity checking, motion checking.
 
-The state space is ``ob.RealVectorStateSpace(4)`` bounded by the URDF joint limits; its metric
+The state space is ``ob.RealVectorStateSpace(nq)`` bounded by the URDF joint limits; its metric
 (the Euclidean norm of joint differences, radians) is the path-length metric for every planner.
 
 Motion-check guarantee
 ----------------------
 A motion is checked at states no more than ``robot.max_joint_step()`` apart (Euclidean, rad),
-which moves no point of the arm more than the security margin m (lever-arm bound, see
-:meth:`WearerArm.max_joint_step`).  Every checked state keeps all pairs at least m apart, so any
+which moves no point of the robot more than the security margin m (lever-arm bound, see
+:meth:`RobotChecker.max_joint_step`).  Every checked state keeps all pairs at least m apart, so any
 state in between is within m/2 of a checked one: **every point of an accepted motion keeps at
-least m/2 (1 cm by default) from the wearer and from the arm's own non-adjacent links.**
+least m/2 (1 cm by default) from the static world (wearer, obstacles) and from the robot's own
+checked links.**
 """
 
 from __future__ import annotations
@@ -20,11 +22,12 @@ import numpy as np
 from ompl import base as ob
 from ompl import geometric as og
 
-from ..model.wearer_arm import WearerArm
+from ..model.robot_checker import RobotChecker
 from ..validation import check_number
 from .paths import MIN_JOINT_STEP, motion_states, set_state, state_to_array
 
 __all__ = [
+    "RobotValidityChecker",
     "WearerValidityChecker",
     "BatchedMotionValidator",
     "make_space",
@@ -33,13 +36,13 @@ __all__ = [
 ]
 
 
-class WearerValidityChecker(ob.StateValidityChecker):
-    """State validity for OMPL: joint limits plus collision checking by the :class:`WearerArm`.
+class RobotValidityChecker(ob.StateValidityChecker):
+    """State validity for OMPL: joint limits plus collision checking by a :class:`RobotChecker`.
 
     ``are_valid`` offers the batched check to planners that know about it (dimension-RRT).
     """
 
-    def __init__(self, si: ob.SpaceInformation, robot: WearerArm) -> None:
+    def __init__(self, si: ob.SpaceInformation, robot: RobotChecker) -> None:
         super().__init__(si)
         self.robot = robot
         self._indices = range(robot.nq)
@@ -53,6 +56,10 @@ class WearerValidityChecker(ob.StateValidityChecker):
         return self.robot.are_valid(Q)
 
 
+WearerValidityChecker = RobotValidityChecker
+"""The name :class:`RobotValidityChecker` had when only the wearer was checked (kept for existing code)."""
+
+
 class BatchedMotionValidator(ob.MotionValidator):
     """Checks a whole straight motion with one batched Pinocchio call.
 
@@ -62,7 +69,7 @@ class BatchedMotionValidator(ob.MotionValidator):
     ``correct_solution_strict`` column, which then really checks 4x more densely.
     """
 
-    def __init__(self, si: ob.SpaceInformation, robot: WearerArm, step: float) -> None:
+    def __init__(self, si: ob.SpaceInformation, robot: RobotChecker, step: float) -> None:
         super().__init__(si)
         self.robot = robot
         self.step = float(step)
@@ -94,7 +101,7 @@ class BatchedMotionValidator(ob.MotionValidator):
         return np.array([ok[bounds[k] : bounds[k + 1]].all() for k in range(len(chunks))], dtype=bool)
 
 
-def make_space(robot: WearerArm) -> ob.RealVectorStateSpace:
+def make_space(robot: RobotChecker) -> ob.RealVectorStateSpace:
     """A RealVector state space bounded by the URDF joint limits (radians)."""
     space = ob.RealVectorStateSpace(robot.nq)
     bounds = ob.RealVectorBounds(robot.nq)
@@ -106,7 +113,7 @@ def make_space(robot: WearerArm) -> ob.RealVectorStateSpace:
 
 
 def make_simple_setup(
-    robot: WearerArm,
+    robot: RobotChecker,
     start: Sequence[float] | None = None,
     goal: Sequence[float] | None = None,
     *,
@@ -114,12 +121,13 @@ def make_simple_setup(
     batched_motion_validator: bool = True,
     check_endpoints: bool = True,
 ) -> og.SimpleSetup:
-    """Build an ``og.SimpleSetup`` for the arm, optionally with start and goal configurations.
+    """Build an ``og.SimpleSetup`` for a robot, optionally with start and goal configurations.
 
     Parameters
     ----------
-    robot : WearerArm
-    start, goal : sequence of 4 floats, radians, optional
+    robot : RobotChecker
+        Any checker: a :class:`~tpee_ompl.model.wearer_arm.WearerArm`, the Panda, another URDF.
+    start, goal : sequence of nq floats (radians, metres for prismatic joints), optional
     joint_step : float, radians
         Longest joint-space step between checked states (default ``robot.max_joint_step()``,
         the guarantee in the module docstring).
@@ -141,7 +149,7 @@ def make_simple_setup(
         step = robot.max_joint_step()
     ss = og.SimpleSetup(space)
     si = ss.getSpaceInformation()
-    checker = WearerValidityChecker(si, robot)
+    checker = RobotValidityChecker(si, robot)
     ss.setStateValidityChecker(checker)
     si.setStateValidityCheckingResolution(step / extent)
     if batched_motion_validator:

@@ -1,0 +1,117 @@
+"""Generate the Panda shelf query set (tpee_ompl/data/queries/panda_shelf.json), seeded.
+
+Each query goes from the tool point in one labelled region (a shelf compartment, or the table
+beside the shelf) to another; start and goal are collision-free and the straight joint-space
+motion between them collides (checked at the checker's max_joint_step).  Configurations come from
+position-only damped least-squares IK towards random points of each region, from random seeds.
+Finally OMPL's RRTConnect tries each query for --check-time seconds; the count is reported
+(unsolved queries are kept: a harder query is still a valid query).
+
+    PYTHONPATH=. python experiments/make_panda_queries.py
+"""
+
+from __future__ import annotations
+
+import argparse
+import itertools
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+
+from tpee_ompl.model.joint_queries import JointQuery, save_joint_queries
+from tpee_ompl.model.robots import PANDA_SHELF_REGIONS, PANDA_TOOL_FRAME, panda_region, panda_shelf
+from tpee_ompl.planning.paths import motion_states
+from tpee_ompl.resources import query_set_path
+
+
+def ik_position(checker, target: np.ndarray, q0: np.ndarray, iters: int = 80) -> np.ndarray:
+    """Damped least-squares IK of the tool point to ``target`` (position only), clipped to the limits."""
+    model, data = checker.model, checker.data
+    fid = model.getFrameId(PANDA_TOOL_FRAME)
+    q = q0.copy()
+    for _ in range(iters):
+        pin.framesForwardKinematics(model, data, q)
+        err = target - data.oMf[fid].translation
+        if np.linalg.norm(err) < 1e-3:
+            break
+        J = pin.computeFrameJacobian(model, data, q, fid, pin.LOCAL_WORLD_ALIGNED)[:3]
+        q = np.clip(q + J.T @ np.linalg.solve(J @ J.T + 1e-3 * np.eye(3), err), checker.lower, checker.upper)
+    return q
+
+
+def region_configs(checker, rng: np.random.Generator, per_region: int, attempts: int) -> dict[str, list[np.ndarray]]:
+    """Up to ``per_region`` valid configurations with the tool point in each region."""
+    out: dict[str, list[np.ndarray]] = {label: [] for label in PANDA_SHELF_REGIONS}
+    for label, (lo, hi) in PANDA_SHELF_REGIONS.items():
+        for _ in range(attempts):
+            if len(out[label]) >= per_region:
+                break
+            q0 = checker.lower + rng.random(checker.nq) * (checker.upper - checker.lower)
+            q = ik_position(checker, lo + rng.random(3) * (np.asarray(hi) - lo), q0)
+            if checker.is_valid(q) and panda_region(checker, q) == label:
+                out[label].append(q)
+    return out
+
+
+def make_queries(checker, rng: np.random.Generator, n: int, pools: dict[str, list[np.ndarray]]) -> list[JointQuery]:
+    """n queries across region pairs (round robin over shuffled pairs), straight motion colliding."""
+    labels = [k for k, v in pools.items() if v]
+    pairs = list(itertools.permutations(labels, 2))
+    rng.shuffle(pairs)
+    step = checker.max_joint_step()
+    queries: list[JointQuery] = []
+    for a, b in itertools.islice(itertools.cycle(pairs), 50 * n):
+        if len(queries) == n:
+            break
+        qa = pools[a][rng.integers(len(pools[a]))]
+        qb = pools[b][rng.integers(len(pools[b]))]
+        if checker.are_valid(motion_states(qa, qb, step)).all():
+            continue  # straight motion free: no planning needed
+        queries.append(JointQuery(len(queries), qa, qb, f"{a}->{b}"))
+    return queries
+
+
+def rrtconnect_solved(checker, queries: list[JointQuery], seconds: float) -> list[bool]:
+    """Whether OMPL's RRTConnect solves each query within ``seconds`` with make_simple_setup."""
+    from ompl import geometric as og
+    from ompl import util as ou
+
+    from tpee_ompl.planning.setup import make_simple_setup
+
+    ou.setLogLevel(ou.LOG_WARN)
+    solved = []
+    for q in queries:
+        ss = make_simple_setup(checker, q.start, q.goal)
+        ss.setPlanner(og.RRTConnect(ss.getSpaceInformation()))
+        solved.append(bool(ss.solve(seconds)) and ss.haveExactSolutionPath())
+    return solved
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--out", type=Path, default=query_set_path("panda_shelf"))
+    ap.add_argument("-n", type=int, default=30, help="number of queries")
+    ap.add_argument("--seed", type=int, default=2022)
+    ap.add_argument("--per-region", type=int, default=12)
+    ap.add_argument("--attempts", type=int, default=400, help="IK attempts per region at most")
+    ap.add_argument("--check-time", type=float, default=1.0, help="RRTConnect seconds per query (0: skip)")
+    args = ap.parse_args()
+    rng = np.random.default_rng(args.seed)
+    checker = panda_shelf(n_threads=1)
+    pools = region_configs(checker, rng, args.per_region, args.attempts)
+    print("configurations per region:", {k: len(v) for k, v in pools.items()})
+    queries = make_queries(checker, rng, args.n, pools)
+    extra = {"robot": "panda_shelf", "security_margin": checker.security_margin,
+             "regions": {k: [list(lo), list(hi)] for k, (lo, hi) in PANDA_SHELF_REGIONS.items()}}
+    if args.check_time > 0:
+        solved = rrtconnect_solved(checker, queries, args.check_time)
+        extra["rrtconnect_solved"] = {"seconds": args.check_time, "solved": sum(solved), "of": len(solved)}
+        print(f"RRTConnect solved {sum(solved)} of {len(solved)} within {args.check_time} s; unsolved ids "
+              f"{[q.id for q, s in zip(queries, solved) if not s]}")
+    save_joint_queries(args.out, queries, name="panda_shelf", seed=args.seed, checker=checker, extra=extra)
+    print(f"wrote {len(queries)} queries to {args.out}")
+
+
+if __name__ == "__main__":
+    main()

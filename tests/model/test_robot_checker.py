@@ -1,0 +1,146 @@
+"""RobotChecker: agreement with Coal, the lever-arm bound, obstacles, locked joints, bad input."""
+
+from __future__ import annotations
+
+import coal
+import numpy as np
+import pinocchio as pin
+import pytest
+
+from tests.helpers.panda import needs_panda
+from tpee_ompl.model.obstacles import Obstacle, box
+from tpee_ompl.model.robot_checker import RobotChecker
+from tpee_ompl.model.wearer_arm import WearerArm
+
+
+@pytest.fixture(scope="module")
+def panda0():
+    from tpee_ompl.model.robots import panda_shelf
+
+    return panda_shelf(n_threads=2, security_margin=0.0)
+
+
+def _coal_verdicts(checker: RobotChecker, Q: np.ndarray) -> np.ndarray:
+    """Collides per configuration from Coal's own per-pair distances after FK (no Pinocchio collision call)."""
+    out = []
+    g = checker.gmodel.geometryObjects
+    req, res = coal.DistanceRequest(), coal.DistanceResult()
+    for q in Q:
+        pin.framesForwardKinematics(checker.model, checker.data, q)
+        pin.updateGeometryPlacements(checker.model, checker.data, checker.gmodel, checker.gdata)
+        hit = False
+        for cp in checker.gmodel.collisionPairs:
+            res.clear()
+            d = coal.distance(g[cp.first].geometry, coal.Transform3s(checker.gdata.oMg[cp.first]),
+                              g[cp.second].geometry, coal.Transform3s(checker.gdata.oMg[cp.second]), req, res)
+            if d <= 0:
+                hit = True
+                break
+        out.append(hit)
+    return np.array(out)
+
+
+@needs_panda
+def test_batched_verdicts_agree_with_coal_distances_at_margin_zero(panda0):
+    rng = np.random.default_rng(3)
+    Q = panda0.lower + rng.random((300, panda0.nq)) * (panda0.upper - panda0.lower)
+    batched = panda0.are_valid(Q)
+    assert 0 < batched.sum() < len(Q)  # both verdicts occur
+    assert (batched == ~_coal_verdicts(panda0, Q)).all()
+
+
+@needs_panda
+def test_small_steps_never_move_a_geometry_point_more_than_the_lever_arm_bound(panda0):
+    rng = np.random.default_rng(4)
+    arms = panda0.lever_arms()
+    pts = []  # points on each geometry: its origin and its bounding-box corners, in the geometry frame
+    for go in panda0.gmodel.geometryObjects:
+        go.geometry.computeLocalAABB()
+        lo, hi = go.geometry.aabb_local.min_, go.geometry.aabb_local.max_
+        corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+        pts.append(np.vstack([np.zeros(3), corners]))
+
+    def world_points(q):
+        pin.framesForwardKinematics(panda0.model, panda0.data, q)
+        pin.updateGeometryPlacements(panda0.model, panda0.data, panda0.gmodel, panda0.gdata)
+        return [(panda0.gdata.oMg[i].rotation @ p.T).T + panda0.gdata.oMg[i].translation for i, p in enumerate(pts)]
+
+    for _ in range(100):
+        q = panda0.lower + rng.random(panda0.nq) * (panda0.upper - panda0.lower)
+        dq = rng.normal(size=panda0.nq) * 0.01
+        a, b = world_points(q), world_points(q + dq)
+        moved = max(np.linalg.norm(pb - pa, axis=1).max() for pa, pb in zip(a, b))
+        assert moved <= float(np.abs(dq) @ arms) + 1e-12
+    step = panda0.max_joint_step(0.01)
+    assert step == pytest.approx(0.01 / np.linalg.norm(arms))
+
+
+@needs_panda
+def test_obstacles_pair_with_moving_geometry_only_and_block_configurations(panda0):
+    g = panda0.gmodel.geometryObjects
+    static = {i for i, go in enumerate(g) if go.parentJoint == 0}
+    assert "table" in panda0.geometry_names(0)
+    for cp in panda0.gmodel.collisionPairs:
+        assert not (cp.first in static and cp.second in static)
+    from tpee_ompl.model.robots import PANDA_LOCKED, panda_files
+
+    urdf, srdf = panda_files()
+    bare = RobotChecker(urdf, srdf, security_margin=0.0, locked=PANDA_LOCKED)
+    rng = np.random.default_rng(5)
+    Q = bare.lower + rng.random((400, bare.nq)) * (bare.upper - bare.lower)
+    with_shelf, without = panda0.are_valid(Q), bare.are_valid(Q)
+    assert not (with_shelf & ~without).any()  # obstacles only remove configurations
+    assert (without & ~with_shelf).any()
+    assert bare.model_hash != panda0.model_hash
+
+
+@needs_panda
+def test_locked_joints_leave_the_planned_joints_and_keep_their_geometry(panda0):
+    assert panda0.nq == 7
+    assert all(not n.startswith("panda_finger") for n in panda0.joint_names)
+    assert "panda_leftfinger_0" in [go.name for go in panda0.gmodel.geometryObjects]
+
+
+def test_a_prismatic_chain_gets_unit_lever_arm_and_its_travel_below(tmp_path):
+    urdf = tmp_path / "slider.urdf"
+    urdf.write_text("""<robot name="s"><link name="base"/><link name="carriage"/><link name="arm">
+      <collision><origin xyz="0.3 0 0"/><geometry><sphere radius="0.05"/></geometry></collision></link>
+      <joint name="rot" type="revolute"><parent link="base"/><child link="carriage"/><axis xyz="0 0 1"/>
+        <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+      <joint name="slide" type="prismatic"><parent link="carriage"/><child link="arm"/><origin xyz="0.1 0 0"/>
+        <axis xyz="1 0 0"/><limit lower="-0.2" upper="0.4" effort="1" velocity="1"/></joint></robot>""")
+    c = RobotChecker(urdf, obstacles=[box("wall", (0.1, 1, 1), (2.0, 0, 0))])
+    np.testing.assert_allclose(c.lever_arms(), [0.1 + 0.4 + 0.3 + 0.05, 1.0])
+    assert c.pruned_pairs == 1  # the wall is beyond the reach of the rotating subtree
+    assert c.are_valid(np.array([[0.0, 0.4]])).all()
+
+
+def test_bad_input_gives_one_line_errors(tmp_path):
+    urdf = WearerArm().files.urdf
+    with pytest.raises(FileNotFoundError, match="URDF file not found"):
+        RobotChecker(tmp_path / "missing.urdf")
+    with pytest.raises(ValueError, match="locked names unknown joint 'nope'"):
+        RobotChecker(urdf, locked={"nope": 0.0})
+    with pytest.raises(ValueError, match="shape must be one of"):
+        Obstacle("o", "cone", (1.0,))
+    with pytest.raises(ValueError, match="needs 3 finite sizes"):
+        Obstacle("o", "box", (1.0, -1.0, 1.0))
+    with pytest.raises(ValueError, match="proper rotation"):
+        Obstacle("o", "sphere", (0.1,), np.diag([1.0, 1.0, -1.0, 1.0]))
+    with pytest.raises(ValueError, match="obstacles must be Obstacle"):
+        RobotChecker(urdf, obstacles=["box"])
+    with pytest.raises(ValueError, match="already a geometry name"):
+        RobotChecker(urdf, obstacles=[box("head_0", (0.1, 0.1, 0.1), (3, 0, 0))])
+    with pytest.raises(ValueError, match="outside the joint limits"):
+        RobotChecker(urdf, locked={"j1": 99.0})
+
+
+def test_an_obstacle_beside_the_wearer_blocks_the_arm_there():
+    plain = WearerArm()
+    rng = np.random.default_rng(6)
+    Q = plain.lower + rng.random((50, 4)) * (plain.upper - plain.lower)
+    q = Q[plain.are_valid(Q)][0]
+    p = plain.frame_placement(q, "muzzle").translation
+    c = RobotChecker(plain.files.urdf, plain.files.srdf, obstacles=[Obstacle("ball", "sphere", (0.05,), p)])
+    assert not c.is_valid(q)
+    assert "ball" in c.closest_pair(q)[:2]

@@ -1,0 +1,45 @@
+"""The wearer's checking answers are bit-for-bit those recorded before the generic checker existed.
+
+The oracle (tests/model/data/wearer_oracle.npz) was written by experiments/record_wearer_oracle.py
+on the code before :class:`~tpee_ompl.model.robot_checker.RobotChecker`; rerun it only on purpose.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from tpee_ompl.model.wearer_arm import WearerArm
+
+ROOT = Path(__file__).resolve().parents[2]
+ORACLE = Path(__file__).parent / "data" / "wearer_oracle.npz"
+
+
+def _recorder():
+    spec = importlib.util.spec_from_file_location("record_wearer_oracle", ROOT / "experiments/record_wearer_oracle.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+@pytest.fixture(scope="module")
+def oracle():
+    with np.load(ORACLE) as data:
+        return dict(data)
+
+
+@pytest.mark.parametrize("setting", ["default", "margin0", "links"])
+def test_wearer_answers_match_the_recorded_oracle_bit_for_bit(oracle, setting):
+    rec = _recorder()
+    robot = WearerArm(n_threads=2, **rec.SETTINGS[setting])
+    now = rec.record(robot, oracle["Q"], setting)
+    for key, value in now.items():
+        want = oracle[key]
+        assert value.shape == want.shape, key
+        if value.dtype.kind == "f":
+            np.testing.assert_array_equal(value, want, err_msg=key)  # exact, NaN == NaN
+        else:
+            assert (value == want).all(), key

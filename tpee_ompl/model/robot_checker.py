@@ -1,0 +1,374 @@
+"""Batched collision checking of any URDF robot among fixed obstacles, with Pinocchio and Coal.
+
+One :class:`RobotChecker` loads a URDF (+ SRDF) once, adds the obstacles, prunes the pairs that
+can never come close, and answers what every planner asks: is this configuration valid (one at a
+time or a batch in one ``pin.computeCollisionsInParallel`` call), how far is it from collision,
+and how large a joint step keeps every point of the robot within a given displacement
+(:meth:`RobotChecker.max_joint_step`, the motion-check guarantee of :mod:`tpee_ompl.planning.setup`).
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+
+from ..validation import as_float_array, check_bool, check_int, check_number
+from .obstacles import Obstacle
+from .urdf_loading import LoadedModel, ModelFiles, bounding_radius, is_prismatic, load_urdf_model
+
+__all__ = ["DEFAULT_SECURITY_MARGIN", "MAX_SECURITY_MARGIN", "RobotChecker", "as_config_batch"]
+
+log = logging.getLogger(__name__)
+
+DEFAULT_SECURITY_MARGIN = 0.02
+"""Metres. A configuration is valid only if every checked pair is at least this far apart."""
+MAX_SECURITY_MARGIN = 1.0
+"""Metres. Largest accepted security margin."""
+
+
+def as_config_batch(Q: np.ndarray, nq: int) -> np.ndarray:
+    """Q as a float array of shape (N, nq) (one row per configuration), or raise ValueError."""
+    Q = as_float_array(Q, "configurations")
+    if Q.ndim == 1:
+        Q = Q[None, :]
+    if Q.ndim != 2 or Q.shape[1] != nq:
+        raise ValueError(f"configurations must have shape (N, {nq}); got {Q.shape}")
+    bad = ~np.all(np.isfinite(Q), axis=1)
+    if bad.any():
+        k = int(np.flatnonzero(bad)[0])
+        raise ValueError(f"configurations contain NaN or inf: row {k} is {Q[k]}")
+    return Q
+
+
+class RobotChecker:
+    """Collision checking of a URDF robot (every 1-DOF joint not locked is planned) among obstacles.
+
+    Parameters
+    ----------
+    urdf_path : path
+    srdf_path : path or None
+        Its ``disable_collisions`` link pairs are not checked.
+    security_margin : float, metres
+        Pairs closer than this count as colliding (Coal security margin).
+    n_threads : int or None
+        Threads for batched checks (default: all cores, at most 2).
+    link_margins : mapping {link name: metres}, optional
+        Larger margins between these links and the static world (the fixed base and the
+        obstacles: every geometry on the universe joint).  Moving-moving pairs keep
+        ``security_margin``.  Never smaller than ``security_margin``.
+    obstacles : sequence of :class:`~tpee_ompl.model.obstacles.Obstacle`
+    locked : mapping {joint name: value}, optional
+        Joints removed from planning, fixed at these values (radians or metres).
+    package_dirs : sequence of paths
+        Where ``package://`` mesh files are found.
+    cylinders_as_capsules : bool
+        Load every URDF ``<cylinder>`` as a Coal capsule of the same radius and length (default,
+        the wearer's rule: urdfdom drops ``<capsule>``, so capsules are written as cylinders).
+        False keeps true cylinders.  Obstacles are never converted.
+    extra_points : sequence of frame names
+        Frames whose origins count as robot points in :meth:`lever_arms` (e.g. a tool tip).
+    """
+
+    def __init__(
+        self,
+        urdf_path: str | os.PathLike,
+        srdf_path: str | os.PathLike | None = None,
+        *,
+        security_margin: float = DEFAULT_SECURITY_MARGIN,
+        n_threads: int | None = None,
+        link_margins: Mapping[str, float] | None = None,
+        obstacles: Sequence[Obstacle] = (),
+        locked: Mapping[str, float] | None = None,
+        package_dirs: Sequence[str | os.PathLike] = (),
+        cylinders_as_capsules: bool = True,
+        extra_points: Sequence[str] = (),
+    ) -> None:
+        for what, value in (("urdf_path", urdf_path), ("srdf_path", srdf_path)):
+            if value is not None and not isinstance(value, (str, os.PathLike)) or isinstance(value, bool):
+                raise ValueError(f"{what} must be a path{' or None' if what == 'srdf_path' else ''}, got {value!r}")
+        if urdf_path is None:
+            raise ValueError("urdf_path must be a path, got None")
+        if locked is not None and not isinstance(locked, Mapping):
+            raise ValueError(f"locked must be a mapping {{joint name: value}}, got {locked!r}")
+        if isinstance(obstacles, (str, Obstacle)) or not isinstance(obstacles, Sequence):
+            raise ValueError(f"obstacles must be a sequence of Obstacle, got {obstacles!r}")
+        if isinstance(package_dirs, (str, os.PathLike)):
+            package_dirs = (package_dirs,)
+        self._options = {"package_dirs": tuple(package_dirs), "locked": dict(locked or {}), "obstacles": tuple(obstacles),
+                         "cylinders_as_capsules": check_bool("cylinders_as_capsules", cylinders_as_capsules)}
+        self._setup(ModelFiles(Path(urdf_path), Path(srdf_path) if srdf_path is not None else None),
+                    security_margin, n_threads, link_margins, extra_points)
+
+    def _setup(self, files: ModelFiles, security_margin: float, n_threads: int | None,
+               link_margins: Mapping[str, float] | None, extra_points: Sequence[str]) -> None:
+        """Check the settings, load the files (:meth:`_load_model`), prune pairs, build the pool."""
+        self.security_margin = check_number("security_margin (metres)", security_margin, low=0.0, high=MAX_SECURITY_MARGIN)
+        n_threads = check_int("n_threads", n_threads, minimum=1, maximum=1024, optional=True)
+        self.files = files
+        self.link_margins = self._check_link_margins(link_margins, self.security_margin)
+        self.n_threads = int(n_threads) if n_threads is not None else min(2, os.cpu_count() or 1)
+        self._lever_arms: np.ndarray | None = None
+        self.collision_checks = 0
+        """Configurations checked for collision so far (single and batched)."""
+        loaded = self._load_model()
+        self.model, self.gmodel = loaded.model, loaded.gmodel
+        self.model_hash = loaded.model_hash
+        """Short SHA-256 of the URDF (+ SRDF, locked joints, obstacles): stored with query sets and path libraries."""
+        self.data = self.model.createData()
+        if isinstance(extra_points, str) or not all(isinstance(f, str) for f in extra_points):
+            raise ValueError(f"extra_points must be a sequence of frame names, got {extra_points!r}")
+        unknown = [f for f in extra_points if not self.model.existFrame(f)]
+        if unknown:
+            raise ValueError(f"extra_points names unknown frame(s) {unknown}")
+        self._extra_frames = tuple(self.model.getFrameId(f) for f in extra_points)
+        self._prune_unreachable_pairs()
+        self._rebuild_geometry_data()
+        self.lower = self.model.lowerPositionLimit.copy()
+        self.upper = self.model.upperPositionLimit.copy()
+        self._lower_list = self.lower.tolist()
+        self._upper_list = self.upper.tolist()
+        log.debug("loaded %s: %d geometries, %d pairs", files.urdf, self.gmodel.ngeoms, len(self.gmodel.collisionPairs))
+
+    def _load_model(self) -> LoadedModel:
+        return load_urdf_model(self.files.urdf, self.files.srdf, **self._options)
+
+    def _prune_unreachable_pairs(self) -> None:
+        """Drop static-static pairs, and static-moving pairs whose static geometry lies beyond the reach
+        of the moving geometry's subtree (the lever arm of its revolute root joint, plus the margin).
+
+        Removing a pair that can never come within the margin changes no answer; it only saves time.
+        """
+        pin.forwardKinematics(self.model, self.data, pin.neutral(self.model))
+        arms = self.lever_arms()
+        margin = max([self.security_margin, *self.link_margins.values()])
+        parents = self.model.parents
+        removed = []
+        for cp in list(self.gmodel.collisionPairs):
+            a, b = self.gmodel.geometryObjects[cp.first], self.gmodel.geometryObjects[cp.second]
+            if a.parentJoint == 0 and b.parentJoint == 0:
+                removed.append(cp)
+                continue
+            static, moving = (a, b) if a.parentJoint == 0 else (b, a) if b.parentJoint == 0 else (None, None)
+            if static is None:
+                continue
+            root = moving.parentJoint
+            while parents[root] != 0:
+                root = parents[root]
+            if is_prismatic(self.model.joints[root]):
+                continue  # its origin moves: no fixed pivot to measure from
+            pivot = self.data.oMi[root].translation
+            gap = np.linalg.norm(static.placement.translation - pivot) - bounding_radius(static.geometry)
+            if gap > arms[root - 1] + margin:
+                removed.append(cp)
+        for cp in removed:
+            self.gmodel.removeCollisionPair(cp)
+        self.pruned_pairs = len(removed)
+        """Collision pairs dropped as never within the margin."""
+
+    @staticmethod
+    def _check_link_margins(link_margins: Mapping[str, float] | None, base: float) -> dict[str, float]:
+        if link_margins is None:
+            return {}
+        if not isinstance(link_margins, Mapping):
+            raise ValueError(f"link_margins must be a mapping {{link name: metres}}, got {link_margins!r}")
+        out = {}
+        for name, m in link_margins.items():
+            if not isinstance(name, str):
+                raise ValueError(f"link_margins keys must be link names, got {name!r}")
+            out[name] = check_number(f"link_margins[{name!r}] (metres, >= security_margin = {base})", m,
+                                     low=base, high=MAX_SECURITY_MARGIN)
+        return out
+
+    def _margin_matrix(self) -> np.ndarray:
+        """(ng, ng) security margins: the base margin, raised for the static pairs of ``link_margins``' links."""
+        static = np.array([g.parentJoint == 0 for g in self.gmodel.geometryObjects])
+        with_geometry = {self.model.frames[g.parentFrame].name for g in self.gmodel.geometryObjects}
+        unknown = sorted(set(self.link_margins) - with_geometry)
+        if unknown:
+            raise ValueError(f"link_margins names unknown link(s) or links without collision geometry {unknown}; "
+                             f"links with geometry: {sorted(with_geometry)}")
+        link_margin = np.array([self.link_margins.get(self.model.frames[g.parentFrame].name, self.security_margin)
+                                for g in self.gmodel.geometryObjects])
+        moving_static = static[:, None] != static[None, :]
+        wide = np.maximum(link_margin[:, None], link_margin[None, :])
+        return np.where(moving_static, wide, self.security_margin)
+
+    def _rebuild_geometry_data(self) -> None:
+        self.gdata = pin.GeometryData(self.gmodel)
+        self.gdata.setSecurityMargins(self.gmodel, self._margin_matrix())
+        for req in self.gdata.collisionRequests:
+            req.enable_contact = True  # Coal misses edge/corner contacts otherwise
+        self.pool = pin.GeometryPool(self.model, self.gmodel, self.n_threads)
+        self.pool.update(self.gdata)
+
+    # ------------------------------------------------------------------ facts
+    @property
+    def nq(self) -> int:
+        """Number of planned joints."""
+        return self.model.nq
+
+    @property
+    def joint_names(self) -> tuple[str, ...]:
+        """Joint names in configuration order."""
+        return tuple(self.model.names[1:])
+
+    def geometry_names(self, joint: str | int = 0) -> list[str]:
+        """Names of the geometries attached to a joint (0 = the static world: fixed base and obstacles)."""
+        jid = joint if isinstance(joint, int) else self.model.getJointId(joint)
+        return [go.name for go in self.gmodel.geometryObjects if go.parentJoint == jid]
+
+    def lever_arms(self) -> np.ndarray:
+        """Per joint, how far a unit step of it can move any robot point: metres per radian for a
+        revolute joint (an upper bound on the distance from its axis to any point it moves), 1 for a
+        prismatic joint.  Points: every geometry (its bounding sphere) and the ``extra_points`` frames.
+
+        Used to bound how far the robot can move for a given joint step (see :meth:`max_joint_step`).
+        The model is fixed after loading, so this is computed once.
+        """
+        if self._lever_arms is None:
+            self._lever_arms = self._compute_lever_arms()
+        return self._lever_arms.copy()
+
+    def _chain_lengths(self, j: int, k: int) -> list[float] | None:
+        """Longest offsets from joint j's origin down to joint k's (root to leaf order), or None if k is
+        not in j's subtree.  A prismatic joint on the way adds its largest travel."""
+        chain = []
+        while k > j:
+            chain.append(k)
+            k = self.model.parents[k]
+        if k != j:
+            return None
+        out = []
+        for m in reversed(chain):
+            out.append(np.linalg.norm(self.model.jointPlacements[m].translation))
+            jm = self.model.joints[m]
+            if is_prismatic(jm):
+                out.append(max(abs(self.lower_limit(m)), abs(self.upper_limit(m))))
+        return out
+
+    def lower_limit(self, jid: int) -> float:
+        """Lower limit of joint ``jid`` (Pinocchio joint index, 1-based)."""
+        return float(self.model.lowerPositionLimit[self.model.joints[jid].idx_q])
+
+    def upper_limit(self, jid: int) -> float:
+        """Upper limit of joint ``jid`` (Pinocchio joint index, 1-based)."""
+        return float(self.model.upperPositionLimit[self.model.joints[jid].idx_q])
+
+    def _compute_lever_arms(self) -> np.ndarray:
+        n = self.model.njoints - 1
+        reach = np.zeros(n)
+        for j in range(1, n + 1):
+            if is_prismatic(self.model.joints[j]):
+                reach[j - 1] = 1.0
+                continue
+            best = 0.0
+            for go in self.gmodel.geometryObjects:
+                chain = self._chain_lengths(j, go.parentJoint)
+                if chain is None:
+                    continue
+                dist = sum(chain)
+                dist += np.linalg.norm(go.placement.translation) + bounding_radius(go.geometry)
+                best = max(best, dist)
+            for fid in self._extra_frames:
+                f = self.model.frames[fid]
+                chain = self._chain_lengths(j, f.parentJoint)
+                if chain is not None:
+                    best = max(best, sum(chain) + np.linalg.norm(f.placement.translation))
+            reach[j - 1] = best
+        return reach
+
+    def max_joint_step(self, displacement: float | None = None) -> float:
+        """Largest Euclidean joint step that moves no point of the robot more than ``displacement`` (m).
+
+        A step dq moves any point at most sum_i |dq_i| r_i <= ||dq||_2 ||r||_2 (Cauchy-Schwarz),
+        with r the lever arms.  Default displacement: the security margin.
+        """
+        d = self.security_margin if displacement is None else float(displacement)
+        if not d > 0:
+            raise ValueError("displacement must be > 0 (a zero security margin gives no motion-check guarantee)")
+        return d / float(np.linalg.norm(self.lever_arms()))
+
+    # ------------------------------------------------------------------ kinematics
+    def check_config(self, q: np.ndarray) -> np.ndarray:
+        """Return q as a float array of shape (nq,), or raise ValueError naming the problem."""
+        q = as_float_array(q, "configuration")
+        if q.shape != (self.nq,):
+            raise ValueError(f"configuration must have shape ({self.nq},); got {q.shape}")
+        if not np.all(np.isfinite(q)):
+            raise ValueError(f"configuration contains NaN or inf: {q}")
+        return q
+
+    def within_limits(self, q: np.ndarray) -> bool:
+        """True if q is inside the URDF joint limits."""
+        q = self.check_config(q)
+        return bool(np.all(q >= self.lower) and np.all(q <= self.upper))
+
+    def frame_placement(self, q: np.ndarray, frame: str) -> pin.SE3:
+        """World placement of a named frame at configuration q."""
+        q = self.check_config(q)
+        fid = self.model.getFrameId(frame)
+        if fid >= self.model.nframes:
+            raise ValueError(f"unknown frame {frame!r}")
+        pin.forwardKinematics(self.model, self.data, q)
+        return pin.updateFramePlacement(self.model, self.data, fid)
+
+    def joint_placement(self, q: np.ndarray, joint: str) -> pin.SE3:
+        """World placement of a joint frame at configuration q."""
+        q = self.check_config(q)
+        pin.forwardKinematics(self.model, self.data, q)
+        return self.data.oMi[self.model.getJointId(joint)].copy()
+
+    # ------------------------------------------------------------------ collision
+    def is_valid(self, q: np.ndarray) -> bool:
+        """True if q is within limits and no checked pair is closer than its margin
+        (``security_margin``, or for a pair with the static world the link's ``link_margins`` entry)."""
+        q = self.check_config(q)
+        if not (np.all(q >= self.lower) and np.all(q <= self.upper)):
+            return False
+        self.collision_checks += 1
+        return not pin.computeCollisions(self.model, self.data, self.gmodel, self.gdata, q, True)
+
+    def is_valid_values(self, values: Sequence[float]) -> bool:
+        """:meth:`is_valid` for nq plain floats (an OMPL state's values), without the input checks.
+
+        The per-state OMPL checker calls this ~10^5 times per plan.  NaN fails the limit test, so a
+        non-finite value is still reported invalid rather than passed to Pinocchio.  Another number of
+        values than ``nq`` raises ValueError naming it (one ``len``: the only check added to the hot path).
+        """
+        if len(values) != self.nq:
+            raise ValueError(f"is_valid_values needs {self.nq} values (one per joint), got {len(values)}")
+        for v, lo, hi in zip(values, self._lower_list, self._upper_list):
+            if not lo <= v <= hi:
+                return False
+        self.collision_checks += 1
+        return not pin.computeCollisions(self.model, self.data, self.gmodel, self.gdata, np.array(values), True)
+
+    def are_valid(self, Q: np.ndarray) -> np.ndarray:
+        """Batched :meth:`is_valid` for Q of shape (N, nq): one Pinocchio call; returns bool (N,)."""
+        Q = as_config_batch(Q, self.nq)
+        ok = np.all((Q >= self.lower) & (Q <= self.upper), axis=1)
+        if ok.any():
+            Qin = np.ascontiguousarray(Q[ok].T)  # Pinocchio wants (nq, N)
+            self.collision_checks += Qin.shape[1]
+            collides = pin.computeCollisionsInParallel(self.n_threads, self.pool, Qin, True, False)
+            ok[ok] = ~np.asarray(collides, dtype=bool)
+        return ok
+
+    def clearance(self, q: np.ndarray) -> float:
+        """Smallest distance (m, negative when penetrating) over all checked pairs at q."""
+        q = self.check_config(q)
+        k = pin.computeDistances(self.model, self.data, self.gmodel, self.gdata, q)
+        return float(self.gdata.distanceResults[k].min_distance)
+
+    def closest_pair(self, q: np.ndarray) -> tuple[str, str, float]:
+        """The two geometry names of the closest checked pair at q, and their distance (m)."""
+        q = self.check_config(q)
+        k = pin.computeDistances(self.model, self.data, self.gmodel, self.gdata, q)
+        cp = self.gmodel.collisionPairs[k]
+        names = self.gmodel.geometryObjects
+        return names[cp.first].name, names[cp.second].name, float(self.gdata.distanceResults[k].min_distance)
