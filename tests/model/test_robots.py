@@ -34,3 +34,35 @@ def test_a_missing_robots_extra_is_named_in_one_line(monkeypatch):
     monkeypatch.setattr(builtins, "__import__", no_erd)
     with pytest.raises(ImportError, match=r"^the Panda needs the optional 'robots' extra: pip install 'tpee-ompl\[robots\]'$"):
         robots.panda_shelf()
+
+
+@needs_panda
+def test_dropping_the_spheres_inside_capsules_changes_no_verdict_and_no_clearance():
+    """panda_collision.urdf caps every cylinder with two spheres: as capsule end caps they are dropped."""
+    import coal
+    import pinocchio as pin
+
+    c = robots.panda_shelf(n_threads=1, security_margin=0.0)
+    urdf, srdf = robots.panda_files()
+    full = pin.buildGeomFromUrdf(c.model, str(urdf), pin.GeometryType.COLLISION)  # spheres kept
+    kept = set(c.geometry_names(0)) | {n for j in c.joint_names for n in c.geometry_names(j)}
+    spheres = [g for g in full.geometryObjects if isinstance(g.geometry, coal.Sphere) and g.name not in kept
+               and g.parentJoint > 0]
+    assert len(spheres) >= 20  # the end caps; 4 spheres sit 0.1 mm off a tilted capsule's axis and stay
+    rng = np.random.default_rng(7)
+    Q = c.lower + rng.random((300, c.nq)) * (c.upper - c.lower)
+    gdata = pin.GeometryData(c.gmodel)
+    for q in Q:
+        pin.updateGeometryPlacements(c.model, c.data, c.gmodel, gdata, q)
+        for s in spheres:  # every dropped sphere is never closer to any obstacle than its link's capsule
+            S = coal.Transform3s(c.data.oMi[s.parentJoint] * s.placement)
+            caps = [k for k, g in enumerate(c.gmodel.geometryObjects)
+                    if g.parentJoint == s.parentJoint and isinstance(g.geometry, coal.Capsule)]
+            for ob in ("table", "board_1", "divider"):
+                o = c.gmodel.geometryObjects[c.gmodel.getGeometryId(ob)]
+                req, res = coal.DistanceRequest(), coal.DistanceResult()
+                d_sphere = coal.distance(s.geometry, S, o.geometry, coal.Transform3s(o.placement), req, res)
+                d_caps = min(coal.distance(c.gmodel.geometryObjects[k].geometry, coal.Transform3s(gdata.oMg[k]),
+                                           o.geometry, coal.Transform3s(o.placement), req, coal.DistanceResult())
+                             for k in caps)
+                assert d_caps <= d_sphere + 1e-9

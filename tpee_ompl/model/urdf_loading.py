@@ -179,6 +179,9 @@ def load_urdf_model(
             go.geometry = coal.Capsule(go.geometry.radius, 2.0 * go.geometry.halfLength)
     if not cylinders_as_capsules:
         extra.append("cylinders_as_capsules=False")
+    dropped = _drop_contained_spheres(gmodel)
+    if dropped:
+        extra.append("dropped_contained_spheres=" + ",".join(dropped))
     names = {go.name for go in gmodel.geometryObjects}
     for ob in obstacles:
         if not isinstance(ob, Obstacle):
@@ -194,6 +197,34 @@ def load_urdf_model(
     if srdf is not None:
         _apply_srdf(model, gmodel, srdf)
     return LoadedModel(model, gmodel, digest.hexdigest()[:16])
+
+
+def _drop_contained_spheres(gmodel: pin.GeometryModel) -> list[str]:
+    """Remove every sphere lying inside a capsule of the same link; return their names.
+
+    Collision URDFs often add a sphere at each end of a cylinder (``panda_collision.urdf`` does): once
+    the cylinder is a capsule those spheres are its end caps, so they change no verdict and no
+    clearance (a contact or distance of the sphere is one of the capsule's too) but triple the pairs.
+    """
+    objs = list(gmodel.geometryObjects)
+    capsules = [g for g in objs if isinstance(g.geometry, coal.Capsule)]
+    dropped = []
+    for g in objs:
+        if not isinstance(g.geometry, coal.Sphere):
+            continue
+        for c in capsules:
+            if c.parentFrame != g.parentFrame or c.parentJoint != g.parentJoint:
+                continue
+            # the sphere's centre in the capsule's frame; the capsule's axis is its local z
+            p = c.placement.actInv(g.placement).translation
+            h = c.geometry.halfLength
+            axis_point = np.array([0.0, 0.0, min(max(p[2], -h), h)])
+            if np.linalg.norm(p - axis_point) + g.geometry.radius <= c.geometry.radius + 1e-9:  # nanometre: float rounding of the URDF numbers
+                dropped.append(g.name)
+                break
+    for name in dropped:
+        gmodel.removeGeometryObject(name)
+    return dropped
 
 
 def _lock_joints(model: pin.Model, gmodel: pin.GeometryModel, locked: Mapping[str, float], urdf: Path):
