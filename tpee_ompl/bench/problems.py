@@ -54,6 +54,9 @@ class Problem:
     """Motion validators it has, the first being its headline one."""
     library: bool = False
     """LibraryDimensionRRT applies (the wearer's DMP path library)."""
+    unsupported: tuple[str, ...] = ()
+    """Planners that cannot run on its state space (refused with :attr:`unsupported_reason`)."""
+    unsupported_reason: str = ""
     query_sets: bool = False
     """It reads query sets (``--queries``); the others have built-in queries."""
     default_queries: str | None = None
@@ -73,6 +76,8 @@ class Problem:
         """Raise ValueError when planner ``name`` does not apply to this problem."""
         if name == "LibraryDimensionRRT" and not self.library:
             raise ValueError(f"LibraryDimensionRRT does not apply to problem {self.name} (its DMP library is the wearer's)")
+        if name in self.unsupported:
+            raise ValueError(f"{name} does not apply to problem {self.name} ({self.unsupported_reason})")
 
 
 # ----------------------------------------------------------------- the wearer
@@ -138,8 +143,17 @@ def _generic(spec: GenericProblem) -> Problem:
         return DimensionRRT(si, groups=spec.groups, max_samples=ctx.max_samples, seed=ctx.seed,
                             stall_samples=ctx.stall_samples)
 
+    extra: dict[str, Any] = {}
+    if spec.kind == "arm-so2":
+        extra = {"unsupported": _NEEDS_INFORMED_SAMPLER, "unsupported_reason": "OMPL's informed sampler does not "
+                 "support compound SO2 spaces", "planners": tuple(n for n in _GENERIC_PLANNERS
+                                                                  if n not in _NEEDS_INFORMED_SAMPLER)}
     return Problem(name=name, description=spec.description, dimension=spec.n, load_queries=load, build=build,
-                   build_dimension_rrt=dimension_rrt, groups=spec.groups)
+                   build_dimension_rrt=dimension_rrt, groups=spec.groups, **extra)
+
+
+_NEEDS_INFORMED_SAMPLER = ("InformedRRTstar", "AORRTC", "BITstar")
+"""OMPL planners whose set-up needs ``PathLengthDirectInfSampler`` (RealVector, SE2, SE3, Dubins, Reeds-Shepp only)."""
 
 
 @functools.lru_cache(maxsize=None)
