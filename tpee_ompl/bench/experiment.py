@@ -93,7 +93,8 @@ def experiment_specs(cfg: dict, qpos: int) -> list[dict]:
             specs.append({"comparison": "iterations", "checker": checker, "cap": int(cap), "budget": None})
     if cfg["anytime_queries"] is None or qpos < cfg["anytime_queries"]:
         for b in cfg["anytime_budgets"]:
-            specs.append({"comparison": "anytime", "checker": cfg["checkers"][0] if cfg["checkers"] else "batched",
+            headline = cfg["checkers"][0] if cfg["checkers"] else get_problem(cfg.get("problem", "wearer")).checkers[0]
+            specs.append({"comparison": "anytime", "checker": headline,
                           "cap": None, "budget": float(b)})
     return specs
 
