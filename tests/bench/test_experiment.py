@@ -29,3 +29,10 @@ def test_alternative_checkers_and_anytime_run_on_the_first_queries_only():
     names = [log_name({"id": 7}, 3, s) for s in first]
     assert names[0] == "q003_iterations_batched_N10.log" and names[-1] == "q003_anytime_batched_T0.5s.log"
     assert len(set(names)) == len(names)
+
+
+def test_anytime_without_validators_uses_the_problems_headline_validator():
+    cfg = dataclasses.asdict(CampaignConfig.for_problem("arm4", sample_caps=(), checkers=(), anytime_budgets=(0.5,)))
+    assert [s["checker"] for s in experiment_specs(cfg, 0)] == ["discrete"]
+    wearer = dataclasses.asdict(CampaignConfig(sample_caps=(), checkers=(), anytime_budgets=(0.5,)))
+    assert [s["checker"] for s in experiment_specs(wearer, 0)] == ["batched"]

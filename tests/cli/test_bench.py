@@ -58,3 +58,36 @@ def test_missing_dask_gives_a_clear_error(monkeypatch, capsys, tmp_path):
 def test_resume_of_a_folder_without_campaign_is_a_clear_error(capsys, tmp_path):
     assert main(["--resume", str(tmp_path), "--workers", "1", "--no-progress"]) == 2
     assert "campaign.json" in capsys.readouterr().err
+
+
+def test_list_problems_prints_every_problem_and_runs_nothing(capsys, tmp_path):
+    from tpee_ompl.bench.problems import PROBLEM_NAMES
+
+    assert main(["--list-problems", "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert out[0].split()[:3] == ["problem", "dim", "queries"]
+    listed = {line.split()[0]: line.split()[1:3] for line in out[1:]}
+    assert set(listed) == set(PROBLEM_NAMES)
+    assert listed["wearer"] == ["4", "120"] and listed["arm6"] == ["6", "10"]
+    assert not list(tmp_path.iterdir())
+
+
+def test_problem_option_takes_the_problem_defaults():
+    cfg = config_from_args(build_parser().parse_args(["--problem", "arm6", "--samples", "10"]))
+    assert cfg.problem == "arm6" and cfg.name == "arm6" and cfg.queries is None
+    assert cfg.checkers == ("discrete",) and "LibraryDimensionRRT" not in cfg.anytime_planners
+
+
+def test_unknown_problem_is_refused_in_one_line(tmp_path):
+    from helpers.cli_run import assert_refused, run_cli
+
+    assert_refused(run_cli(["bench", "--problem", "bad-name", "--out", str(tmp_path)], tmp_path), 2, "--problem",
+                   "bad-name")
+    assert not list(tmp_path.iterdir())
+
+
+def test_validator_a_problem_lacks_is_refused_naming_the_option(capsys, tmp_path):
+    assert main(["--problem", "arm4", "--checkers", "batched", "--out", str(tmp_path), "--no-progress"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "--checkers" in err and "arm4" in err and len(err.splitlines()) == 1
+    assert not list(tmp_path.iterdir())

@@ -71,7 +71,7 @@ def query_rows(name_or_path: str, robot=None) -> tuple[str, list[dict]]:
 
 
 def stratified_subset(queries: list[dict], k: int | None) -> list[dict]:
-    """All queries reordered round-robin over (from, to) sector pairs, then the first k.
+    """All queries reordered round-robin over (from, to) sector pairs (if they have them), then the first k.
 
     The first k of a set ordered pair by pair would cover only a few pairs; round-robin keeps every
     pair represented (24 of the 120 planning-necessary queries = 2 per ordered pair).
@@ -80,8 +80,8 @@ def stratified_subset(queries: list[dict], k: int | None) -> list[dict]:
 
     k = check_int("max_queries", k, minimum=1, optional=True)
     groups: dict[tuple[int, int], list[dict]] = {}
-    for q in queries:
-        groups.setdefault((q["from_sector"], q["to_sector"]), []).append(q)
+    for q in queries:  # problems without sectors: one group, the set's order
+        groups.setdefault((q.get("from_sector"), q.get("to_sector")), []).append(q)
     out: list[dict] = []
     lists = list(groups.values())
     for i in range(max((len(g) for g in lists), default=0)):
@@ -121,12 +121,12 @@ class CampaignPlan:
 def prepare_campaign(config: CampaignConfig) -> CampaignPlan:
     """Check everything a campaign needs before anything is created; raise ValueError/FileNotFoundError if not.
 
-    The query set loads and was made for this model (``model_hash``), every planner factory
+    The problem's query set loads and was made for its model (``model_hash``), every planner factory
     imports, query k's seed ``seed + k`` stays in OMPL's range, and ``out`` can hold a new folder.
     """
-    from ..model.wearer_arm import default_robot
     from ..validation import MAX_SEED
     from .planners import planner_factory
+    from .problems import get_problem
 
     _check_out_folder(config.out)
     for field_name in ("iteration_planners", "anytime_planners"):
@@ -135,14 +135,18 @@ def prepare_campaign(config: CampaignConfig) -> CampaignPlan:
                 planner_factory(name)
             except ValueError as exc:
                 raise ValueError(f"{field_name}: {exc}") from None
+    problem = get_problem(config.problem)
+    what = config.queries or problem.default_queries or problem.name
     try:
-        set_name, queries = query_rows(config.queries, default_robot())
+        set_name, queries = problem.queries(config.queries)
+    except ImportError as exc:  # a robot-checker problem whose model this install lacks
+        raise ValueError(str(exc)) from None
     except (OSError, ValueError) as exc:  # missing, unreadable, not a query set, made for another model
-        msg = str(exc).removeprefix(f"{config.queries}: ")
-        raise ValueError(f"queries {config.queries}: {msg}") from None
+        msg = str(exc).removeprefix(f"{what}: ")
+        raise ValueError(msg if msg.startswith("queries") else f"queries {what}: {msg}") from None
     queries = stratified_subset(queries, config.max_queries)
     if not queries:
-        raise ValueError(f"query set {config.queries!r} has no queries")
+        raise ValueError(f"query set {what!r} has no queries")
     if config.seed + len(queries) - 1 > MAX_SEED:
         raise ValueError(f"seed {config.seed}: query k uses seed + k, which must stay <= {MAX_SEED} "
                          f"for {len(queries)} queries")
@@ -196,6 +200,7 @@ def _run_campaign(plan: CampaignPlan, on_task_done, report: bool, progress_bar: 
     cfg = dataclasses.asdict(config)
     meta = {
         "config": cfg,
+        "problem": config.problem,
         "query_set": plan.query_set,
         "queries": [q["id"] for q in queries],
         "query_data": queries,
@@ -229,6 +234,7 @@ def load_campaign(directory: str | os.PathLike) -> dict:
         raise ValueError(f"resume {directory}: campaign.json is not a campaign's (no config/query_set)")
     if "query_data" not in meta:
         raise ValueError(f"resume {directory}: written by an older version (no query_data): cannot resume")
+    meta["config"].setdefault("problem", "wearer")  # written before campaigns had problems
     try:
         CampaignConfig(**{k: tuple(v) if isinstance(v, list) else v for k, v in meta["config"].items()})
     except (TypeError, ValueError) as exc:

@@ -78,8 +78,12 @@ class CampaignConfig:
 
     name: str = "bench"
     """Folder suffix: ``<out>/<UTC timestamp>_<name>/``."""
-    queries: str = "planning_necessary"
-    """Query-set name (packaged ``data/queries/<name>.json``) or a JSON file path."""
+    problem: str = "wearer"
+    """Benchmark problem (:data:`tpee_ompl.bench.problems.PROBLEM_NAMES`): the wearer, its random queries,
+    generic OMPL problems, robot-checker problems."""
+    queries: str | None = None
+    """Query-set name (packaged ``data/queries/<name>.json``) or a JSON file path, for the problems that read
+    query sets; None = the problem's own queries (the wearer's: ``planning_necessary``)."""
     sample_caps: tuple[int, ...] = (500, 1000, 1500, 2000, 2500)
     iteration_planners: tuple[str, ...] = ITERATION_PLANNERS
     checkers: tuple[str, ...] = CHECKERS
@@ -106,11 +110,27 @@ class CampaignConfig:
     simplify: bool = True
     """OMPL's default; ``solution_length`` stays the raw length either way."""
 
+    @classmethod
+    def for_problem(cls, problem: str, **fields) -> CampaignConfig:
+        """A configuration for ``problem`` whose motion validators and anytime planners default to the problem's."""
+        from .problems import get_problem
+
+        p = get_problem(problem)
+        fields.setdefault("checkers", p.checkers)
+        fields.setdefault("anytime_planners", p.planners)
+        return cls(problem=problem, **fields)
+
     def __post_init__(self) -> None:
         from ..validation import check_bool, check_int, check_name, check_number, check_seed
 
+        from .problems import get_problem
+
         check_name("name", self.name)
-        check_name("queries", self.queries)
+        problem = get_problem(self.problem)
+        if self.queries is not None:
+            check_name("queries", self.queries)
+            if not problem.query_sets:
+                raise ValueError(f"queries: problem {self.problem} has built-in queries (give no query set)")
         check_name("out", self.out)
         caps = tuple(check_int("sample_caps", n, minimum=1) for n in self.sample_caps)
         budgets = tuple(check_number("anytime_budgets", b, low=0, low_open=True) for b in self.anytime_budgets)
@@ -122,6 +142,11 @@ class CampaignConfig:
                 check_planner_name(n, f"{field_name} entry")
             if len(set(names)) != len(names):
                 raise ValueError(f"{field_name} names a planner twice: {list(names)}")
+            for n in names:
+                try:
+                    problem.check_planner(n)
+                except ValueError as exc:
+                    raise ValueError(f"{field_name}: {exc}") from None
         for n in self.iteration_planners:
             if n in NOT_ITERATION_CAPPED:
                 raise ValueError(f"iteration_planners: {n} cannot be stopped at a sample count (RRTConnect counts no "
@@ -133,6 +158,9 @@ class CampaignConfig:
         for c in self.checkers:
             if c not in CHECKERS:
                 raise ValueError(f"unknown motion validator {c!r}: choose from {CHECKERS}")
+            if c not in problem.checkers:
+                raise ValueError(f"checkers: problem {self.problem} has no {c!r} motion validator (it has "
+                                 f"{', '.join(problem.checkers)})")
         if caps and not self.checkers:
             raise ValueError("give at least one motion validator")
         check_int("alt_checker_queries", self.alt_checker_queries, minimum=0, optional=True)

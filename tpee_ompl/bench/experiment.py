@@ -22,16 +22,18 @@ import os
 import socket
 import tempfile
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import numpy as np
 from ompl import tools as ot
 from ompl import util as ou
 
+from ..planning.grouped_space import RealVectorLayout
 from ..planning.paths import path_length, path_passes_motion_checks
 from .database import failed_run_properties, pad_aborted_runs, patch_recorded_data
 from .planners import PlannerContext, RecordingPlanner, planner_factory
+from .problems import get_problem
 from ..files import write_new_file
 from .results import format_value
 
@@ -40,16 +42,25 @@ __all__ = ["experiment_specs", "group_lengths", "log_name", "run_query_task"]
 log = logging.getLogger(__name__)
 
 
-def group_lengths(waypoints: np.ndarray) -> tuple[float, float, float]:
-    """Lengths of a joint-space path: (4-D, DOF1/DOF2 group, DOF3/DOF4 group), radians.
+def group_lengths(waypoints: np.ndarray, first: Sequence[int] = (0, 1),
+                  layout: RealVectorLayout | None = None) -> tuple[float, float, float]:
+    """Lengths of a path: (whole, group ``first``, the other coordinates); the ``length_dof12``/``length_dof34`` columns.
 
-    waypoints : ndarray, shape (K, 4).  Each is the sum over segments of the Euclidean norm of the
-    segment's components (all four, the first two, the last two).
+    waypoints : ndarray, shape (K, n), n > 2 (the wearer: (K, 4), groups DOF1/DOF2 and DOF3/DOF4, radians).
+    The whole length is in the space's metric (``layout.path_length``, what ``si.distance`` sums; default
+    Euclidean); each group's is the sum over segments of the Euclidean norm of the segment's components
+    in that group (SO2 components taken the short way round when ``layout`` has them).
     """
     W = np.asarray(waypoints, dtype=float)
-    if W.ndim != 2 or W.shape[1] != 4:
-        raise ValueError(f"waypoints must have shape (K, 4), got {W.shape}")
-    return path_length(W), path_length(W[:, :2]), path_length(W[:, 2:])
+    first = [int(i) for i in first]
+    if W.ndim != 2 or W.shape[1] <= max(first) + 1:
+        raise ValueError(f"waypoints must have shape (K, n) with n > {max(first) + 1}, got {W.shape}")
+    rest = [i for i in range(W.shape[1]) if i not in first]
+    if layout is None or layout.is_plain:
+        return path_length(W), path_length(W[:, first]), path_length(W[:, rest])
+    D = layout.delta(W[:-1], W[1:])
+    return (layout.path_length(W), float(np.linalg.norm(D[:, first], axis=1).sum()),
+            float(np.linalg.norm(D[:, rest], axis=1).sum()))
 
 
 # --------------------------------------------------------------------------- seeds, experiment list
@@ -82,7 +93,8 @@ def experiment_specs(cfg: dict, qpos: int) -> list[dict]:
             specs.append({"comparison": "iterations", "checker": checker, "cap": int(cap), "budget": None})
     if cfg["anytime_queries"] is None or qpos < cfg["anytime_queries"]:
         for b in cfg["anytime_budgets"]:
-            specs.append({"comparison": "anytime", "checker": cfg["checkers"][0] if cfg["checkers"] else "batched",
+            headline = cfg["checkers"][0] if cfg["checkers"] else get_problem(cfg.get("problem", "wearer")).checkers[0]
+            specs.append({"comparison": "anytime", "checker": headline,
                           "cap": None, "budget": float(b)})
     return specs
 
@@ -108,13 +120,10 @@ def run_query_task(task: dict) -> dict:
     Returns (JSON-able): ``qpos``, ``query_id``, ``logs`` ({file name: log text}), ``extras``
     ({file name: {planner: [per-run properties]}}), ``errors``, ``pid``, ``host``, ``elapsed``.
     """
-    from ..model.wearer_arm import WearerArm
-
     t0 = time.perf_counter()
     cfg, query, qpos = task["config"], task["query"], int(task["qpos"])
     _seed_process(task["seed"])
     ou.setLogLevel(ou.LOG_WARN)
-    robot = WearerArm(n_threads=task.get("n_threads"))
     log_dir = Path(task["log_dir"]) if task.get("log_dir") else None
     specs = task.get("specs") or experiment_specs(cfg, qpos)
     out: dict = {"qpos": qpos, "query_id": query["id"], "logs": {}, "extras": {}, "errors": {},
@@ -123,7 +132,7 @@ def run_query_task(task: dict) -> dict:
         fname = log_name(query, qpos, spec)
         if log_dir is not None and (log_dir / fname).is_file():
             continue  # written by an earlier attempt of this task whose worker died
-        text, extras, error = _run_experiment(robot, cfg, task, spec)
+        text, extras, error = _run_experiment(cfg, task, spec)
         out["logs"][fname], out["extras"][fname] = text, extras
         if error:
             out["errors"][fname] = error
@@ -152,42 +161,46 @@ def _guarded(fn: Callable, *args) -> None:
         log.exception("benchmark event %s failed", getattr(fn, "__name__", fn))
 
 
-def _experiment_parameters(robot, cfg: dict, task: dict, spec: dict, start: np.ndarray, goal: np.ndarray) -> dict:
-    """The experiment's parameters (``"name TYPE": text``), columns of the ``experiments`` table."""
+def _experiment_parameters(cfg: dict, task: dict, spec: dict, straight: float, model_hash: str) -> dict:
+    """The experiment's parameters (``"name TYPE": text``), columns of the ``experiments`` table.
+
+    Sectors are 0 for problems without them; ``straight_length`` is ``si.distance(start, goal)``.
+    """
     query, cap, budget = task["query"], spec["cap"], spec["budget"]
     return {
         "comparison TEXT": spec["comparison"],
         "query_set TEXT": task["query_set"],
         "query_id TEXT": str(query["id"]),
         "query_index INTEGER": str(int(task["qpos"])),
-        "from_sector INTEGER": str(query["from_sector"]),
-        "to_sector INTEGER": str(query["to_sector"]),
+        "from_sector INTEGER": str(int(query.get("from_sector", 0))),
+        "to_sector INTEGER": str(int(query.get("to_sector", 0))),
         "sample_cap INTEGER": str(cap) if cap is not None else "0",
         "time_budget REAL": format_value(budget) if budget is not None else "0",
         "motion_validator TEXT": spec["checker"],
-        "straight_length REAL": format_value(float(np.linalg.norm(goal - start))),
+        "straight_length REAL": format_value(float(straight)),
         "campaign_seed INTEGER": str(cfg["seed"]),
         "process_seed INTEGER": str(task["seed"]),
-        "model_hash TEXT": robot.model_hash,
+        "model_hash TEXT": str(model_hash),
     }
 
 
-def _path_properties(si, rec: dict, start: np.ndarray, goal: np.ndarray) -> dict:
+def _path_properties(si, rec: dict, start: np.ndarray, goal: np.ndarray, first: Sequence[int],
+                     layout: RealVectorLayout) -> dict:
     """Run properties measured on the raw path of a RecordingPlanner record (none without a path)."""
     W = rec.get("waypoints")
     if W is None or len(W) < 1:
         return {}
-    l4, l12, l34 = group_lengths(W) if len(W) >= 2 else (0.0, 0.0, 0.0)
-    ok = path_passes_motion_checks(si, W)
+    l4, l12, l34 = group_lengths(W, first, layout) if len(W) >= 2 else (0.0, 0.0, 0.0)
+    ok = path_passes_motion_checks(si, W if layout.is_plain else layout.to_path(si, W))
     best = rec["best_cost"]
     if best is None or not math.isfinite(float(best)):
         best = l4
-    ends = bool(np.allclose(W[0], start, atol=1e-6) and np.allclose(W[-1], goal, atol=1e-6))
+    ends = bool(np.all(np.abs(layout.delta(W[0], start)) <= 1e-6) and np.all(np.abs(layout.delta(W[-1], goal)) <= 1e-6))
     return {"reaches_goal INTEGER": int(ends), "best_cost REAL": best, "length_dof12 REAL": l12,
             "length_dof34 REAL": l34, "raw_length REAL": l4, "path_valid_dense INTEGER": int(ok)}
 
 
-def _run_experiment(robot, cfg: dict, task: dict, spec: dict) -> tuple[str, dict, str | None]:
+def _run_experiment(cfg: dict, task: dict, spec: dict) -> tuple[str, dict, str | None]:
     """One OMPL experiment; returns (log text, {planner: [run properties]}, benchmark error or None).
 
     Exceptions from Python callbacks never escape: planner exceptions are caught in
@@ -196,17 +209,18 @@ def _run_experiment(robot, cfg: dict, task: dict, spec: dict) -> tuple[str, dict
     OMPL checks the path) restores OMPL's logging and records every run that did not finish as a
     failed run (status *crash*, ``planner_error`` = 1).
     """
-    from ..planning.setup import make_simple_setup
-
     query, qpos = task["query"], int(task["qpos"])
+    problem = get_problem(cfg.get("problem", "wearer"))
     start, goal = np.asarray(query["start"], float), np.asarray(query["goal"], float)
-    ss = make_simple_setup(robot, start, goal, batched_motion_validator=spec["checker"] == "batched")
+    ss, checker = problem.make_setup(query, spec["checker"] == "batched", task.get("n_threads"))
     si = ss.getSpaceInformation()
+    layout = RealVectorLayout(si.getStateSpace())
+    straight = si.distance(layout.write(si.allocState(), start), layout.write(si.allocState(), goal))
     cap, budget = spec["cap"], spec["budget"]
     name = (f"{spec['comparison']}_{task['query_set']}_q{qpos:03d}_"
             + (f"N{cap}" if cap is not None else f"T{budget:g}s") + f"_{spec['checker']}")
     bench = ot.Benchmark(ss, name)
-    for k, v in _experiment_parameters(robot, cfg, task, spec, start, goal).items():
+    for k, v in _experiment_parameters(cfg, task, spec, straight, checker.model_hash).items():
         pname, ptype = k.rsplit(" ", 1)
         bench.addExperimentParameter(pname, ptype, v)
 
@@ -214,9 +228,10 @@ def _run_experiment(robot, cfg: dict, task: dict, spec: dict) -> tuple[str, dict
     wrappers = {}
     tag = cap if cap is not None else int(round(budget * 1000))
     for k, pname in enumerate(planners):
-        ctx = PlannerContext(query=query, max_samples=cap, seed=_sub_seed(cfg["seed"], qpos, k, tag))
+        ctx = PlannerContext(query=query, max_samples=cap, seed=_sub_seed(cfg["seed"], qpos, k, tag),
+                             problem=problem.name)
         inner = planner_factory(pname)(si, ctx)
-        w = RecordingPlanner(si, inner, max_iterations=cap)
+        w = RecordingPlanner(si, inner, max_iterations=cap, read=None if layout.is_plain else layout.read)
         wrappers[w.getName()] = w
         bench.addPlanner(w)
 
@@ -224,10 +239,10 @@ def _run_experiment(robot, cfg: dict, task: dict, spec: dict) -> tuple[str, dict
     counter = {"before": 0}
 
     def pre_run(planner) -> None:
-        counter["before"] = robot.collision_checks
+        counter["before"] = checker.collision_checks
 
     def post_run_props(planner) -> dict:
-        checks = robot.collision_checks - counter["before"]
+        checks = checker.collision_checks - counter["before"]
         rec = wrappers[planner.getName()].last
         props = {
             "collision_checks INTEGER": checks,
@@ -245,7 +260,7 @@ def _run_experiment(robot, cfg: dict, task: dict, spec: dict) -> tuple[str, dict
         if rec.get("graph_states") is not None:  # OMPL's own columns, which it cannot fill through the wrapper
             props["graph states INTEGER"] = rec["graph_states"]
             props["graph motions INTEGER"] = rec["graph_motions"]
-        props.update(_path_properties(si, rec, start, goal))
+        props.update(_path_properties(si, rec, start, goal, problem.groups[0], layout))
         return {"props": props, "progress": rec["progress"]}
 
     def post_run(planner, run) -> None:

@@ -43,11 +43,13 @@ log = logging.getLogger(__name__)
 
 @dataclass(frozen=True)
 class PlannerContext:
-    """What a planner factory may use: the query (plain dict), the cap and a seed."""
+    """What a planner factory may use: the query (plain dict), the cap, a seed and the problem's name."""
 
     query: dict
     max_samples: int | None
     seed: int
+    problem: str = "wearer"
+    """:data:`~tpee_ompl.bench.problems.PROBLEMS` name: dimension-RRT is built with its grouping."""
     stall_samples: int | None = None
     """Our planners stop after this many samples without a shorter path (None: the paper's behaviour,
     as in every campaign; ``tpee-ompl plan`` sets it so a converged run does not idle to its time limit)."""
@@ -65,11 +67,9 @@ def _native(cls_name: str) -> PlannerFactory:
 
 
 def _dimension_rrt(si, ctx: PlannerContext):
-    from ..planning.tpee import tpee_dimension_rrt
+    from .problems import get_problem
 
-    q = ctx.query
-    return tpee_dimension_rrt(si, int(q["from_sector"]), int(q["to_sector"]), max_samples=ctx.max_samples, seed=ctx.seed,
-                              stall_samples=ctx.stall_samples)
+    return get_problem(ctx.problem).build_dimension_rrt(si, ctx)
 
 
 _LIBRARIES: dict[str, object] = {}
@@ -80,7 +80,9 @@ def _library_dimension_rrt(si, ctx: PlannerContext):
     from ..library import LibraryDimensionRRT, PathLibrary
     from ..model.wearer_arm import default_robot
     from ..resources import default_library_path
+    from .problems import get_problem
 
+    get_problem(ctx.problem).check_planner("LibraryDimensionRRT")
     robot = getattr(si.getStateValidityChecker(), "robot", None) or default_robot()
     lib = _LIBRARIES.get(robot.model_hash)
     if lib is None:
@@ -161,16 +163,22 @@ class RecordingPlanner(ob.Planner):
         get their cap through their factory).
     progress_period : float, seconds
         Progress sampling period for native planners exposing ``bestCost``/``numIterations``.
+    read : callable, optional
+        ``state -> array (n,)`` for spaces other than RealVector (e.g. ``RealVectorLayout.read`` of an
+        SO2 compound); n is the space's dimension.
 
-    After each ``solve``, :attr:`last` holds the run's record: ``waypoints`` (raw path, (K, 4), or
+    After each ``solve``, :attr:`last` holds the run's record: ``waypoints`` (raw path, (K, n), or
     None), ``iterations``, ``samples``, ``best_cost``, ``first_solution_time``, ``progress``
     (list of (time, best cost, iterations)) and ``error`` (None, or the exception's repr).
     Exceptions never escape to OMPL (they would abort the whole benchmark): a failing ``solve``
     returns status *crash*.
     """
 
-    def __init__(self, si, inner, max_iterations: int | None = None, progress_period: float = 0.05) -> None:
+    def __init__(self, si, inner, max_iterations: int | None = None, progress_period: float = 0.05,
+                 read: Callable[[ob.State], object] | None = None) -> None:
         super().__init__(si, inner.getName())
+        self._dim = int(si.getStateSpace().getDimension())
+        self._read = read
         self.inner = inner
         self.max_iterations = max_iterations
         self.progress_period = float(progress_period)
@@ -229,7 +237,7 @@ class RecordingPlanner(ob.Planner):
         pdef = self.getProblemDefinition()
         waypoints = None
         if error is None and pdef.hasSolution():
-            waypoints = path_to_array(pdef.getSolutionPath(), 4)
+            waypoints = path_to_array(pdef.getSolutionPath(), self._dim, read=self._read)
         self.last = {"waypoints": waypoints, "error": error, **self._run_stats(elapsed, progress, has_cost),
                      **self._graph_size()}
         return status

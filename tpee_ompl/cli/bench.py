@@ -17,12 +17,15 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from ..bench.config import CHECKERS, CampaignConfig, check_planner_name
+from ..bench.problems import DEFAULT_PROBLEM, get_problem
 from ._common import Parser, positive_float, positive_int, seed
 
-__all__ = ["DESCRIPTION", "EXAMPLE", "add_arguments", "build_parser", "config_from_args", "main", "register", "run"]
+__all__ = ["DESCRIPTION", "EXAMPLE", "add_arguments", "build_parser", "config_from_args", "list_problems", "main",
+           "register", "run"]
 
 DESCRIPTION = "Benchmark dimension-RRT against OMPL planners (ompl.tools.Benchmark)."
-EXAMPLE = "example:\n  tpee-ompl bench --max-queries 24 --samples 500 2500 --anytime 0.1 0.5 --workers 2"
+EXAMPLE = ("example:\n  tpee-ompl bench --max-queries 24 --samples 500 2500 --anytime 0.1 0.5 --workers 2\n"
+           "  tpee-ompl bench --list-problems\n  tpee-ompl bench --problem arm6 --samples 500 --anytime 0.1 0.5 1")
 
 
 def _default(name: str):
@@ -36,6 +39,14 @@ def _planner(text: str) -> str:
     """argparse type: a planner name (:func:`~tpee_ompl.bench.config.check_planner_name`)."""
     try:
         return check_planner_name(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+def _problem(text: str) -> str:
+    """argparse type: a problem name (:data:`~tpee_ompl.bench.problems.PROBLEM_NAMES`)."""
+    try:
+        return get_problem(text).name
     except ValueError as exc:
         raise argparse.ArgumentTypeError(str(exc)) from None
 
@@ -54,6 +65,7 @@ _OPTION_OF = {"sample_caps": "--samples", "anytime_budgets": "--anytime", "itera
               "anytime_planners": "--anytime-planners", "alt_checker_queries": "--alt-checker-queries",
               "alt_checker_caps": "--alt-checker-samples", "anytime_queries": "--anytime-queries",
               "max_queries": "--max-queries", "max_time": "--max-time", "queries": "--queries", "name": "--name",
+              "problem": "--problem", "checkers": "--checkers",
               "runs": "--runs", "workers": "--workers", "seed": "--seed", "out": "--out", "resume": "--resume"}
 """:class:`CampaignConfig` field -> option, to name the option in a refusal."""
 
@@ -71,7 +83,12 @@ def _user_message(exc: BaseException) -> str:
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     """Add the campaign, executor and resume options to ``p``."""
-    p.add_argument("--queries", default=_default("queries"), help="query-set name or JSON file (default: %(default)s)")
+    p.add_argument("--problem", type=_problem, default=_default("problem"),
+                   help="benchmark problem (default: %(default)s; --list-problems lists them)")
+    p.add_argument("--list-problems", action="store_true", help="list the problems (name, dimension, queries) and exit")
+    p.add_argument("--queries", default=_default("queries"),
+                   help="query-set name or JSON file, for problems that read query sets (default: the problem's "
+                        "own, for the wearer planning_necessary)")
     p.add_argument("--name", default=None, help="results folder suffix (default: the query-set name)")
     p.add_argument("--samples", type=positive_int, nargs="*", default=_default("sample_caps"),
                    help="sample/iteration caps of the Table-4 comparison (default: %(default)s); none to skip")
@@ -79,9 +96,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="time budgets (s) of the anytime comparison (default: %(default)s); none to skip")
     p.add_argument("--planners", type=_planner, nargs="+", default=_default("iteration_planners"),
                    help="iteration-matched planners; the first is compared with the second (default: %(default)s)")
-    p.add_argument("--anytime-planners", type=_planner, nargs="+", default=_default("anytime_planners"), help="(default: %(default)s)")
-    p.add_argument("--checkers", nargs="+", default=_default("checkers"), choices=CHECKERS,
-                   help="motion validators; the first is the headline (default: %(default)s)")
+    p.add_argument("--anytime-planners", type=_planner, nargs="+", default=None,
+                   help=f"(default: the problem's planners; the wearer's: {' '.join(_default('anytime_planners'))})")
+    p.add_argument("--checkers", nargs="+", default=None, choices=CHECKERS,
+                   help="motion validators; the first is the headline (default: the problem's: for the wearer "
+                        f"{' '.join(_default('checkers'))}, for the generic problems discrete only)")
     p.add_argument("--alt-checker-queries", type=_count, default=_default("alt_checker_queries"),
                    help="run the non-headline validators on the first k queries only (default: all)")
     p.add_argument("--alt-checker-samples", type=positive_int, nargs="+", default=_default("alt_checker_caps"),
@@ -129,18 +148,23 @@ def register(subparsers: argparse._SubParsersAction,
 
 
 def config_from_args(args: argparse.Namespace) -> CampaignConfig:
-    """A :class:`CampaignConfig` from parsed arguments."""
-    name = args.name or Path(args.queries).stem
-    return CampaignConfig(
+    """A :class:`CampaignConfig` from parsed arguments; checkers and anytime planners default to the problem's."""
+    problem = get_problem(getattr(args, "problem", DEFAULT_PROBLEM))
+    name = args.name or (Path(args.queries).stem if args.queries else problem.default_queries or problem.name)
+    extra = {}
+    if args.checkers is not None:
+        extra["checkers"] = tuple(args.checkers)
+    if args.anytime_planners is not None:
+        extra["anytime_planners"] = tuple(args.anytime_planners)
+    return CampaignConfig.for_problem(
+        problem.name,
         name=name,
         queries=args.queries,
         sample_caps=tuple(args.samples or ()),
         iteration_planners=tuple(args.planners),
-        checkers=tuple(args.checkers),
         alt_checker_queries=args.alt_checker_queries,
         alt_checker_caps=tuple(args.alt_checker_samples) if args.alt_checker_samples else None,
         anytime_budgets=tuple(args.anytime or ()),
-        anytime_planners=tuple(args.anytime_planners),
         anytime_queries=args.anytime_queries,
         max_queries=args.max_queries,
         runs=args.runs,
@@ -148,7 +172,23 @@ def config_from_args(args: argparse.Namespace) -> CampaignConfig:
         seed=args.seed,
         out=args.out,
         max_time=args.max_time,
+        **extra,
     )
+
+
+def list_problems() -> int:
+    """Print the problems: name, dimension, queries and a one-line description; returns 0."""
+    from ..bench.problems import problem_table
+
+    rows = problem_table()
+    width = max(len(r["name"]) for r in rows)
+    print(f"{'problem':{width}s}  dim  queries  description")
+    for r in rows:
+        n = str(r["queries"]) if r["queries"] is not None else "n/a"
+        note = f" [unavailable: {r['note']}]" if r["note"] else ""
+        default = " (default)" if r["name"] == DEFAULT_PROBLEM else ""
+        print(f"{r['name']:{width}s}  {r['dimension']:>3d}  {n:>7s}  {r['description']}{default}{note}")
+    return 0
 
 
 def run(args: argparse.Namespace) -> int:
@@ -161,6 +201,8 @@ def run(args: argparse.Namespace) -> int:
     from ..bench.campaign import load_campaign, prepare_campaign, resume_campaign, run_campaign
     from ..bench.executors import make_executor
 
+    if getattr(args, "list_problems", False):
+        return list_problems()
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     prog = getattr(args, "bench_prog", "bench")
     try:
