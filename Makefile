@@ -45,7 +45,7 @@ bench-generic: $(STAMP)
 		MPLBACKEND=Agg $(PY) experiments/run_benchmark.py --problem $$p --name $$p --max-queries 4 \
 			--samples 500 --anytime 0.1 0.5 1 --workers 2 --no-progress || exit 1; \
 	done
-	-MPLBACKEND=Agg $(PY) experiments/run_benchmark.py --problem panda-shelf --name panda-shelf --max-queries 4 \
+	MPLBACKEND=Agg $(PY) experiments/run_benchmark.py --problem panda-shelf --name panda-shelf --max-queries 4 \
 		--samples 500 --anytime 0.1 0.5 1 --workers 2 --no-progress
 
 # Default cross-sector DMP path library (12 pairs x <= 20 dimension-RRT demos, ~3.5 min on 2 cores).

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import ast
 import gc
+import subprocess
 import sys
 from pathlib import Path
 
@@ -16,8 +17,9 @@ from tpee_ompl.bench.experiment import group_lengths
 from tpee_ompl.bench.generic_problems import GENERIC_PROBLEMS
 from tpee_ompl.bench.problems import DEFAULT_PROBLEM, PROBLEM_NAMES, get_problem, problem_table
 from tpee_ompl.planning.grouped_space import RealVectorLayout
+from tests.helpers.panda import needs_panda
 
-BUILDABLE = [n for n in PROBLEM_NAMES if n != "panda-shelf"]  # panda-shelf needs modules this branch lacks
+BUILDABLE = [pytest.param(n, marks=needs_panda) if n == "panda-shelf" else n for n in PROBLEM_NAMES]
 STRAIGHT_MAY_BE_FREE = {"wearer-random"}  # the paper's random queries: most straight motions are free
 
 
@@ -103,15 +105,24 @@ def test_configuration_refuses_what_a_problem_cannot_run():
     assert CampaignConfig.for_problem("wearer") == CampaignConfig()
 
 
-def test_robot_problem_without_its_modules_fails_with_one_line(monkeypatch):
-    monkeypatch.setitem(sys.modules, "tpee_ompl.model.robots", None)  # as on a version without them
-    p = get_problem("panda-shelf")
-    assert p.dimension == 7 and p.checkers[0] == "batched"
-    with pytest.raises(ImportError, match="panda-shelf needs tpee_ompl.model.robots") as exc:
-        p.queries()
-    assert "\n" not in str(exc.value)
-    row = next(r for r in problem_table() if r["name"] == "panda-shelf")
-    assert row["queries"] is None and "tpee_ompl.model.robots" in row["note"]
+def test_robot_problem_without_the_robots_extra_fails_with_one_line_naming_it():
+    # a fresh process: this one may have loaded the Panda already (the problem caches its checker)
+    code = ("import sys; sys.modules['example_robot_data'] = None\n"
+            "from tpee_ompl.bench.problems import get_problem, problem_table\n"
+            "p = get_problem('panda-shelf'); assert p.dimension == 7 and p.checkers[0] == 'batched'\n"
+            "row = next(r for r in problem_table() if r['name'] == 'panda-shelf')\n"
+            "assert row['queries'] is None and 'robots' in row['note'], row\n"
+            "try:\n    p.queries()\nexcept ImportError as exc:\n    print(exc)\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == "the Panda needs the optional 'robots' extra: pip install 'tpee-ompl[robots]'"
+
+
+@needs_panda
+def test_the_panda_problem_groups_are_the_robot_modules_groups():
+    from tpee_ompl.model.robots import PANDA_GROUPS
+
+    assert get_problem("panda-shelf").groups == PANDA_GROUPS
 
 
 def test_group_lengths_of_an_so2_path_go_the_short_way_round():

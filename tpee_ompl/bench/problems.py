@@ -169,15 +169,13 @@ def _generic_queries(name: str) -> list[dict]:
 # ----------------------------------------------------------------- robot-checker problems (hook)
 def _robot_problem(name: str, dimension: int, description: str, robot: str, query_set: str, groups_name: str,
                    ) -> Problem:
-    """A problem on a ``RobotChecker`` of :mod:`tpee_ompl.model.robots` (``.collision_checks``, ``.model_hash``,
-    ``.nq``), its joint query set and ``make_simple_setup``: one entry per robot in :data:`PROBLEMS`."""
+    """A problem on a :class:`~tpee_ompl.model.robot_checker.RobotChecker` made by a function of
+    :mod:`tpee_ompl.model.robots`, its joint query set and ``make_simple_setup``: one entry per robot in
+    :data:`PROBLEMS`."""
 
     def modules():
-        try:
-            from ..model import joint_queries, robots
-        except ImportError:
-            raise ImportError(f"problem {name} needs tpee_ompl.model.robots and tpee_ompl.model.joint_queries, "
-                              "which this version does not have") from None
+        from ..model import joint_queries, robots  # lazy: the robots need the optional 'robots' extra
+
         return robots, joint_queries
 
     @functools.lru_cache(maxsize=2)
