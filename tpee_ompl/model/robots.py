@@ -26,8 +26,8 @@ PANDA_LOCKED = {"panda_finger_joint1": 0.02, "panda_finger_joint2": 0.02}
 """The fingers, half open (metres), are not planned."""
 PANDA_TOOL_FRAME = "panda_hand_tcp"
 """The frame between the fingertips: the end-effector point the query labels use."""
-PANDA_SECURITY_MARGIN = 0.01
-"""Metres: the default margin of :func:`panda_shelf` (the compartments leave room for 1 cm)."""
+PANDA_SECURITY_MARGIN = 0.02
+"""Metres: the default margin of :func:`panda_shelf`, as the wearer's (the motion-check step is then 0.0093 rad)."""
 _EXTRA_MESSAGE = "the Panda needs the optional 'robots' extra: pip install 'tpee-ompl[robots]'"
 
 _SHELF_FRONT, _SHELF_BACK, _SHELF_HALF_WIDTH = 0.42, 0.77, 0.46
