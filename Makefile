@@ -30,11 +30,14 @@ bench: $(STAMP)
 		--max-queries 24 --samples 500 2500 --alt-checker-queries 4 --alt-checker-samples 500 \
 		--anytime 0.1 0.5 1 --anytime-queries 6 --workers 2
 
-# Full campaign: all 120 queries, 500..2500 samples, anytime 0.1..2 s, both named query sets.
+# Full campaign, both named query sets: Table 4 (500..2500 samples, one run per ladder) on all 120
+# queries of each; OMPL's per-state validator on 12 stratified queries per set at 500 and 2500;
+# the anytime comparison (0.1..2 s, separate runs) on 2 stratified queries per set.
 bench-full: $(STAMP)
-	MPLBACKEND=Agg $(PY) experiments/run_benchmark.py --queries planning_necessary --name full --workers 2
+	MPLBACKEND=Agg $(PY) experiments/run_benchmark.py --queries planning_necessary --name full --workers 2 \
+		--alt-checker-queries 12 --alt-checker-samples 500 2500 --anytime-queries 2
 	MPLBACKEND=Agg $(PY) experiments/run_benchmark.py --queries paper_random --name full_random --workers 2 \
-		--anytime
+		--alt-checker-queries 12 --alt-checker-samples 500 2500 --anytime-queries 2
 
 # The generic problems (plain OMPL + numpy set-ups), each in its own campaign with short settings:
 # 4 queries, 500 samples, anytime 0.1/0.5/1 s (tpee-ompl bench --list-problems lists them).

@@ -15,7 +15,7 @@ import tpee_ompl.bench.generic_problems as generic
 from tpee_ompl.bench.config import CampaignConfig
 from tpee_ompl.bench.experiment import group_lengths
 from tpee_ompl.bench.generic_problems import GENERIC_PROBLEMS
-from tpee_ompl.bench.problems import DEFAULT_PROBLEM, PROBLEM_NAMES, get_problem, problem_table
+from tpee_ompl.bench.problems import DEFAULT_PROBLEM, PROBLEM_NAMES, get_problem
 from tpee_ompl.planning.grouped_space import RealVectorLayout
 from tests.helpers.panda import needs_panda
 

@@ -109,6 +109,9 @@ class CampaignConfig:
     """Safety time limit per iteration-capped run (s); a run hitting it counts as a failure."""
     simplify: bool = True
     """OMPL's default; ``solution_length`` stays the raw length either way."""
+    one_run_per_ladder: bool = True
+    """Run each iteration ladder (every cap of one validator) once, at its largest cap, and read the smaller
+    caps' rows at checkpoints (:mod:`tpee_ompl.bench.ladder`); False: one separate run per cap."""
 
     @classmethod
     def for_problem(cls, problem: str, **fields) -> CampaignConfig:
@@ -176,6 +179,7 @@ class CampaignConfig:
         check_seed("seed", self.seed)
         check_number("max_time", self.max_time, low=0, low_open=True)
         check_bool("simplify", self.simplify)
+        check_bool("one_run_per_ladder", self.one_run_per_ladder)
 
 
 @dataclass

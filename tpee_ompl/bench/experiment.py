@@ -128,16 +128,22 @@ def run_query_task(task: dict) -> dict:
     specs = task.get("specs") or experiment_specs(cfg, qpos)
     out: dict = {"qpos": qpos, "query_id": query["id"], "logs": {}, "extras": {}, "errors": {},
                  "pid": os.getpid(), "host": socket.gethostname()}
-    for spec in specs:
-        fname = log_name(query, qpos, spec)
-        if log_dir is not None and (log_dir / fname).is_file():
-            continue  # written by an earlier attempt of this task whose worker died
-        text, extras, error = _run_experiment(cfg, task, spec)
-        out["logs"][fname], out["extras"][fname] = text, extras
-        if error:
-            out["errors"][fname] = error
-        if log_dir is not None:
-            write_new_file(log_dir / fname, text)
+    from .ladder import Ladder, group_ladders
+
+    # written by an earlier attempt of this task whose worker died
+    specs = [s for s in specs if log_dir is None or not (log_dir / log_name(query, qpos, s)).is_file()]
+    for group in group_ladders(specs, cfg.get("one_run_per_ladder", True), cfg["iteration_planners"]):
+        ladder = Ladder(group) if len(group) > 1 else None  # one run at the largest cap gives every cap's log
+        results = [_run_experiment(cfg, task, group[-1], ladder)]
+        if ladder is not None:
+            results = (ladder.derived or [_run_experiment(cfg, task, s) for s in group[:-1]]) + results
+        for spec, (text, extras, error) in zip(group, results):
+            fname = log_name(query, qpos, spec)
+            out["logs"][fname], out["extras"][fname] = text, extras
+            if error:
+                out["errors"][fname] = error
+            if log_dir is not None:
+                write_new_file(log_dir / fname, text)
     out["elapsed"] = time.perf_counter() - t0
     return out
 
@@ -200,7 +206,7 @@ def _path_properties(si, rec: dict, start: np.ndarray, goal: np.ndarray, first: 
             "length_dof34 REAL": l34, "raw_length REAL": l4, "path_valid_dense INTEGER": int(ok)}
 
 
-def _run_experiment(cfg: dict, task: dict, spec: dict) -> tuple[str, dict, str | None]:
+def _run_experiment(cfg: dict, task: dict, spec: dict, ladder=None) -> tuple[str, dict, str | None]:
     """One OMPL experiment; returns (log text, {planner: [run properties]}, benchmark error or None).
 
     Exceptions from Python callbacks never escape: planner exceptions are caught in
@@ -208,6 +214,8 @@ def _run_experiment(cfg: dict, task: dict, spec: dict) -> tuple[str, dict, str |
     and anything else that aborts ``benchmark()`` (e.g. a Python validity checker raising while
     OMPL checks the path) restores OMPL's logging and records every run that did not finish as a
     failed run (status *crash*, ``planner_error`` = 1).
+    With a :class:`~tpee_ompl.bench.ladder.Ladder`, the run also gives the logs of its smaller caps
+    (``ladder.derived``).
     """
     query, qpos = task["query"], int(task["qpos"])
     problem = get_problem(cfg.get("problem", "wearer"))
@@ -227,11 +235,14 @@ def _run_experiment(cfg: dict, task: dict, spec: dict) -> tuple[str, dict, str |
     planners = cfg["iteration_planners"] if spec["comparison"] == "iterations" else cfg["anytime_planners"]
     wrappers = {}
     tag = cap if cap is not None else int(round(budget * 1000))
+    tag = spec.get("seed_tag", tag)  # a separate run with a ladder's planner seeds (tests/bench/test_ladder.py)
     for k, pname in enumerate(planners):
         ctx = PlannerContext(query=query, max_samples=cap, seed=_sub_seed(cfg["seed"], qpos, k, tag),
                              problem=problem.name)
         inner = planner_factory(pname)(si, ctx)
-        w = RecordingPlanner(si, inner, max_iterations=cap, read=None if layout.is_plain else layout.read)
+        read = None if layout.is_plain else layout.read
+        w = (RecordingPlanner(si, inner, max_iterations=cap, read=read) if ladder is None
+             else ladder.wrap(si, inner, cap, pname, ctx, checker=checker, read=read))
         wrappers[w.getName()] = w
         bench.addPlanner(w)
 
@@ -300,5 +311,12 @@ def _run_experiment(cfg: dict, task: dict, spec: dict) -> tuple[str, dict, str |
         path = Path(tmp) / "experiment.log"
         bench.saveResultsToFile(str(path))
         text = path.read_text()
+    if ladder is not None:
+        try:
+            ladder.derived = ladder.derive(
+                bench, ss, name, records, start, goal, bool(cfg["simplify"]), float(cfg["max_time"]),
+                lambda si_, rec, s0, s1: _path_properties(si_, rec, s0, s1, problem.groups[0], layout))
+        except Exception:  # noqa: BLE001 (the smaller caps then run separately)
+            log.exception("checkpoint rows of %s failed; running its smaller caps separately", name)
     extras = {n: [{k.rsplit(" ", 1)[0]: v for k, v in r["props"].items()} for r in recs] for n, recs in records.items()}
     return text, extras, error
