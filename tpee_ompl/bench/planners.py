@@ -169,7 +169,10 @@ class RecordingPlanner(ob.Planner):
 
     After each ``solve``, :attr:`last` holds the run's record: ``waypoints`` (raw path, (K, n), or
     None), ``iterations``, ``samples``, ``best_cost``, ``first_solution_time``, ``progress``
-    (list of (time, best cost, iterations)) and ``error`` (None, or the exception's repr).
+    (list of (time, best cost, iterations)) and ``error`` (None, or the exception's repr).  A native
+    planner's ``first_solution_time`` is the first termination check that saw an exact solution (a finite
+    ``bestCost()``, or one in the problem definition for planners without it, e.g. AORRTC), else the run's
+    end when it returned one (RRTConnect stops at its first path).
     Exceptions never escape to OMPL (they would abort the whole benchmark): a failing ``solve``
     returns status *crash*.
     """
@@ -182,7 +185,8 @@ class RecordingPlanner(ob.Planner):
         self.inner = inner
         self.max_iterations = max_iterations
         self.progress_period = float(progress_period)
-        self._native_stats = hasattr(inner, "numIterations") and not hasattr(inner, "last_run_stats")
+        self._native = not hasattr(inner, "last_run_stats")
+        """A native OMPL planner: watched at every termination check (cap, first solution, progress)."""
         if max_iterations is not None and not hasattr(inner, "last_run_stats") and not hasattr(inner, "numIterations"):
             raise ValueError(f"{inner.getName()} has no numIterations(): it cannot be iteration-capped")
         self._setup_error: str | None = None
@@ -207,24 +211,30 @@ class RecordingPlanner(ob.Planner):
 
     def solve(self, ptc):  # noqa: D102 (OMPL override)
         inner, cap = self.inner, self.max_iterations
+        pdef = self.getProblemDefinition()
         t0 = time.perf_counter()
         progress: list[tuple[float, float, int]] = []
-        state = {"next": 0.0}
+        state = {"next": 0.0, "first": None}
         has_cost = hasattr(inner, "bestCost")
+        has_iterations = hasattr(inner, "numIterations")
 
         def stop() -> bool:
-            it = inner.numIterations()
+            """Called at every termination check: the first exact solution's time, progress, the cap."""
+            it = inner.numIterations() if has_iterations else None
             now = time.perf_counter() - t0
+            if state["first"] is None and (math.isfinite(inner.bestCost().value()) if has_cost
+                                           else pdef.hasExactSolution()):
+                state["first"] = now
             if has_cost and now >= state["next"]:
                 progress.append((now, inner.bestCost().value(), it))
                 state["next"] = now + self.progress_period
-            return cap is not None and it >= cap
+            return cap is not None and it is not None and it >= cap
 
         error = self._setup_error
         try:
             if error is not None:
                 raise RuntimeError(f"setup failed: {error}")
-            if self._native_stats:
+            if self._native:
                 cond = ob.plannerOrTerminationCondition(ptc, ob.PlannerTerminationCondition(stop))
                 status = inner.solve(cond)
             else:
@@ -234,12 +244,13 @@ class RecordingPlanner(ob.Planner):
             error = repr(exc)
             status = ob.PlannerStatus(ob.PlannerStatus.CRASH)
         elapsed = time.perf_counter() - t0
-        pdef = self.getProblemDefinition()
         waypoints = None
         if error is None and pdef.hasSolution():
             waypoints = path_to_array(pdef.getSolutionPath(), self._dim, read=self._read)
-        self.last = {"waypoints": waypoints, "error": error, **self._run_stats(elapsed, progress, has_cost),
-                     **self._graph_size()}
+        if state["first"] is None and error is None and pdef.hasExactSolution():
+            state["first"] = elapsed  # found as the planner returned (RRTConnect stops at its first path)
+        self.last = {"waypoints": waypoints, "error": error,
+                     **self._run_stats(elapsed, progress, has_cost, state["first"]), **self._graph_size()}
         return status
 
     def _graph_size(self) -> dict:
@@ -254,7 +265,7 @@ class RecordingPlanner(ob.Planner):
         except Exception:  # noqa: BLE001 (a planner without planner data)
             return {"graph_states": None, "graph_motions": None}
 
-    def _run_stats(self, elapsed: float, progress: list, has_cost: bool) -> dict:
+    def _run_stats(self, elapsed: float, progress: list, has_cost: bool, first: float | None) -> dict:
         """Iterations, samples, best cost, first-solution time and progress of the run that just ended."""
         inner = self.inner
         if hasattr(inner, "last_run_stats"):
@@ -273,11 +284,10 @@ class RecordingPlanner(ob.Planner):
         best = inner.bestCost().value() if has_cost else None
         if has_cost:
             progress.append((elapsed, best, iterations))
-        finite = [t for t, c, _ in progress if math.isfinite(c)]
         return {
             "iterations": iterations,
             "samples": iterations,
             "best_cost": best,
-            "first_solution_time": finite[0] if finite else None,
+            "first_solution_time": first,
             "progress": progress,
         }

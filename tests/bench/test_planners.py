@@ -1,0 +1,43 @@
+"""The recording wrapper: the first exact solution's time of native planners, read at every termination check."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+from ompl import base as ob
+from ompl import geometric as og
+
+from tests.helpers.planning_spaces import box_problem
+from tpee_ompl.bench.planners import RecordingPlanner
+
+
+def _solve(planner_cls, seconds: float, cap: int | None = None) -> dict:
+    si, checker = box_problem()
+    pdef = ob.ProblemDefinition(si)
+    start, goal = si.allocState(), si.allocState()
+    start[0], start[1], goal[0], goal[1] = -0.9, 0.0, 0.9, 0.0
+    pdef.setStartAndGoalStates(start, goal, 1e-9)
+    pdef.setOptimizationObjective(ob.PathLengthOptimizationObjective(si))
+    w = RecordingPlanner(si, planner_cls(si), max_iterations=cap)
+    w.setProblemDefinition(pdef)
+    w.setup()
+    status = w.solve(ob.timedPlannerTerminationCondition(seconds))
+    return dict(w.last, status=str(status), exact=pdef.hasExactSolution(), keep=(si, checker, start, goal))
+
+
+@pytest.mark.parametrize("planner_cls", [og.RRTstar, og.AORRTC])
+def test_native_anytime_planners_record_their_first_exact_solution_before_the_run_ends(planner_cls):
+    rec = _solve(planner_cls, 0.5)
+    assert rec["exact"] and rec["first_solution_time"] is not None
+    assert 0.0 < rec["first_solution_time"] < 0.4  # found in a few ms on this problem, then improved to the end
+
+
+def test_rrtconnect_first_solution_is_the_end_of_its_run():
+    rec = _solve(og.RRTConnect, 1.0)
+    assert rec["exact"] and rec["first_solution_time"] is not None and math.isfinite(rec["first_solution_time"])
+
+
+def test_a_run_without_an_exact_solution_records_no_first_solution_time():
+    rec = _solve(og.RRTstar, 5.0, cap=1)  # one iteration: no path from one sample
+    assert not rec["exact"] and rec["first_solution_time"] is None
