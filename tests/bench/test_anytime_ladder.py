@@ -79,7 +79,7 @@ def test_rrtconnect_still_running_at_a_budget_is_run_separately_there():
 
 @pytest.mark.parametrize("name", ["RRTConnectSimplify", "AORRTC", "BITstar", "LibraryDimensionRRT"])
 def test_planners_that_know_their_budget_or_are_unverified_run_separately(name):
-    ss, si = _setup_2d(0.9)
+    _, si = _setup_2d(0.9)
     ladder = AnytimeLadder([_spec(0.1), _spec(1.0)], lambda spec, names: ([], {}, None))
     # the choice goes by the configuration's planner name (a cheap inner planner stands in)
     w = ladder.wrap(si, og.RRTConnect(si), None, name, PlannerContext(query={}, max_samples=None, seed=1))
