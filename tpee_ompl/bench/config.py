@@ -112,6 +112,10 @@ class CampaignConfig:
     one_run_per_ladder: bool = True
     """Run each iteration ladder (every cap of one validator) once, at its largest cap, and read the smaller
     caps' rows at checkpoints (:mod:`tpee_ompl.bench.ladder`); False: one separate run per cap."""
+    one_run_per_anytime_ladder: bool = True
+    """Run each anytime ladder (every budget of one validator) once, at its longest budget, and read the shorter
+    budgets' rows at time checkpoints where that is exact (:mod:`tpee_ompl.bench.anytime_ladder`; the other
+    planners run separately per budget); False: one separate run per budget."""
 
     @classmethod
     def for_problem(cls, problem: str, **fields) -> CampaignConfig:
@@ -180,6 +184,7 @@ class CampaignConfig:
         check_number("max_time", self.max_time, low=0, low_open=True)
         check_bool("simplify", self.simplify)
         check_bool("one_run_per_ladder", self.one_run_per_ladder)
+        check_bool("one_run_per_anytime_ladder", self.one_run_per_anytime_ladder)
 
 
 @dataclass

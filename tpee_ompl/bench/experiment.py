@@ -128,12 +128,17 @@ def run_query_task(task: dict) -> dict:
     specs = task.get("specs") or experiment_specs(cfg, qpos)
     out: dict = {"qpos": qpos, "query_id": query["id"], "logs": {}, "extras": {}, "errors": {},
                  "pid": os.getpid(), "host": socket.gethostname()}
+    from .anytime_ladder import AnytimeLadder, group_anytime_ladders
     from .ladder import Ladder, group_ladders
 
     # written by an earlier attempt of this task whose worker died
     specs = [s for s in specs if log_dir is None or not (log_dir / log_name(query, qpos, s)).is_file()]
-    for group in group_ladders(specs, cfg.get("one_run_per_ladder", True), cfg["iteration_planners"]):
-        ladder = Ladder(group) if len(group) > 1 else None  # one run at the largest cap gives every cap's log
+    groups = group_ladders(specs, cfg.get("one_run_per_ladder", True), cfg["iteration_planners"])
+    for group in group_anytime_ladders(groups, cfg.get("one_run_per_anytime_ladder", True)):
+        ladder = None  # one run at the largest cap (longest budget) gives every cap's (budget's) log
+        if len(group) > 1:
+            ladder = (Ladder(group) if group[0]["comparison"] == "iterations"
+                      else AnytimeLadder(group, lambda spec, names: _run_separately(cfg, task, spec, names)))
         results = [_run_experiment(cfg, task, group[-1], ladder)]
         if ladder is not None:
             results = (ladder.derived or [_run_experiment(cfg, task, s) for s in group[:-1]]) + results
@@ -206,7 +211,16 @@ def _path_properties(si, rec: dict, start: np.ndarray, goal: np.ndarray, first: 
             "length_dof34 REAL": l34, "raw_length REAL": l4, "path_valid_dense INTEGER": int(ok)}
 
 
-def _run_experiment(cfg: dict, task: dict, spec: dict, ladder=None) -> tuple[str, dict, str | None]:
+def _run_separately(cfg: dict, task: dict, spec: dict, planners: list[str]) -> tuple[list, dict, str | None]:
+    """An experiment of only ``planners`` (anytime ladder: the budgets they cannot be read at); returns
+    its recorded planners (detached copies), extras and error."""
+    sink: dict = {}
+    _, extras, error = _run_experiment(cfg, task, spec, only=planners, sink=sink)
+    return sink["planners"], extras, error
+
+
+def _run_experiment(cfg: dict, task: dict, spec: dict, ladder=None, only: list[str] | None = None,
+                    sink: dict | None = None) -> tuple[str, dict, str | None]:
     """One OMPL experiment; returns (log text, {planner: [run properties]}, benchmark error or None).
 
     Exceptions from Python callbacks never escape: planner exceptions are caught in
@@ -214,8 +228,10 @@ def _run_experiment(cfg: dict, task: dict, spec: dict, ladder=None) -> tuple[str
     and anything else that aborts ``benchmark()`` (e.g. a Python validity checker raising while
     OMPL checks the path) restores OMPL's logging and records every run that did not finish as a
     failed run (status *crash*, ``planner_error`` = 1).
-    With a :class:`~tpee_ompl.bench.ladder.Ladder`, the run also gives the logs of its smaller caps
-    (``ladder.derived``).
+    With a :class:`~tpee_ompl.bench.ladder.Ladder` (:class:`~tpee_ompl.bench.anytime_ladder.AnytimeLadder`),
+    the run also gives the logs of its smaller caps (shorter budgets) in ``ladder.derived``.  ``only``: run
+    only these planners (same seeds as in the full experiment); ``sink["planners"]`` then receives detached
+    copies of the recorded planners.
     """
     query, qpos = task["query"], int(task["qpos"])
     problem = get_problem(cfg.get("problem", "wearer"))
@@ -237,6 +253,8 @@ def _run_experiment(cfg: dict, task: dict, spec: dict, ladder=None) -> tuple[str
     tag = cap if cap is not None else int(round(budget * 1000))
     tag = spec.get("seed_tag", tag)  # a separate run with a ladder's planner seeds (tests/bench/test_ladder.py)
     for k, pname in enumerate(planners):
+        if only is not None and pname not in only:
+            continue
         ctx = PlannerContext(query=query, max_samples=cap, seed=_sub_seed(cfg["seed"], qpos, k, tag),
                              problem=problem.name)
         inner = planner_factory(pname)(si, ctx)
@@ -311,12 +329,16 @@ def _run_experiment(cfg: dict, task: dict, spec: dict, ladder=None) -> tuple[str
         path = Path(tmp) / "experiment.log"
         bench.saveResultsToFile(str(path))
         text = path.read_text()
+    if sink is not None:
+        from .anytime_ladder import copy_planner
+
+        sink["planners"] = [copy_planner(pl) for pl in bench.getRecordedExperimentData().planners]
     if ladder is not None:
         try:
             ladder.derived = ladder.derive(
                 bench, ss, name, records, start, goal, bool(cfg["simplify"]), float(cfg["max_time"]),
                 lambda si_, rec, s0, s1: _path_properties(si_, rec, s0, s1, problem.groups[0], layout))
         except Exception:  # noqa: BLE001 (the smaller caps then run separately)
-            log.exception("checkpoint rows of %s failed; running its smaller caps separately", name)
+            log.exception("checkpoint rows of %s failed; running its smaller caps (budgets) separately", name)
     extras = {n: [{k.rsplit(" ", 1)[0]: v for k, v in r["props"].items()} for r in recs] for n, recs in records.items()}
     return text, extras, error

@@ -145,19 +145,27 @@ class CheckpointPlanner(RecordingPlanner):
         self._run["posted"] = (_waypoints(states, self.getSpaceInformation().getStateDimension(), self._read),
                                float(cost.value()))
 
+    def _count(self) -> int | None:
+        """The search's position at this termination check: samples so far (Python) or RRT*'s iterations."""
+        if self.python:
+            self._run["calls"] += 1
+            return self._run["calls"] - 1
+        return self.inner.numIterations()
+
+    def _due(self, n: int | None, now: float) -> list:
+        """The checkpoints reached at this termination check."""
+        return [n] if n in self._run["todo"] else []
+
     def _watch(self) -> bool:
         run = self._run
-        if self.python:
-            n = run["calls"]
-            run["calls"] += 1
-        else:
-            n = self.inner.numIterations()
-        if n in run["todo"]:
-            run["todo"].discard(n)
+        n = self._count()
+        now = time.perf_counter() - run["t0"]
+        for key in self._due(n, now):
+            run["todo"].discard(key)
             try:
-                run["snaps"][n] = self._snapshot(n, time.perf_counter() - run["t0"])
+                run["snaps"][key] = self._snapshot(n, now)
             except Exception:  # noqa: BLE001 (an exception would abort the benchmark)
-                log.exception("checkpoint %d of %s failed", n, self.inner.getName())
+                log.exception("checkpoint %s of %s failed", key, self.inner.getName())
         return False
 
     def _snapshot(self, n: int, now: float) -> dict:
@@ -225,10 +233,7 @@ class Ladder:
         """One ``(log text, extras, None)`` per smaller cap, ascending (edits the recorded data in place:
         call after the largest cap's log is saved).  ``path_properties(si, record, start, goal)`` measures a
         path as the post-run event does (the experiment's, with its problem's groups and state layout)."""
-        import tempfile
-        from pathlib import Path
-
-        from .database import _dedupe_times, _planner_name
+        from .database import _planner_name
 
         ed = bench.getRecordedExperimentData()
         si, pdef = ss.getSpaceInformation(), ss.getProblemDefinition()
@@ -247,35 +252,16 @@ class Ladder:
                 for i, run in enumerate(pl.runs):
                     snap = w.snapshots[i].get(n) if i < len(w.snapshots) else None
                     rec = recs[i] if i < len(recs) else {"props": {}, "progress": []}
-                    if snap is None:  # the run ended (error, time limit) before n: a run capped at n did too
-                        row, prog, props = run.to_dict(), rec["progress"], rec["props"]
-                    else:
-                        c0 = w._checks()
-                        row = self._ompl_columns(si, pdef, run.to_dict(), snap, simplify)
-                        checks = snap.get("own_checks", snap["checks"] - w.start_checks[i]) + w._checks() - c0
-                        props = self._our_columns(si, rec["props"], snap, checks, start, goal, path_properties)
-                        row.update({k: format_value(v) for k, v in props.items()})
-                        prog = snap.get("progress")
-                        if prog is None:
-                            prog = [p for p in rec["progress"] if p[0] <= snap["time"]]
-                            prog.append((snap["time"], snap["best_cost"], n))
-                    new = ot.RunProperties()
-                    for k, v in row.items():
-                        new[k] = v
-                    runs.append(new)
-                    total += float(row.get("time REAL") or 0) + float(row.get("simplification time REAL") or 0)
+                    row, prog, props = derived_run(si, pdef, w, i, run.to_dict(), rec, snap, simplify, start, goal,
+                                                   path_properties)
+                    runs.append(row)
+                    total += run_seconds(row)
                     progress.append(prog)
                     extras.setdefault(pname, []).append({k.rsplit(" ", 1)[0]: v for k, v in props.items()})
-                pl.runs = runs
+                set_runs(pl, runs, progress)
                 pl.common["iteration_cap"] = str(n)
-                pl.runsProgressData = [
-                    [{"best cost REAL": format_value(c), "iterations INTEGER": format_value(k),
-                      "time REAL": format_value(t)} for t, c, k in _dedupe_times(p)] for p in progress]
             ed.totalDuration = total
-            with tempfile.TemporaryDirectory(prefix="tpee_log_") as tmp:
-                path = Path(tmp) / "experiment.log"
-                bench.saveResultsToFile(str(path))
-                out.append((path.read_text(), extras, None))
+            out.append((log_text(bench), extras, None))
         return out
 
     def _run_pending(self, ss, max_time: float) -> None:
@@ -372,3 +358,53 @@ class Ladder:
         if snap["waypoints"] is None and math.isfinite(float(snap["best_cost"])):
             out["best_cost REAL"] = snap["best_cost"]
         return out
+
+
+def derived_run(si, pdef, w: CheckpointPlanner, i: int, row: dict, rec: dict, snap: dict | None, simplify: bool,
+                start: np.ndarray, goal: np.ndarray, path_properties) -> tuple[dict, list, dict]:
+    """Run ``i``'s (OMPL row, progress, our columns) at one checkpoint: the recorded run itself when
+    ``snap`` is None (the run ended before the checkpoint), else the snapshot's columns."""
+    if snap is None:
+        return row, rec["progress"], rec["props"]
+    c0 = w._checks()
+    row = Ladder._ompl_columns(si, pdef, row, snap, simplify)
+    checks = snap.get("own_checks", snap["checks"] - w.start_checks[i]) + w._checks() - c0
+    props = Ladder._our_columns(si, rec["props"], snap, checks, start, goal, path_properties)
+    row.update({k: format_value(v) for k, v in props.items()})
+    prog = snap.get("progress")
+    if prog is None:
+        prog = [p for p in rec["progress"] if p[0] <= snap["time"]]
+        prog.append((snap["time"], snap["best_cost"], snap["iterations"]))
+    return row, prog, props
+
+
+def run_seconds(row: dict) -> float:
+    """A run's planning plus simplification time (s), from its OMPL row."""
+    return float(row.get("time REAL") or 0) + float(row.get("simplification time REAL") or 0)
+
+
+def set_runs(pl, rows: list[dict], progress: list[list]) -> None:
+    """Replace a recorded planner's runs and progress (``pl``: an ``ot.PlannerExperiment``)."""
+    from .database import _dedupe_times
+
+    runs = []
+    for row in rows:
+        new = ot.RunProperties()
+        for k, v in row.items():
+            new[k] = v
+        runs.append(new)
+    pl.runs = runs
+    pl.runsProgressData = [
+        [{"best cost REAL": format_value(c), "iterations INTEGER": format_value(k),
+          "time REAL": format_value(t)} for t, c, k in _dedupe_times(p)] for p in progress]
+
+
+def log_text(bench) -> str:
+    """The OMPL log of the benchmark's recorded data, as text."""
+    import tempfile
+    from pathlib import Path
+
+    with tempfile.TemporaryDirectory(prefix="tpee_log_") as tmp:
+        path = Path(tmp) / "experiment.log"
+        bench.saveResultsToFile(str(path))
+        return path.read_text()
