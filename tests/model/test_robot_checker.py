@@ -144,3 +144,56 @@ def test_an_obstacle_beside_the_wearer_blocks_the_arm_there():
     c = RobotChecker(plain.files.urdf, plain.files.srdf, obstacles=[Obstacle("ball", "sphere", (0.05,), p)])
     assert not c.is_valid(q)
     assert "ball" in c.closest_pair(q)[:2]
+
+
+def _pair_distances(checker: RobotChecker, q: np.ndarray) -> np.ndarray:
+    pin.computeDistances(checker.model, checker.data, checker.gmodel, checker.gdata, q)
+    return np.array([r.min_distance for r in checker.gdata.distanceResults])
+
+
+def _assert_pair_levers_bound_distance_changes(checker: RobotChecker, rng: np.random.Generator, n: int) -> None:
+    R = checker.pair_lever_arms()
+    assert R.shape == (len(checker.gmodel.collisionPairs), checker.nq) and (R >= 0).all()
+    for _ in range(n):
+        q = rng.uniform(checker.lower, checker.upper)
+        q2 = np.clip(q + rng.normal(size=checker.nq) * rng.choice([0.01, 0.1, 0.5]), checker.lower, checker.upper)
+        change = np.abs(_pair_distances(checker, q2) - _pair_distances(checker, q))
+        assert (change <= R @ np.abs(q2 - q) + 1e-7).all()
+
+
+def test_pair_lever_arms_bound_every_pair_distance_change_on_the_wearer(robot):
+    _assert_pair_levers_bound_distance_changes(robot, np.random.default_rng(11), 400)
+
+
+@needs_panda
+def test_pair_lever_arms_bound_every_pair_distance_change_on_the_panda(panda0):
+    _assert_pair_levers_bound_distance_changes(panda0, np.random.default_rng(12), 400)
+
+
+def test_pair_lever_arms_count_only_joints_between_the_two_bodies(robot):
+    R, gm = robot.pair_lever_arms(), robot.gmodel
+    names = [(gm.geometryObjects[cp.first].name, gm.geometryObjects[cp.second].name) for cp in gm.collisionPairs]
+    # the barrel (link4) against the boom (link2): only pan and tilt lie between them, and the boom's
+    # vertical capsule is symmetric about the pan axis, so only tilt can change that distance
+    p = names.index(("link2_1", "link4_0"))
+    assert R[p, :3].tolist() == [0.0, 0.0, 0.0] and R[p, 3] > 0
+    # a wearer part against the barrel: every arm joint counts, never more than the arm's lever arms
+    p = names.index(("backpack_0", "link4_0"))
+    assert (R[p] > 0).all() and (R[p] <= robot.lever_arms() + 1e-12).all()
+
+
+def test_pair_margins_follow_link_margins_for_static_pairs_only(tmp_path):
+    urdf = tmp_path / "two.urdf"
+    urdf.write_text("""<robot name="t"><link name="base"/><link name="a">
+      <collision><origin xyz="0.3 0 0"/><geometry><sphere radius="0.05"/></geometry></collision></link>
+      <link name="b"><collision><origin xyz="0.3 0 0"/><geometry><sphere radius="0.05"/></geometry></collision></link>
+      <joint name="j1" type="revolute"><parent link="base"/><child link="a"/><axis xyz="0 0 1"/>
+        <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+      <joint name="j2" type="revolute"><parent link="a"/><child link="b"/><origin xyz="0.6 0 0"/><axis xyz="0 0 1"/>
+        <limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>""")
+    c = RobotChecker(urdf, obstacles=[box("wall", (0.1, 1, 1), (1.1, 0, 0))], link_margins={"b": 0.05})
+    gm = c.gmodel
+    margins = {tuple(sorted((gm.geometryObjects[cp.first].name, gm.geometryObjects[cp.second].name))): m
+               for cp, m in zip(gm.collisionPairs, c.pair_margins())}
+    assert margins[("b_0", "wall")] == pytest.approx(0.05)
+    assert margins[("a_0", "b_0")] == pytest.approx(c.security_margin)

@@ -14,6 +14,7 @@ import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
+import coal
 import numpy as np
 import pinocchio as pin
 
@@ -43,6 +44,18 @@ def as_config_batch(Q: np.ndarray, nq: int) -> np.ndarray:
         k = int(np.flatnonzero(bad)[0])
         raise ValueError(f"configurations contain NaN or inf: row {k} is {Q[k]}")
     return Q
+
+
+def _symmetric_about(go: pin.GeometryObject, point: np.ndarray, axis: np.ndarray, tol: float = 1e-9) -> bool:
+    """True if the geometry (placed in its joint's frame) is mapped onto itself by every rotation about
+    the line through ``point`` along unit ``axis``: a sphere centred on it, a capsule or cylinder along it."""
+    offset = go.placement.translation - point
+    on_axis = np.linalg.norm(np.cross(offset, axis)) <= tol
+    if isinstance(go.geometry, coal.Sphere):
+        return bool(on_axis)
+    if isinstance(go.geometry, (coal.Capsule, coal.Cylinder)):
+        return bool(on_axis and np.linalg.norm(np.cross(go.placement.rotation[:, 2], axis)) <= tol)
+    return False
 
 
 class RobotChecker:
@@ -113,6 +126,7 @@ class RobotChecker:
         self.link_margins = self._check_link_margins(link_margins, self.security_margin)
         self.n_threads = int(n_threads) if n_threads is not None else min(2, os.cpu_count() or 1)
         self._lever_arms: np.ndarray | None = None
+        self._pair_lever_arms: np.ndarray | None = None
         self.collision_checks = 0
         """Configurations checked for collision so far (single and batched)."""
         loaded = self._load_model()
@@ -281,6 +295,71 @@ class RobotChecker:
                     best = max(best, sum(chain) + np.linalg.norm(f.placement.translation))
             reach[j - 1] = best
         return reach
+
+    def pair_lever_arms(self) -> np.ndarray:
+        """Per checked pair, how fast each joint can change the pair's distance: shape (P, nq), P =
+        ``len(gmodel.collisionPairs)`` in that order; metres per radian (revolute) or per metre (prismatic).
+
+        Seen from the two bodies' lowest common ancestor, only the joints on the kinematic path between
+        them move one body relative to the other; joint i of that path moves a point of geometry g by at
+        most ``|dq_i|`` times the lever of i to g (as in :meth:`lever_arms`, but for g alone).  So
+        ``|d_p(q') - d_p(q)| <= sum_i |q'_i - q_i| R[p, i]`` along any straight joint motion.  A row of
+        zeros is a pair whose distance cannot change.  Computed once (the model is fixed after loading).
+        """
+        if self._pair_lever_arms is None:
+            self._pair_lever_arms = self._compute_pair_lever_arms()
+        return self._pair_lever_arms.copy()
+
+    def _ancestors(self, j: int) -> list[int]:
+        """Joints from ``j`` up to (not including) the universe."""
+        out = []
+        while j > 0:
+            out.append(j)
+            j = self.model.parents[j]
+        return out
+
+    def _geometry_lever(self, k: int, go: pin.GeometryObject) -> float:
+        """Bound on how far a unit step of joint k (an ancestor of go's joint) moves any point of go."""
+        if is_prismatic(self.model.joints[k]):
+            return 1.0
+        chain = self._chain_lengths(k, go.parentJoint)
+        return float(sum(chain) + np.linalg.norm(go.placement.translation) + bounding_radius(go.geometry))
+
+    def _compute_pair_lever_arms(self) -> np.ndarray:
+        out = np.zeros((len(self.gmodel.collisionPairs), self.nq))
+        for p, cp in enumerate(self.gmodel.collisionPairs):
+            ga, gb = self.gmodel.geometryObjects[cp.first], self.gmodel.geometryObjects[cp.second]
+            up_a, up_b = set(self._ancestors(ga.parentJoint)), set(self._ancestors(gb.parentJoint))
+            for go, other, path in ((ga, gb, up_a - up_b), (gb, ga, up_b - up_a)):
+                for k in path:
+                    if not self._distance_ignores_joint(k, go, other):
+                        out[p, self.model.joints[k].idx_q] = self._geometry_lever(k, go)
+        return out
+
+    def _distance_ignores_joint(self, k: int, go: pin.GeometryObject, other: pin.GeometryObject) -> bool:
+        """True if turning revolute joint k (on go's side) cannot change go's distance to ``other``:
+        go hangs on k and is symmetric about k's axis, or k hangs on other's joint and other is
+        symmetric about k's axis (a rotation that maps the shape onto itself)."""
+        if is_prismatic(self.model.joints[k]):
+            return False
+        jdata = self.model.joints[k].createData()
+        self.model.joints[k].calc(jdata, pin.neutral(self.model))
+        motion = np.asarray(jdata.S).reshape(6, -1)[:, 0]
+        if np.linalg.norm(motion[:3]) > 1e-12:
+            return False  # not a pure rotation about an axis through the joint origin
+        axis = motion[3:] / np.linalg.norm(motion[3:])
+        if go.parentJoint == k and _symmetric_about(go, np.zeros(3), axis):
+            return True
+        if self.model.parents[k] == other.parentJoint:
+            jp = self.model.jointPlacements[k]
+            return _symmetric_about(other, jp.translation, jp.rotation @ axis)
+        return False
+
+    def pair_margins(self) -> np.ndarray:
+        """Per checked pair (``gmodel.collisionPairs`` order), its security margin in metres (shape (P,)):
+        a configuration is valid only if every pair's distance is at least its margin."""
+        M = self._margin_matrix()
+        return np.array([M[cp.first, cp.second] for cp in self.gmodel.collisionPairs])
 
     def max_joint_step(self, displacement: float | None = None) -> float:
         """Largest Euclidean joint step that moves no point of the robot more than ``displacement`` (m).

@@ -17,6 +17,7 @@ checked links.**
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
 from ompl import base as ob
@@ -26,6 +27,9 @@ from ..model.robot_checker import RobotChecker
 from ..validation import check_number
 from .paths import MIN_JOINT_STEP, motion_states, set_state, state_to_array
 
+if TYPE_CHECKING:
+    from .certified import CertifiedMotionOptions
+
 __all__ = [
     "RobotValidityChecker",
     "WearerValidityChecker",
@@ -33,7 +37,11 @@ __all__ = [
     "make_space",
     "make_simple_setup",
     "motion_check_step",
+    "MOTION_VALIDATORS",
 ]
+
+MOTION_VALIDATORS = ("batched", "certified", "discrete")
+"""Names accepted by ``make_simple_setup(motion_validator=...)``."""
 
 
 class RobotValidityChecker(ob.StateValidityChecker):
@@ -118,8 +126,10 @@ def make_simple_setup(
     goal: Sequence[float] | None = None,
     *,
     joint_step: float | None = None,
-    batched_motion_validator: bool = True,
+    batched_motion_validator: bool | None = None,
     check_endpoints: bool = True,
+    motion_validator: str | None = None,
+    certified_options: CertifiedMotionOptions | None = None,
 ) -> og.SimpleSetup:
     """Build an ``og.SimpleSetup`` for a robot, optionally with start and goal configurations.
 
@@ -131,11 +141,17 @@ def make_simple_setup(
     joint_step : float, radians
         Longest joint-space step between checked states (default ``robot.max_joint_step()``,
         the guarantee in the module docstring).
-    batched_motion_validator : bool
-        Check each motion with one batched call (default) instead of OMPL's per-state
-        ``DiscreteMotionValidator``; both check the same states.
+    batched_motion_validator : bool, optional
+        Old switch: True is ``motion_validator="batched"``, False is ``"discrete"``.
     check_endpoints : bool
         Raise ValueError when start or goal is out of limits or in collision.
+    motion_validator : {"batched", "certified", "discrete"}, optional
+        ``"batched"`` (default): :class:`BatchedMotionValidator`, each motion's states in one batched
+        call; ``"discrete"``: OMPL's per-state ``DiscreteMotionValidator`` (the same states);
+        ``"certified"``: :class:`~tpee_ompl.planning.certified.CertifiedMotionValidator` (clearance
+        certificates, falling back to the batched check near contact; a stronger guarantee).
+    certified_options : CertifiedMotionOptions, optional
+        Settings of the certified validator (only with ``motion_validator="certified"``).
 
     The objective is path length in the joint-space Euclidean metric.  The setup's
     ``getSpaceInformation()`` is fully set up on return; :func:`motion_check_step` gives back the
@@ -152,8 +168,15 @@ def make_simple_setup(
     checker = RobotValidityChecker(si, robot)
     ss.setStateValidityChecker(checker)
     si.setStateValidityCheckingResolution(step / extent)
-    if batched_motion_validator:
+    kind = _motion_validator_kind(motion_validator, batched_motion_validator)
+    if certified_options is not None and kind != "certified":
+        raise ValueError(f"certified_options needs motion_validator='certified', got {kind!r}")
+    if kind == "batched":
         si.setMotionValidator(BatchedMotionValidator(si, robot, step))
+    elif kind == "certified":
+        from .certified import CertifiedMotionValidator  # certified builds on this module
+
+        si.setMotionValidator(CertifiedMotionValidator(si, robot, step, certified_options))
     ss.setOptimizationObjective(ob.PathLengthOptimizationObjective(si))
     # Python objects referenced only from C++ would be collected: keep them on the setup.
     ss._tpee_refs = (robot, checker, si.getMotionValidator())  # type: ignore[attr-defined]
@@ -174,6 +197,20 @@ def make_simple_setup(
         ss.setStartAndGoalStates(s0, s1, 1e-9)
     si.setup()
     return ss
+
+
+def _motion_validator_kind(name: str | None, batched: bool | None) -> str:
+    """The motion validator named by ``motion_validator`` and the older ``batched_motion_validator``."""
+    if batched is not None and not isinstance(batched, bool):
+        raise ValueError(f"batched_motion_validator must be True or False, got {batched!r}")
+    old = None if batched is None else ("batched" if batched else "discrete")
+    if name is None:
+        return old or "batched"
+    if name not in MOTION_VALIDATORS:
+        raise ValueError(f"motion_validator must be one of {MOTION_VALIDATORS}, got {name!r}")
+    if old == "discrete" and name != "discrete":
+        raise ValueError(f"batched_motion_validator=False contradicts motion_validator={name!r}")
+    return name
 
 
 def motion_check_step(setup: og.SimpleSetup | ob.SpaceInformation) -> float:
