@@ -51,7 +51,7 @@ def test_problem_builds_setups_with_valid_ends_and_a_colliding_straight_motion(n
     straight_free = 0
     for q in rows:
         assert len(q["start"]) == len(q["goal"]) == p.dimension
-        ss, checker = p.make_setup(q, batched=False)
+        ss, checker = p.make_setup(q, p.checkers[-1] if p.checkers[0] == "discrete" else "discrete")
         si = ss.getSpaceInformation()
         layout = RealVectorLayout(si.getStateSpace())
         a, b = layout.write(si.allocState(), q["start"]), layout.write(si.allocState(), q["goal"])
@@ -83,11 +83,22 @@ def test_generic_problem_set_up_code_imports_no_project_module():
             assert all(a.name.split(".")[0] in {"hashlib", "math", "numpy"} for a in node.names), ast.unparse(node)
 
 
-def test_generic_problems_have_no_batched_validator():
+def test_generic_problems_have_no_batched_or_certified_validator():
     p = get_problem("arm4")
     _, rows = p.queries()
-    with pytest.raises(ValueError, match="no batched motion validator"):
-        p.make_setup(rows[0], batched=True)
+    for validator in ("batched", "certified"):
+        with pytest.raises(ValueError, match=f"problem arm4: motion validator '{validator}' is not one of"):
+            p.make_setup(rows[0], validator)
+    with pytest.raises(ValueError, match="checkers: problem arm4 has no 'certified'"):
+        CampaignConfig.for_problem("arm4", checkers=("certified",))
+
+
+def test_robot_problems_run_the_certified_validator_only_when_asked():
+    assert CampaignConfig().checkers == ("batched", "discrete")
+    cfg = CampaignConfig(checkers=("batched", "certified"))
+    assert cfg.checkers[1] == "certified"
+    ss, _ = get_problem("wearer").make_setup(get_problem("wearer").queries()[1][0], "certified")
+    assert type(ss.getSpaceInformation().getMotionValidator()).__name__ == "CertifiedMotionValidator"
 
 
 def test_configuration_refuses_what_a_problem_cannot_run():

@@ -14,6 +14,7 @@ from pathlib import Path
 __all__ = [
     "ANYTIME_PLANNERS",
     "CHECKERS",
+    "DEFAULT_CHECKERS",
     "CLI_PLANNER_NAMES",
     "CampaignConfig",
     "CampaignResult",
@@ -46,8 +47,11 @@ KNOWN_PLANNERS: tuple[str, ...] = (*ANYTIME_PLANNERS, "RRT", "PRMstar")
 """Every built-in planner name (:data:`tpee_ompl.bench.planners.PLANNER_FACTORIES`); ``module:function`` names a factory elsewhere."""
 NOT_ITERATION_CAPPED: tuple[str, ...] = ("RRTConnectSimplify",)
 """Planners that cannot be stopped at a sample count, so they never join the iteration-matched comparison."""
-CHECKERS = ("batched", "discrete")
-"""Motion validators: one batched Pinocchio call per motion, or OMPL's DiscreteMotionValidator."""
+CHECKERS = ("batched", "discrete", "certified")
+"""Motion validators: one batched Pinocchio call per motion, OMPL's DiscreteMotionValidator, or clearance
+certificates (a few Coal distances per motion; robot-checker problems only)."""
+DEFAULT_CHECKERS = ("batched", "discrete")
+"""The validators a campaign runs unless told (``certified`` is chosen explicitly: ``--checkers``)."""
 PROGRESS_PROPERTIES = ["best cost REAL", "iterations INTEGER", "time REAL"]  # sorted, as OMPL's map
 """Columns of the ``progress`` table (name and SQL type, as OMPL's log writes them)."""
 
@@ -86,7 +90,7 @@ class CampaignConfig:
     query sets; None = the problem's own queries (the wearer's: ``planning_necessary``)."""
     sample_caps: tuple[int, ...] = (500, 1000, 1500, 2000, 2500)
     iteration_planners: tuple[str, ...] = ITERATION_PLANNERS
-    checkers: tuple[str, ...] = CHECKERS
+    checkers: tuple[str, ...] = DEFAULT_CHECKERS
     """Motion validators for the iteration comparison; the first is the headline configuration."""
     alt_checker_queries: int | None = None
     """Queries (first k) that also run with the non-headline validators; None = all."""
@@ -123,7 +127,7 @@ class CampaignConfig:
         from .problems import get_problem
 
         p = get_problem(problem)
-        fields.setdefault("checkers", p.checkers)
+        fields.setdefault("checkers", tuple(c for c in p.checkers if c in DEFAULT_CHECKERS))
         fields.setdefault("anytime_planners", p.planners)
         return cls(problem=problem, **fields)
 

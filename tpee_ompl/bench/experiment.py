@@ -236,7 +236,7 @@ def _run_experiment(cfg: dict, task: dict, spec: dict, ladder=None, only: list[s
     query, qpos = task["query"], int(task["qpos"])
     problem = get_problem(cfg.get("problem", "wearer"))
     start, goal = np.asarray(query["start"], float), np.asarray(query["goal"], float)
-    ss, checker = problem.make_setup(query, spec["checker"] == "batched", task.get("n_threads"))
+    ss, checker = problem.make_setup(query, spec["checker"], task.get("n_threads"))
     si = ss.getSpaceInformation()
     layout = RealVectorLayout(si.getStateSpace())
     straight = si.distance(layout.write(si.allocState(), start), layout.write(si.allocState(), goal))

@@ -9,8 +9,10 @@ Importing this module imports no OMPL (:mod:`tpee_ompl.bench.config` and the com
 read :data:`PROBLEM_NAMES` from it); each problem imports what it needs when it is used.
 
 Motion validators (``CampaignConfig.checkers``): ``batched`` is one batched call per motion through
-the robot's checker (:func:`tpee_ompl.planning.setup.make_simple_setup`), ``discrete`` OMPL's
-``DiscreteMotionValidator`` calling the validity checker per state.  The generic problems have
+the robot's checker (:func:`tpee_ompl.planning.setup.make_simple_setup`), ``certified`` the
+clearance-certificate validator (:mod:`tpee_ompl.planning.certified`: a few Coal distances per motion,
+dense batched checks near contact), ``discrete`` OMPL's ``DiscreteMotionValidator`` calling the
+validity checker per state.  The generic problems have
 plain Python validity checkers and OMPL's default validator, so ``discrete`` is their only one.
 """
 
@@ -41,9 +43,9 @@ class Problem:
     dimension: int
     load_queries: Callable[[str | None, bool], tuple[str, list[dict]]]
     """``(query set or None, check_model) -> (query-set name, rows)``; None = the problem's own set."""
-    build: Callable[[dict, bool, int | None], tuple[Any, Any]]
-    """``(query, batched, n_threads) -> (og.SimpleSetup, checker)``; the checker counts ``collision_checks``
-    and has ``model_hash``."""
+    build: Callable[[dict, str, int | None], tuple[Any, Any]]
+    """``(query, motion validator name, n_threads) -> (og.SimpleSetup, checker)``; the checker counts
+    ``collision_checks`` and has ``model_hash``."""
     build_dimension_rrt: Callable[[Any, Any], Any]
     """``(si, PlannerContext) -> DimensionRRT`` with the problem's grouping."""
     groups: tuple[tuple[int, ...], ...]
@@ -61,9 +63,12 @@ class Problem:
     """It reads query sets (``--queries``); the others have built-in queries."""
     default_queries: str | None = None
 
-    def make_setup(self, query: dict, batched: bool, n_threads: int | None = None) -> tuple[Any, Any]:
-        """``(og.SimpleSetup, checker)`` for one query, in this process; ``checker.collision_checks`` counts."""
-        return self.build(query, batched, n_threads)
+    def make_setup(self, query: dict, validator: str, n_threads: int | None = None) -> tuple[Any, Any]:
+        """``(og.SimpleSetup, checker)`` for one query with the named motion validator (one of
+        :attr:`checkers`), in this process; ``checker.collision_checks`` counts."""
+        if validator not in self.checkers:
+            raise ValueError(f"problem {self.name}: motion validator {validator!r} is not one of {self.checkers}")
+        return self.build(query, validator, n_threads)
 
     def queries(self, name_or_path: str | None = None, check_model: bool = True) -> tuple[str, list[dict]]:
         """The query-set name and its rows (plain, JSON-able dicts).
@@ -91,14 +96,14 @@ def _wearer_queries(default: str) -> Callable[[str | None, bool], tuple[str, lis
     return load
 
 
-def _wearer_setup(query: dict, batched: bool, n_threads: int | None) -> tuple[Any, Any]:
+def _wearer_setup(query: dict, validator: str, n_threads: int | None) -> tuple[Any, Any]:
     import numpy as np
 
     from ..planning.setup import make_simple_setup
 
     robot = _wearer_robot(n_threads)
     ss = make_simple_setup(robot, np.asarray(query["start"], float), np.asarray(query["goal"], float),
-                           batched_motion_validator=batched)
+                           motion_validator=validator)
     return ss, robot
 
 
@@ -122,7 +127,7 @@ def _wearer(name: str, queries: str, what: str) -> Problem:
     return Problem(name=name, description=f"TPEE wearer's 4-DOF arm, query set {queries} ({what})", dimension=4,
                    load_queries=_wearer_queries(queries), build=_wearer_setup,
                    build_dimension_rrt=_wearer_dimension_rrt, groups=((0, 1), (2, 3)), planners=ANYTIME_PLANNERS,
-                   checkers=("batched", "discrete"), library=True, query_sets=True, default_queries=queries)
+                   checkers=("batched", "discrete", "certified"), library=True, query_sets=True, default_queries=queries)
 
 
 # ----------------------------------------------------------------- generic problems
@@ -134,8 +139,8 @@ def _generic(spec: GenericProblem) -> Problem:
             raise ValueError(f"queries: problem {name} has built-in queries (give no query set)")
         return name, _generic_queries(name)
 
-    def build(query: dict, batched: bool, n_threads: int | None) -> tuple[Any, Any]:
-        return make_generic_setup(spec, query["start"], query["goal"], batched)
+    def build(query: dict, validator: str, n_threads: int | None) -> tuple[Any, Any]:
+        return make_generic_setup(spec, query["start"], query["goal"], validator != "discrete")
 
     def dimension_rrt(si, ctx):
         from ..planning.dimension_rrt import DimensionRRT
@@ -190,11 +195,11 @@ def _robot_problem(name: str, dimension: int, description: str, robot: str, quer
                  "goal": [float(x) for x in q.goal]} for q in queries]
         return str(header.get("name") or query_set), rows
 
-    def build(query: dict, batched: bool, n_threads: int | None) -> tuple[Any, Any]:
+    def build(query: dict, validator: str, n_threads: int | None) -> tuple[Any, Any]:
         from ..planning.setup import make_simple_setup
 
         c = checker(n_threads)
-        return make_simple_setup(c, query["start"], query["goal"], batched_motion_validator=batched), c
+        return make_simple_setup(c, query["start"], query["goal"], motion_validator=validator), c
 
     def dimension_rrt(si, ctx):
         from ..planning.dimension_rrt import DimensionRRT
@@ -205,7 +210,7 @@ def _robot_problem(name: str, dimension: int, description: str, robot: str, quer
 
     return Problem(name=name, description=description, dimension=dimension, load_queries=load, build=build,
                    build_dimension_rrt=dimension_rrt, groups=((0, 1, 2), (3, 4, 5, 6)),
-                   checkers=("batched", "discrete"), query_sets=True, default_queries=query_set)
+                   checkers=("batched", "discrete", "certified"), query_sets=True, default_queries=query_set)
 
 
 PROBLEMS: dict[str, Problem] = {p.name: p for p in (
