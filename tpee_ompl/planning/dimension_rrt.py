@@ -328,7 +328,7 @@ class DimensionRRT(PythonPlanner):
         checks0 = checker.counter()
         search = Search(self.grouped, checker, self._rng, q0, q1, self.narrow_after, self.narrowing, self._ranges,
                          self._initial)
-        poster = SolutionPoster(self, si, pdef, t0, self.grouped.to_path, self._notify)
+        poster = SolutionPoster(self, si, pdef, t0, self.grouped.to_path, self._notify, checker.passed)
         stats = self._stats
         progress = stats["progress"]
         cap = self.max_samples if self.grouped.planned else 0
