@@ -17,15 +17,25 @@ ALL planned groups jointly (one sample covers every planned DOF; with a single p
 the TPEE case, that is the group) and are built once, so progress in one group is never lost when
 the improvement phase's group turns over (a per-group feasibility phase stalled on a 6-joint arm
 split in three groups).  They are seeded with the valid prefix and suffix of the initial path
-(prescribed groups as given, the others straight).  The sample is tried at every step t: connected
-to the nearest forward node of step t-1 it joins the forward tree, to the nearest backward node of
-step t+1 the backward tree, to both and the path is complete.  Without prescribed groups a node
-also serves later (forward) or earlier (backward) steps by staying put (a zero-length motion), and
-the repeated waypoints of the resulting path are spread along its segments (kept only if that path
-passes the checker).  Every node is valid and reached by a valid motion, so two neighbouring
-waypoints that both start in collision cannot deadlock it.  Half of its samples are Gaussian around
-a random tree node (sigma log-uniform in 1-10 % of the bound widths) so the trees grow out of narrow
-pockets; the other half are uniform.
+(prescribed groups as given, the others straight).  Every node is a valid waypoint; motions are
+checked lazily, as in LazyRRT: the sample is checked as a waypoint at every step t that has a
+forward node before it or a backward node after it; of the steps with both, the one whose motions
+(from the nearest forward node of step t-1, to the nearest backward node of step t+1; holding:
+of a step before / after) are shortest
+completes a candidate path, and only then are the path's motions not checked before checked
+(every 8th state of all of them first, then ``si.checkMotion`` one by one, stopping at the first
+failure).  A failed motion kills the node it leads into with its subtree; the sample joins the trees
+through its motions that did not fail, and at the other steps on unchecked motions whose every 8th state
+is valid.  Without prescribed groups a node also serves later (forward) or earlier (backward) steps
+by staying put (a zero-length motion); the sample then joins each tree once, at the lowest
+(forward) or highest (backward) step such a motion allows, and, as RRT-Connect's partial step,
+when the motion into or out of the sample failed its coarse test the last state it reached joins
+the forward tree.  The repeated waypoints of the final path are spread along its segments (kept
+only if that path passes the checker).  Half of the samples are Gaussian around a random live tree
+node (sigma log-uniform in 1-10 % of the bound widths) so the trees grow out of narrow pockets; the
+other half are uniform.  Lazy checking cut the collision checks to a first path about 2-4x against
+checking every motion of every sample (planar arms with 4-8 joints, and the wearer's
+planning-necessary queries; ``experiments/first_path.py``, ``experiments/foreign_problems.py``).
 
 Narrowing: once a valid path exists and the group has drawn ``narrow_after`` samples, 90 % of the
 samples come from the bounding box of the current path's group values (all ``h`` steps), padded
@@ -33,10 +43,11 @@ by ``max(range_, span * narrowing ** (m / 100))`` (``span``: the group's bound w
 samples since narrowing started) and clipped to the bounds; 10 % stay uniform over the bounds.
 
 Batching: the candidate waypoints of one sample and their motions go through the validity
-checker's batched ``are_valid(Q)`` when it has one (two calls per sample at most: candidates plus
-every 8th interior motion state, then the remaining interior states of the survivors); otherwise
-per-state ``si.isValid`` and per-motion ``si.checkMotion``.  Motion states are those OMPL's
-discrete motion validator checks.
+checker's batched ``are_valid(Q)`` when it has one (improvement: two calls per sample at most,
+candidates plus every 8th interior motion state, then the remaining interior states of the
+survivors); otherwise per-state ``si.isValid`` and per-motion ``si.checkMotion``.  Motion states
+are those OMPL's discrete motion validator checks (SO2 entries the short way round).  A motion
+that passed ``si.checkMotion`` in the search is not checked again when its path is posted.
 
 Stopping like an OMPL planner: each improved path is added to the problem definition as it is found
 (so ``ob.exactSolnPlannerTerminationCondition(pdef)`` stops at the first), after every segment not
