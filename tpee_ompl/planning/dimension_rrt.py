@@ -37,6 +37,15 @@ other half are uniform.  Lazy checking cut the collision checks to a first path 
 checking every motion of every sample (planar arms with 4-8 joints, and the wearer's
 planning-necessary queries; ``experiments/first_path.py``, ``experiments/foreign_problems.py``).
 
+Raising h (sec. 4.1.3 names the limit: with ``h`` fixed, a path has at most ``h - 1`` segments, and
+an obstacle that needs more turns is never bridged): with ``max_h`` set, after 500 samples without
+a first path ``h`` becomes ``2h - 1`` (a step halfway between every two) while that is at most
+``max_h``; the layered trees start again from the refined initial path (motions already checked
+stay known).  A prescribed group keeps its rows at the even steps and moves linearly between them
+(the same polyline, so the TPEE case's Table 3 motion is unchanged, only sampled at more steps).
+``max_h`` is None by default: ``h`` stays fixed (7 for the TPEE case, as in Table 3) and such a
+problem times out; ``last_run_stats()["h"]`` reports the steps used.
+
 Narrowing: once a valid path exists and the group has drawn ``narrow_after`` samples, 90 % of the
 samples come from the bounding box of the current path's group values (all ``h`` steps), padded
 by ``max(range_, span * narrowing ** (m / 100))`` (``span``: the group's bound widths; ``m``:
@@ -81,13 +90,16 @@ from ompl import geometric as og
 
 from ..validation import check_bool, check_int, check_name, check_number
 from .dimension_search import Checker, Search
-from .grouped_space import GroupedSpace
+from .grouped_space import MAX_H, GroupedSpace
 from .planner_base import PythonPlanner, planner_status
 from .solution_posting import SolutionPoster
 
 __all__ = ["DimensionRRT", "DimensionRRTOptions"]
 
 log = logging.getLogger(__name__)
+
+_REFINE_AFTER = 500
+"""Samples without a first path after which ``h`` is raised (when ``max_h`` allows; see "Raising h")."""
 
 _PROGRESS_PERIOD = 0.01
 """Seconds between progress-trace entries (OMPL's benchmark records progress about as often)."""
@@ -120,6 +132,9 @@ class DimensionRRTOptions:
     stall_samples : int, optional
         Stop once a valid path exists and this many samples in a row brought no shorter one (None,
         the default: run until the termination condition or ``max_samples``, as the paper does).
+    max_h : int, optional
+        Largest number of fake-time steps the feasibility phase may raise ``h`` to (None, the
+        default: ``h`` stays fixed, as in the paper).  See "Raising h" in the module docstring.
     """
 
     groups: Sequence[Sequence[int]] | None = None
@@ -132,6 +147,7 @@ class DimensionRRTOptions:
     name: str = "DimensionRRT"
     batch: bool = True
     stall_samples: int | None = None
+    max_h: int | None = None
 
     def __post_init__(self) -> None:
         check_name("name", self.name)
@@ -142,6 +158,7 @@ class DimensionRRTOptions:
         set_("narrowing", check_number("narrowing", self.narrowing, low=0.0, high=1.0, low_open=True))
         set_("batch", check_bool("batch", self.batch))
         set_("stall_samples", check_int("stall_samples", self.stall_samples, minimum=1, optional=True))
+        set_("max_h", check_int("max_h", self.max_h, minimum=3, maximum=MAX_H, optional=True))
         if self.range_ is not None:
             try:
                 arr = np.asarray(self.range_, dtype=float)
@@ -297,6 +314,7 @@ class DimensionRRT(PythonPlanner):
             "range": str([round(float(v), 6) for v in self.range_]),
             "batch": str(self.batch),
             "stall_samples": str(self.options.stall_samples),
+            "max_h": str(self.options.max_h),
             "initial_waypoints": "none" if self._initial is None else "set",
         }
 
@@ -304,6 +322,7 @@ class DimensionRRT(PythonPlanner):
     def _empty_stats() -> dict[str, Any]:
         return {
             "samples": 0,
+            "h": 0,
             "collision_checks": 0,
             "first_solution_time": None,
             "best_cost": math.inf,
@@ -313,7 +332,7 @@ class DimensionRRT(PythonPlanner):
         }
 
     def last_run_stats(self) -> dict[str, Any]:
-        """Statistics of the last solve: samples, collision_checks, first_solution_time (s or None),
+        """Statistics of the last solve: samples, h (fake-time steps at the end), collision_checks, first_solution_time (s or None),
         best_cost (inf if none), iterations, progress [(time_s, best_cost, samples), ...],
         solutions_posted (paths added to the problem definition)."""
         return super().last_run_stats()
@@ -343,18 +362,27 @@ class DimensionRRT(PythonPlanner):
         stats = self._stats
         progress = stats["progress"]
         cap = self.max_samples if self.grouped.planned else 0
+        grouped, done = self.grouped, 0  # ``done``: samples of the searches before the last raise of h
+        max_h = self.options.max_h or 0
         last_log = -math.inf
 
         def record(now: float) -> None:
-            progress.append((now - t0, poster.found_cost, search.samples))
+            progress.append((now - t0, poster.found_cost, done + search.samples))
 
         if search.valid:
             poster.offer(search.W, search.cost, time.perf_counter())
         record(time.perf_counter())
         stall, improved_at = self.options.stall_samples, 0
-        while not poster.satisfied and not ptc() and (cap is None or search.samples < cap):
+        while not poster.satisfied and not ptc() and (cap is None or done + search.samples < cap):
             if stall is not None and math.isfinite(poster.found_cost) and search.samples - improved_at >= stall:
                 break  # converged: nothing shorter in the last ``stall`` samples
+            if search.samples >= _REFINE_AFTER and not search.valid and 2 * grouped.h - 1 <= max_h:
+                grouped = grouped.refined(q0, q1)  # no path yet: twice the steps, trees start again
+                done += search.samples
+                search = Search(grouped, checker, self._rng, q0, q1, self.narrow_after, self.narrowing,
+                                self._ranges, None)
+                log.info("DimensionRRT: no path after %d samples, h raised to %d", done, grouped.h)
+                continue
             accepted = search.iterate()
             now = time.perf_counter()
             if accepted and search.valid and search.cost < poster.found_cost:
@@ -368,8 +396,9 @@ class DimensionRRT(PythonPlanner):
         poster.flush()
         record(time.perf_counter())
         stats.update(
-            samples=search.samples,
-            iterations=search.samples,
+            h=grouped.h,
+            samples=done + search.samples,
+            iterations=done + search.samples,
             collision_checks=checker.counter() - checks0,
             first_solution_time=poster.first_time,
             best_cost=poster.best_cost,

@@ -106,28 +106,14 @@ class Checker:
 
     def coarse(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
         """Whether every 8th interior state of the motions A[k] -> B[k] is valid (one batched call, or
-        per-state checks): most invalid motions already fail here."""
-        return self.coarse_reach(A, B)[0]
-
-    def coarse_reach(self, A: np.ndarray, B: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """:meth:`coarse`, and for each motion the fraction of the way to B[k] of the last checked
-        state before its first failing one (1 when none fails, 0 when the first fails)."""
+        per-state checks): most invalid motions already fail here (not all: a thin wall can fit
+        between two of those states)."""
         K = len(A)
-        reach = np.ones(K)
         if K == 0:
-            return np.ones(0, dtype=bool), reach
+            return np.ones(0, dtype=bool)
         S, idx, j = self.interior(A, B)
         c = j % _COARSE_STRIDE == 0
-        ic, jc = idx[c], j[c]
-        fail = ~self.states(S[c])
-        ok = np.bincount(ic[fail], minlength=K) == 0
-        if not ok.all():
-            nd = np.bincount(idx, minlength=K) + 1  # segments per motion
-            first = np.full(K, np.iinfo(np.int64).max)
-            np.minimum.at(first, ic[fail], jc[fail])
-            bad = ~ok
-            reach[bad] = np.maximum(0, first[bad] - _COARSE_STRIDE) / nd[bad]
-        return ok, reach
+        return np.bincount(idx[c][~self.states(S[c])], minlength=K) == 0
 
     def motions(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
         """Validity of the motions A[k] -> B[k] (valid ends assumed): :meth:`coarse`, then
@@ -232,8 +218,6 @@ class Search:
         self._dims = {gi: grouped.group_dims(gi) for gi in grouped.planned}
         self._bounds = {gi: grouped.group_bounds(gi) for gi in grouped.planned}
         self._tree: LayeredTrees | None = None
-        self._reach: dict[int, float] = {}
-        """Segment -> how far its coarse test got, for the segments that failed it in the last check."""
         self._known: dict[bytes, bool] = {W[k : k + 2].tobytes(): bool(self.E[k]) for k in range(len(W) - 1)
                                           if self.V[k] and self.V[k + 1]}
         """Segment (two waypoint rows as bytes) -> motion valid, for every motion checked so far."""
@@ -316,9 +300,10 @@ class Search:
         steps with both, the one with the shortest motions completes a candidate path, whose not yet
         checked motions are checked now: all pass and it is the path; a failed motion kills the node
         it leads into (and its subtree), and c joins the trees through those of its motions that
-        did not fail (holding, also the partial step of :meth:`_extend`).  At the other steps c joins
-        the trees on unchecked motions that pass :meth:`Checker.coarse` (when holding: once per tree,
-        at the lowest forward / highest backward step).  Returns 1 when the path is complete, else 0.
+        passed in full.  At the other steps c joins the trees on unchecked motions that pass
+        :meth:`Checker.coarse`; when holding, once per tree instead, at the lowest forward / highest
+        backward step whose motion passes in full (coarse screening alone let trees grow through
+        thin walls there).  Returns 1 when the path is complete, else 0.
         """
         tree = self._tree
         d = tree.dims
@@ -357,17 +342,16 @@ class Search:
                 elif side == "b":
                     tree.bwd.kill(node)
             f, b = int(fi[k]), int(bi[k])
-            ci = -1
-            if t - 1 not in bad and tree.fwd.alive[f]:
-                ci = tree.fwd.add(c, t, f)
+            known = self._known  # c joins through a motion checked in full, or of zero length
+            passed = [known.get(W[k : k + 2].tobytes(), not np.any(W[k] != W[k + 1])) for k in (t - 1, t)]
+            if passed[0] and tree.fwd.alive[f]:
+                tree.fwd.add(c, t, f)
                 joined.add(id(tree.fwd))
-            if t not in bad and tree.bwd.alive[b]:
+            if passed[1] and tree.bwd.alive[b]:
                 tree.bwd.add(c, t, b)
                 joined.add(id(tree.bwd))
-            if self._hold:
-                self._extend(W, t, f, ci)
         # the other steps: c joins on unchecked motions that pass the coarse test; holding, once per
-        # tree, at the lowest step (forward) or highest (backward) such a motion allows
+        # tree, at the lowest step (forward) or highest (backward) whose motion passes in full
         if self._hold:
             if not vc[0]:
                 return 0
@@ -392,52 +376,43 @@ class Search:
             E[2 * m], E[2 * m + 1] = (pt, ct) if tr is tree.fwd else (ct, pt)
         checker = self.checker
         # one call when batched; per state, in order, skipping what holding makes useless
-        ok = checker.coarse(E[0::2], E[1::2]) if checker.batched else None
+        ok = checker.coarse(E[0::2], E[1::2]) if checker.batched and not self._hold else None
         for m, (tr, p, t) in enumerate(adds):
             if self._hold and id(tr) in joined:
                 continue
-            if ok[m] if ok is not None else checker.coarse(E[2 * m : 2 * m + 1], E[2 * m + 1 : 2 * m + 2])[0]:
+            if self._hold:  # checked in full: coarse screening alone let motions through thin walls
+                good = self._check_segments(E[2 * m : 2 * m + 2]) == []
+            else:
+                good = ok[m] if ok is not None else checker.coarse(E[2 * m : 2 * m + 1], E[2 * m + 1 : 2 * m + 2])[0]
+            if good:
                 tr.add(c, t, p)
                 joined.add(id(tr))
         return 0
 
-    def _extend(self, W: np.ndarray, t: int, f: int, ci: int) -> None:
-        """Holding: RRT-Connect's partial step.  When the motion into c (segment t-1, from forward
-        node f) or out of c (segment t, c being forward node ci) failed the coarse test, the last
-        state it reached joins the forward tree after f or c (an unchecked motion)."""
-        fwd, interp = self._tree.fwd, self.g.layout.interpolate
-        for seg, parent, step in ((t - 1, f, int(fwd.steps[f]) + 1), (t, ci, t + 1)):
-            r = self._reach.get(seg, 0.0)
-            if parent >= 0 and fwd.alive[parent] and 0.0 < r < 1.0 and step <= self.g.h - 2:
-                fwd.add(interp(W[seg], W[seg + 1], r), step, parent)
-
     def _check_segments(self, W: np.ndarray) -> list[int]:
-        """Segments of W (h, n) found invalid, stopping at the first failure (lazy checking).
+        """Segments of W (K, n) found invalid (lazy checking: called once W is a complete candidate).
 
         The waypoints are known valid; zero-length segments and segments checked before cost
-        nothing; the others go through :meth:`Checker.coarse` together, then ``si.checkMotion``
-        one by one.  Every result is remembered."""
+        nothing; the others go through :meth:`Checker.coarse` together (any failure there ends the
+        check), then ``si.checkMotion`` one by one.  Every result is remembered."""
         known, checker = self._known, self.checker
-        self._reach = {}
         keys = [W[k : k + 2].tobytes() for k in range(len(W) - 1)]
         bad = [k for k, key in enumerate(keys) if not known.get(key, True)]
         todo = [k for k, key in enumerate(keys) if key not in known and np.any(W[k] != W[k + 1])]
         if bad or not todo:
             return bad
         ends = np.array(todo)
-        good, reach = checker.coarse_reach(W[ends], W[ends + 1])  # finds most failing motions at once
+        good = checker.coarse(W[ends], W[ends + 1])  # finds most failing motions at once
         bad = [k for k, g in zip(todo, good) if not g]
-        for k, g, r in zip(todo, good, reach):
-            if not g:
-                known[keys[k]] = False
-                self._reach[k] = float(r)
+        for k in bad:
+            known[keys[k]] = False
         if bad:
             return bad
-        for k in todo:
-            ok = known[keys[k]] = checker.check_motion(W[k], W[k + 1])
-            if not ok:
-                return [k]
-        return []
+        for k in todo:  # all of them: a motion the coarse test missed may not be the only one
+            if not checker.check_motion(W[k], W[k + 1]):
+                bad.append(k)
+            known[keys[k]] = k not in bad
+        return bad
 
     def _adopt(self, W: np.ndarray) -> None:
         """Take W (h, n), checked by the trees, as the current (valid) path.
