@@ -7,7 +7,8 @@
 Home: for every query of each named set (the wearer, ``make_simple_setup`` with its batched motion
 validator), RRTConnect and dimension-RRT (``tpee_dimension_rrt``, seed = query index) run one after the
 other in this process, each stopped by ``exactSolnPlannerTerminationCondition`` or --limit s; prints the
-median and p95 time to the first exact path of each and the ratio of the medians.
+median and p95 time to the first exact path of each, the ratio of the medians and the median
+number of configurations checked (dimension-RRT's is deterministic under its seed).
 
 Overhead: dimension-RRT on a 6-D box with a wall and a hole (straight path blocked), a plain Python
 validity checker that returns at once (no batched call), capped at --samples samples; prints the time
@@ -64,18 +65,23 @@ def home(args: argparse.Namespace) -> None:
     robot = WearerArm()
     for name in args.queries:
         qs = load_queries(name, robot)[: args.max_queries]
-        rc, dr = [], []
+        rc, dr, rc_checks, dr_checks = [], [], [], []
         for k, q in enumerate(qs):
             ss = make_simple_setup(robot, q.start, q.goal)
             si = ss.getSpaceInformation()
+            c0 = robot.collision_checks
             rc.append(_first(ss, og.RRTConnect(si), args.limit))
+            c1 = robot.collision_checks
             dr.append(_first(ss, tpee_dimension_rrt(si, q.from_sector, q.to_sector, seed=k), args.limit))
+            rc_checks.append(c1 - c0)
+            dr_checks.append(robot.collision_checks - c1)
         r = [x for x in rc if x is not None]
         d = [x for x in dr if x is not None]
         print(f"home {name:20s} queries {len(qs):4d}  solved D/R {len(d)}/{len(r)}  "
               f"median D {1e3 * statistics.median(d):6.1f} ms  R {1e3 * statistics.median(r):6.1f} ms  "
               f"ratio {statistics.median(d) / statistics.median(r):5.2f}  p95 D {1e3 * _p95(d):6.1f} ms  "
-              f"R {1e3 * _p95(r):6.1f} ms", flush=True)
+              f"R {1e3 * _p95(r):6.1f} ms  median checks D {statistics.median(dr_checks):.0f} "
+              f"R {statistics.median(rc_checks):.0f}", flush=True)
 
 
 def overhead(args: argparse.Namespace) -> None:
