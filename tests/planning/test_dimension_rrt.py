@@ -206,8 +206,10 @@ def test_settings_and_stats_shape(robot: WearerArm) -> None:
     assert settings["h"] == "7" and settings["max_samples"] == "500" and settings["groups"] == "[[0, 1], [2, 3]]"
     assert all(isinstance(v, str) for v in settings.values())
     assert set(planner.last_run_stats()) == {
-        "samples", "collision_checks", "first_solution_time", "best_cost", "iterations", "progress", "solutions_posted"
+        "samples", "h", "collision_checks", "first_solution_time", "best_cost", "iterations", "progress",
+        "solutions_posted",
     }
+    assert settings["max_h"] == "None"
 
 
 def test_stall_samples_stop_a_converged_run_before_its_cap(robot: WearerArm) -> None:

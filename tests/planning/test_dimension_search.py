@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from helpers.planning_spaces import box_problem
+from ompl import base as ob
 
 from tpee_ompl.planning.dimension_search import Checker, Search
 from tpee_ompl.planning.grouped_space import GroupedSpace
@@ -57,3 +58,44 @@ def test_search_finds_a_valid_path_around_the_box_and_only_shortens_it(batch: bo
     assert path_passes_motion_checks(si, search.W)
     assert search.cost == pytest.approx(grouped.path_length(search.W))
     np.testing.assert_array_equal(search.W[[0, -1]], [start, goal])
+
+
+class _Band(ob.StateValidityChecker):
+    """Two continuous joints; invalid where the first is within 0.5 rad of 0 (so never near +-pi)."""
+
+    def __init__(self, si: ob.SpaceInformation) -> None:
+        super().__init__(si)
+        self.seen: list[np.ndarray] = []
+
+    def are_valid(self, Q: np.ndarray) -> np.ndarray:
+        Q = np.asarray(Q, dtype=float)
+        self.seen.append(Q.copy())
+        return np.abs(Q[:, 0]) > 0.5
+
+    def isValid(self, state: ob.State) -> bool:  # noqa: N802 (OMPL override)
+        return abs(state[0].value) > 0.5
+
+
+def test_batched_checker_moves_continuous_joints_the_short_way_round() -> None:
+    space = ob.CompoundStateSpace()
+    for _ in range(2):
+        space.addSubspace(ob.SO2StateSpace(), 1.0)
+    si = ob.SpaceInformation(space)
+    band = _Band(si)
+    si.setStateValidityChecker(band)
+    si.setup()
+    grouped = GroupedSpace(si, [[0, 1]], 5)
+    checker = Checker(si, grouped.layout, batch=True)
+    assert checker.batched
+    A, B = np.array([[3.0, -3.0]]), np.array([[-3.0, 3.0]])  # 0.28 rad apart through +-pi on both joints
+    S, idx, _ = checker.interior(A, B)
+    assert len(S) >= 1 and np.all(idx == 0)
+    assert np.all(np.abs(S) >= 3.0 - 1e-12) and np.all((S >= -np.pi) & (S < np.pi))
+    # the long way would cross the invalid band around 0; the short way is valid, as for si.checkMotion
+    a, b = si.allocState(), si.allocState()
+    grouped.layout.write(a, A[0])
+    grouped.layout.write(b, B[0])
+    assert si.checkMotion(a, b)
+    band.seen.clear()
+    assert checker.motions(A, B).all() and checker.coarse(A, B).all()
+    assert all(np.all(np.abs(Q[:, 0]) >= 3.0 - 1e-12) for Q in band.seen)

@@ -17,15 +17,35 @@ ALL planned groups jointly (one sample covers every planned DOF; with a single p
 the TPEE case, that is the group) and are built once, so progress in one group is never lost when
 the improvement phase's group turns over (a per-group feasibility phase stalled on a 6-joint arm
 split in three groups).  They are seeded with the valid prefix and suffix of the initial path
-(prescribed groups as given, the others straight).  The sample is tried at every step t: connected
-to the nearest forward node of step t-1 it joins the forward tree, to the nearest backward node of
-step t+1 the backward tree, to both and the path is complete.  Without prescribed groups a node
-also serves later (forward) or earlier (backward) steps by staying put (a zero-length motion), and
-the repeated waypoints of the resulting path are spread along its segments (kept only if that path
-passes the checker).  Every node is valid and reached by a valid motion, so two neighbouring
-waypoints that both start in collision cannot deadlock it.  Half of its samples are Gaussian around
-a random tree node (sigma log-uniform in 1-10 % of the bound widths) so the trees grow out of narrow
-pockets; the other half are uniform.
+(prescribed groups as given, the others straight).  Every node is a valid waypoint; motions are
+checked lazily, as in LazyRRT: the sample is checked as a waypoint at every step t that has a
+forward node before it or a backward node after it; of the steps with both, the one whose motions
+(from the nearest forward node of step t-1, to the nearest backward node of step t+1; holding:
+of a step before / after) are shortest completes a candidate path, and only then are the path's
+motions not checked before checked (every 8th state of all of them first, ending the check at any
+failure there, then ``si.checkMotion`` one by one).  A failed motion kills the node it leads into with its subtree; the sample joins the
+trees through its motions of that path that passed in full, and at the other steps on unchecked
+motions whose every 8th state is valid (the checks are then left to the path that uses them).
+Without prescribed groups a node also serves later (forward) or earlier (backward) steps by
+staying put (a zero-length motion); the sample then joins each tree once, at the lowest (forward)
+or highest (backward) step whose motion passes in full (coarse screening alone let the trees grow
+through thin walls there: a 2-D problem with two 0.1-wide walls never connected).  The repeated
+waypoints of the final path are spread along its segments (kept only if that path passes the
+checker).  Half of the samples are Gaussian around a random live tree node (sigma log-uniform in
+1-10 % of the bound widths) so the trees grow out of narrow pockets; the other half are uniform.
+Measured against checking every motion of every sample: on the wearer's 120 planning-necessary
+queries the median collision checks to a first path fell from 3347 to 1026 (RRTConnect: about
+1150) and on planar arms with 4-8 joints about 2-4x; with prescribed groups and thin walls the
+coarse screening makes the first path slower than full checks would (``experiments/first_path.py``,
+``experiments/foreign_problems.py``).
+
+Raising h (sec. 4.1.3 names the limit: with ``h`` fixed, a path has at most ``h - 1`` segments, and
+an obstacle that needs more turns is never bridged): with ``max_h`` set, after 500 samples without
+a first path ``h`` becomes ``2h - 1`` (a step halfway between every two) while that is at most
+``max_h``; the layered trees start again from the refined initial path.  A prescribed group keeps its rows at the even steps and moves linearly between them
+(the same polyline, so the TPEE case's Table 3 motion is unchanged, only sampled at more steps).
+``max_h`` is None by default: ``h`` stays fixed (7 for the TPEE case, as in Table 3) and such a
+problem times out; ``last_run_stats()["h"]`` reports the steps used.
 
 Narrowing: once a valid path exists and the group has drawn ``narrow_after`` samples, 90 % of the
 samples come from the bounding box of the current path's group values (all ``h`` steps), padded
@@ -33,10 +53,11 @@ by ``max(range_, span * narrowing ** (m / 100))`` (``span``: the group's bound w
 samples since narrowing started) and clipped to the bounds; 10 % stay uniform over the bounds.
 
 Batching: the candidate waypoints of one sample and their motions go through the validity
-checker's batched ``are_valid(Q)`` when it has one (two calls per sample at most: candidates plus
-every 8th interior motion state, then the remaining interior states of the survivors); otherwise
-per-state ``si.isValid`` and per-motion ``si.checkMotion``.  Motion states are those OMPL's
-discrete motion validator checks.
+checker's batched ``are_valid(Q)`` when it has one (improvement: two calls per sample at most,
+candidates plus every 8th interior motion state, then the remaining interior states of the
+survivors); otherwise per-state ``si.isValid`` and per-motion ``si.checkMotion``.  Motion states
+are those OMPL's discrete motion validator checks (SO2 entries the short way round).  A motion
+that passed ``si.checkMotion`` in the search is not checked again when its path is posted.
 
 Stopping like an OMPL planner: each improved path is added to the problem definition as it is found
 (so ``ob.exactSolnPlannerTerminationCondition(pdef)`` stops at the first), after every segment not
@@ -70,13 +91,16 @@ from ompl import geometric as og
 
 from ..validation import check_bool, check_int, check_name, check_number
 from .dimension_search import Checker, Search
-from .grouped_space import GroupedSpace
+from .grouped_space import MAX_H, GroupedSpace
 from .planner_base import PythonPlanner, planner_status
 from .solution_posting import SolutionPoster
 
 __all__ = ["DimensionRRT", "DimensionRRTOptions"]
 
 log = logging.getLogger(__name__)
+
+_REFINE_AFTER = 500
+"""Samples without a first path after which ``h`` is raised (when ``max_h`` allows; see "Raising h")."""
 
 _PROGRESS_PERIOD = 0.01
 """Seconds between progress-trace entries (OMPL's benchmark records progress about as often)."""
@@ -109,6 +133,9 @@ class DimensionRRTOptions:
     stall_samples : int, optional
         Stop once a valid path exists and this many samples in a row brought no shorter one (None,
         the default: run until the termination condition or ``max_samples``, as the paper does).
+    max_h : int, optional
+        Largest number of fake-time steps the feasibility phase may raise ``h`` to (None, the
+        default: ``h`` stays fixed, as in the paper).  See "Raising h" in the module docstring.
     """
 
     groups: Sequence[Sequence[int]] | None = None
@@ -121,6 +148,7 @@ class DimensionRRTOptions:
     name: str = "DimensionRRT"
     batch: bool = True
     stall_samples: int | None = None
+    max_h: int | None = None
 
     def __post_init__(self) -> None:
         check_name("name", self.name)
@@ -131,6 +159,7 @@ class DimensionRRTOptions:
         set_("narrowing", check_number("narrowing", self.narrowing, low=0.0, high=1.0, low_open=True))
         set_("batch", check_bool("batch", self.batch))
         set_("stall_samples", check_int("stall_samples", self.stall_samples, minimum=1, optional=True))
+        set_("max_h", check_int("max_h", self.max_h, minimum=3, maximum=MAX_H, optional=True))
         if self.range_ is not None:
             try:
                 arr = np.asarray(self.range_, dtype=float)
@@ -286,6 +315,7 @@ class DimensionRRT(PythonPlanner):
             "range": str([round(float(v), 6) for v in self.range_]),
             "batch": str(self.batch),
             "stall_samples": str(self.options.stall_samples),
+            "max_h": str(self.options.max_h),
             "initial_waypoints": "none" if self._initial is None else "set",
         }
 
@@ -293,6 +323,7 @@ class DimensionRRT(PythonPlanner):
     def _empty_stats() -> dict[str, Any]:
         return {
             "samples": 0,
+            "h": 0,
             "collision_checks": 0,
             "first_solution_time": None,
             "best_cost": math.inf,
@@ -302,7 +333,7 @@ class DimensionRRT(PythonPlanner):
         }
 
     def last_run_stats(self) -> dict[str, Any]:
-        """Statistics of the last solve: samples, collision_checks, first_solution_time (s or None),
+        """Statistics of the last solve: samples, h (fake-time steps at the end), collision_checks, first_solution_time (s or None),
         best_cost (inf if none), iterations, progress [(time_s, best_cost, samples), ...],
         solutions_posted (paths added to the problem definition)."""
         return super().last_run_stats()
@@ -328,22 +359,31 @@ class DimensionRRT(PythonPlanner):
         checks0 = checker.counter()
         search = Search(self.grouped, checker, self._rng, q0, q1, self.narrow_after, self.narrowing, self._ranges,
                          self._initial)
-        poster = SolutionPoster(self, si, pdef, t0, self.grouped.to_path, self._notify)
+        poster = SolutionPoster(self, si, pdef, t0, self.grouped.to_path, self._notify, checker.passed)
         stats = self._stats
         progress = stats["progress"]
         cap = self.max_samples if self.grouped.planned else 0
+        grouped, done = self.grouped, 0  # ``done``: samples of the searches before the last raise of h
+        max_h = self.options.max_h or 0
         last_log = -math.inf
 
         def record(now: float) -> None:
-            progress.append((now - t0, poster.found_cost, search.samples))
+            progress.append((now - t0, poster.found_cost, done + search.samples))
 
         if search.valid:
             poster.offer(search.W, search.cost, time.perf_counter())
         record(time.perf_counter())
         stall, improved_at = self.options.stall_samples, 0
-        while not poster.satisfied and not ptc() and (cap is None or search.samples < cap):
+        while not poster.satisfied and not ptc() and (cap is None or done + search.samples < cap):
             if stall is not None and math.isfinite(poster.found_cost) and search.samples - improved_at >= stall:
                 break  # converged: nothing shorter in the last ``stall`` samples
+            if search.samples >= _REFINE_AFTER and not search.valid and 2 * grouped.h - 1 <= max_h:
+                grouped = grouped.refined(q0, q1)  # no path yet: twice the steps, trees start again
+                done += search.samples
+                search = Search(grouped, checker, self._rng, q0, q1, self.narrow_after, self.narrowing,
+                                self._ranges, None)
+                log.info("DimensionRRT: no path after %d samples, h raised to %d", done, grouped.h)
+                continue
             accepted = search.iterate()
             now = time.perf_counter()
             if accepted and search.valid and search.cost < poster.found_cost:
@@ -357,8 +397,9 @@ class DimensionRRT(PythonPlanner):
         poster.flush()
         record(time.perf_counter())
         stats.update(
-            samples=search.samples,
-            iterations=search.samples,
+            h=grouped.h,
+            samples=done + search.samples,
+            iterations=done + search.samples,
             collision_checks=checker.counter() - checks0,
             first_solution_time=poster.first_time,
             best_cost=poster.best_cost,

@@ -19,7 +19,7 @@ from .grouped_space import GroupedSpace, RealVectorLayout
 from .layered_trees import LayeredTrees, spread_waypoints
 from .paths import motion_interior_states
 
-__all__ = ["Checker", "Search"]
+__all__ = ["Checker", "Search", "segment_key"]
 
 _COARSE_STRIDE = 8
 """First pass over a motion checks every 8th interior state (collisions span many states)."""
@@ -33,6 +33,11 @@ _REPAIR_FRACTION = 0.5
 """Share of repair samples while no valid path exists."""
 _REPAIR_SIGMA = (0.01, 0.1)
 """Repair samples: Gaussian around a waypoint, sigma log-uniform in this range times the bound widths."""
+
+
+def segment_key(a: np.ndarray, b: np.ndarray) -> bytes:
+    """Key of the motion a -> b (n,): the bytes of its two float64 ends, as ``W[k : k + 2].tobytes()``."""
+    return np.ascontiguousarray(a, dtype=float).tobytes() + np.ascontiguousarray(b, dtype=float).tobytes()
 
 
 class Checker:
@@ -56,11 +61,19 @@ class Checker:
                 self.euclid = layout.is_plain
         self.batched = self.step is not None
         self._are_valid = are_valid if self.batched else None
+        if self.step is None:  # only for the coarse screening of motions (si.checkMotion decides)
+            factor = max(1, int(si.getStateSpace().getValidSegmentCountFactor()))
+            self._coarse_step = float(si.getStateSpace().getLongestValidSegmentLength()) / factor
+            self.euclid = layout.is_plain
+        else:
+            self._coarse_step = self.step
         counter_owner = getattr(svc, "robot", svc)
         self._counter_owner = counter_owner if isinstance(getattr(counter_owner, "collision_checks", None), int) else None
         self.own_checks = 0
         self._longest = float(si.getStateSpace().getLongestValidSegmentLength())
         self._s1, self._s2 = si.allocState(), si.allocState()
+        self.passed: set[bytes] = set()
+        """Keys (:func:`segment_key`) of the motions that passed ``si.checkMotion`` here."""
 
     def counter(self) -> int:
         """Configurations checked so far (the robot's counter when available, else our own count)."""
@@ -81,28 +94,44 @@ class Checker:
         return out
 
     def interior(self, A: np.ndarray, B: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Interior states of motions A[k] -> B[k]: (states (M, n), motion index (M,), step index j >= 1)."""
-        return motion_interior_states(A, B, self.step, None if self.euclid else self.layout.distance(A, B))
+        """Interior states of motions A[k] -> B[k]: (states (M, n), motion index (M,), step index j >= 1).
 
-    def motions(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
-        """Validity of the interiors of motions A[k] -> B[k] (ends not checked), one call when batched."""
+        SO2 entries move the short way round and are wrapped into [-pi, pi), as ``SO2StateSpace``
+        interpolates."""
+        lay = self.layout
+        if not lay.has_circular:
+            return motion_interior_states(A, B, self._coarse_step, None if self.euclid else lay.distance(A, B))
+        S, idx, j = motion_interior_states(A, A + lay.delta(A, B), self._coarse_step, lay.distance(A, B))
+        return lay.wrap(S), idx, j
+
+    def coarse(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
+        """Whether every 8th interior state of the motions A[k] -> B[k] is valid (one batched call, or
+        per-state checks): most invalid motions already fail here (not all: a thin wall can fit
+        between two of those states)."""
         K = len(A)
         if K == 0:
-            return np.zeros(0, dtype=bool)
-        if self.batched:
-            S, idx, _ = self.interior(A, B)
-            ok = self.states(S)
-            return np.bincount(idx[~ok], minlength=K) == 0
-        out = np.empty(K, dtype=bool)
-        for k in range(K):
-            out[k] = self._check_motion(A[k], B[k])
+            return np.ones(0, dtype=bool)
+        S, idx, j = self.interior(A, B)
+        c = j % _COARSE_STRIDE == 0
+        return np.bincount(idx[c][~self.states(S[c])], minlength=K) == 0
+
+    def motions(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
+        """Validity of the motions A[k] -> B[k] (valid ends assumed): :meth:`coarse`, then
+        :meth:`check_motion` for the motions still in question."""
+        out = np.zeros(len(A), dtype=bool)
+        for k in np.flatnonzero(self.coarse(A, B)):
+            out[k] = self.check_motion(A[k], B[k])
         return out
 
-    def _check_motion(self, a: np.ndarray, b: np.ndarray) -> bool:
+    def check_motion(self, a: np.ndarray, b: np.ndarray) -> bool:
+        """``si.checkMotion`` of a -> b (n,); a motion that passes is remembered in :attr:`passed`."""
         self.layout.write(self._s1, a)
         self.layout.write(self._s2, b)
         self.own_checks += max(1, math.ceil(float(self.layout.distance(a, b)) / self._longest))
-        return bool(self.si.checkMotion(self._s1, self._s2))
+        ok = bool(self.si.checkMotion(self._s1, self._s2))
+        if ok:
+            self.passed.add(segment_key(a, b))
+        return ok
 
     def candidates(
         self, C: np.ndarray, A: np.ndarray, B: np.ndarray, left_known: np.ndarray, right_known: np.ndarray, strict: np.ndarray
@@ -143,9 +172,9 @@ class Checker:
             if not vc[k]:
                 continue
             if left_known[k]:
-                left[k] = self._check_motion(A[k], C[k])
+                left[k] = self.check_motion(A[k], C[k])
             if right_known[k] and (left[k] or not strict[k]):
-                right[k] = self._check_motion(C[k], B[k])
+                right[k] = self.check_motion(C[k], B[k])
         return vc, left, right
 
 
@@ -189,6 +218,9 @@ class Search:
         self._dims = {gi: grouped.group_dims(gi) for gi in grouped.planned}
         self._bounds = {gi: grouped.group_bounds(gi) for gi in grouped.planned}
         self._tree: LayeredTrees | None = None
+        self._known: dict[bytes, bool] = {W[k : k + 2].tobytes(): bool(self.E[k]) for k in range(len(W) - 1)
+                                          if self.V[k] and self.V[k + 1]}
+        """Segment (two waypoint rows as bytes) -> motion valid, for every motion checked so far."""
         # feasibility phase: all planned groups vary jointly (with one planned group: that group)
         self._fdims = np.concatenate([self._dims[gi] for gi in grouped.planned]) if grouped.planned else np.zeros(0, int)
         self._fbounds = (grouped.layout.lower[self._fdims], grouped.layout.upper[self._fdims])
@@ -261,40 +293,126 @@ class Search:
         return self._improve(gi, c) if valid else self._grow(c)
 
     def _grow(self, c: np.ndarray) -> int:
-        """Feasibility phase: extend the forward/backward layered trees with the sample c."""
+        """Feasibility phase: grow the layered trees with the sample c, motions checked lazily.
+
+        c is checked as a waypoint at every step t that has a forward node before it or a backward
+        node after it (once when holding: the configuration is then the same at every step).  Of the
+        steps with both, the one with the shortest motions completes a candidate path, whose not yet
+        checked motions are checked now: all pass and it is the path; a failed motion kills the node
+        it leads into (and its subtree), and c joins the trees through those of its motions that
+        passed in full.  At the other steps c joins the trees on unchecked motions that pass
+        :meth:`Checker.coarse`; when holding, once per tree instead, at the lowest forward / highest
+        backward step whose motion passes in full (coarse screening alone let trees grow through
+        thin walls there).  Returns 1 when the path is complete, else 0.
+        """
         tree = self._tree
         d = tree.dims
+        h = self.g.h
         fi_all, bi_all = tree.nearest(c)
-        ts = [t for t in range(1, self.g.h - 1) if fi_all[t - 1] >= 0 or bi_all[t - 1] >= 0]
+        ts = [t for t in range(1, h - 1) if fi_all[t - 1] >= 0 or bi_all[t - 1] >= 0]
         if not ts:
             return 0
-        fi = [fi_all[t - 1] for t in ts]
-        bi = [bi_all[t - 1] for t in ts]
-        ts_a = np.array(ts)
         base = tree.base
+        ts_a = np.array(ts)
         C = base[ts_a].copy()
         C[:, d] = c
-        A = base[ts_a - 1].copy()
-        B = base[ts_a + 1].copy()
-        has_f, has_b = np.array(fi) >= 0, np.array(bi) >= 0
-        for k in range(len(ts)):
-            if fi[k] >= 0:
-                A[k, d] = tree.fwd.values[fi[k]]
-            if bi[k] >= 0:
-                B[k, d] = tree.bwd.values[bi[k]]
-        vc, left, right = self.checker.candidates(C, A, B, has_f, has_b, np.zeros(len(ts), dtype=bool))
-        for k, t in enumerate(ts):
-            if not vc[k]:
-                continue
-            if left[k] and right[k]:
-                self._adopt(tree.path(t, c, fi[k], bi[k]))
+        vc = np.repeat(self.checker.states(C[:1]), len(ts)) if self._hold else self.checker.states(C)
+        fi = np.array([fi_all[t - 1] for t in ts])
+        bi = np.array([bi_all[t - 1] for t in ts])
+        both = np.flatnonzero(vc & (fi >= 0) & (bi >= 0))
+        tried = -1
+        joined: set[int] = set()  # holding: the trees c joined already
+        if len(both):
+            A = base[ts_a[both] - 1].copy()
+            B = base[ts_a[both] + 1].copy()
+            A[:, d] = tree.fwd.values[fi[both]]
+            B[:, d] = tree.bwd.values[bi[both]]
+            k = int(both[np.argmin(self.dist(A, C[both]) + self.dist(C[both], B))])
+            tried, t = k, ts[k]
+            W, owners = tree.path(t, c, int(fi[k]), int(bi[k]))
+            bad = self._check_segments(W)
+            if not bad:
+                self._adopt(W)
                 self._tree = None
                 return 1
-            if left[k]:
-                tree.fwd.add(c, t, fi[k])
-            if right[k]:
-                tree.bwd.add(c, t, bi[k])
+            for seg in bad:
+                side, node = owners.get(seg, ("", -1))
+                if side == "f":
+                    tree.fwd.kill(node)
+                elif side == "b":
+                    tree.bwd.kill(node)
+            f, b = int(fi[k]), int(bi[k])
+            known = self._known  # c joins through a motion checked in full, or of zero length
+            passed = [known.get(W[k : k + 2].tobytes(), not np.any(W[k] != W[k + 1])) for k in (t - 1, t)]
+            if passed[0] and tree.fwd.alive[f]:
+                tree.fwd.add(c, t, f)
+                joined.add(id(tree.fwd))
+            if passed[1] and tree.bwd.alive[b]:
+                tree.bwd.add(c, t, b)
+                joined.add(id(tree.bwd))
+        # the other steps: c joins on unchecked motions that pass the coarse test; holding, once per
+        # tree, at the lowest step (forward) or highest (backward) whose motion passes in full
+        if self._hold:
+            if not vc[0]:
+                return 0
+            adds = []
+            for tr, p, order, sgn in ((tree.fwd, fi, range(len(ts)), 1), (tree.bwd, bi, range(len(ts) - 1, -1, -1), -1)):
+                seen = []
+                for k in order:
+                    if id(tr) not in joined and p[k] >= 0 and tr.alive[p[k]] and int(p[k]) not in seen:
+                        seen.append(int(p[k]))
+                        adds.append((tr, int(p[k]), int(tr.steps[p[k]]) + sgn))
+        else:
+            adds = [(tr, int(p[k]), ts[k]) for k in range(len(ts)) if k != tried and vc[k]
+                    for tr, p in ((tree.fwd, fi), (tree.bwd, bi)) if p[k] >= 0]
+        if not adds:
+            return 0
+        E = np.empty((2 * len(adds), self.g.n))
+        for m, (tr, p, t) in enumerate(adds):
+            ct = base[t].copy()
+            ct[d] = c
+            pt = base[int(tr.steps[p])].copy()
+            pt[d] = tr.values[p]
+            E[2 * m], E[2 * m + 1] = (pt, ct) if tr is tree.fwd else (ct, pt)
+        checker = self.checker
+        # one call when batched; per state, in order, skipping what holding makes useless
+        ok = checker.coarse(E[0::2], E[1::2]) if checker.batched and not self._hold else None
+        for m, (tr, p, t) in enumerate(adds):
+            if self._hold and id(tr) in joined:
+                continue
+            if self._hold:  # checked in full: coarse screening alone let motions through thin walls
+                good = self._check_segments(E[2 * m : 2 * m + 2]) == []
+            else:
+                good = ok[m] if ok is not None else checker.coarse(E[2 * m : 2 * m + 1], E[2 * m + 1 : 2 * m + 2])[0]
+            if good:
+                tr.add(c, t, p)
+                joined.add(id(tr))
         return 0
+
+    def _check_segments(self, W: np.ndarray) -> list[int]:
+        """Segments of W (K, n) found invalid (lazy checking: called once W is a complete candidate).
+
+        The waypoints are known valid; zero-length segments and segments checked before cost
+        nothing; the others go through :meth:`Checker.coarse` together (any failure there ends the
+        check), then ``si.checkMotion`` one by one.  Every result is remembered."""
+        known, checker = self._known, self.checker
+        keys = [W[k : k + 2].tobytes() for k in range(len(W) - 1)]
+        bad = [k for k, key in enumerate(keys) if not known.get(key, True)]
+        todo = [k for k, key in enumerate(keys) if key not in known and np.any(W[k] != W[k + 1])]
+        if bad or not todo:
+            return bad
+        ends = np.array(todo)
+        good = checker.coarse(W[ends], W[ends + 1])  # finds most failing motions at once
+        bad = [k for k, g in zip(todo, good) if not g]
+        for k in bad:
+            known[keys[k]] = False
+        if bad:
+            return bad
+        for k in todo:  # all of them: a motion the coarse test missed may not be the only one
+            if not checker.check_motion(W[k], W[k + 1]):
+                bad.append(k)
+            known[keys[k]] = k not in bad
+        return bad
 
     def _adopt(self, W: np.ndarray) -> None:
         """Take W (h, n), checked by the trees, as the current (valid) path.

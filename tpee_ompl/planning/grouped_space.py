@@ -39,6 +39,7 @@ __all__ = [
     "validate_groups",
     "validate_prescribed",
     "interpolate_waypoints",
+    "refine_waypoints",
     "MAX_H",
 ]
 
@@ -120,6 +121,14 @@ def interpolate_waypoints(start: np.ndarray, goal: np.ndarray, h: int) -> np.nda
     start, goal = np.asarray(start, dtype=float), np.asarray(goal, dtype=float)
     s = np.linspace(0.0, 1.0, h)[:, None]
     return start + s * (goal - start)
+
+
+def refine_waypoints(W: np.ndarray, layout: RealVectorLayout) -> np.ndarray:
+    """W (h, n) with the midpoint of every segment inserted (in the space's geodesic): (2h - 1, n)."""
+    out = np.empty((2 * len(W) - 1, W.shape[1]))
+    out[0::2] = W
+    out[1::2] = layout.interpolate(W[:-1], W[1:], np.full(len(W) - 1, 0.5))
+    return out
 
 
 class RealVectorLayout:
@@ -327,6 +336,14 @@ class GroupedSpace:
             W[:, self.group_dims(g)] = traj
         W[0], W[-1] = start, goal
         return W
+
+    def refined(self, start: np.ndarray, goal: np.ndarray) -> GroupedSpace:
+        """The same problem with ``2h - 1`` fake-time steps: a step is inserted halfway between every
+        two.  Prescribed trajectories keep their rows at the even steps and get the midpoints (their
+        polyline is unchanged, so a Table 3 row still prescribes the same motion)."""
+        W = refine_waypoints(self.initial_waypoints(start, goal), self.layout)
+        prescribed = {g: W[:, self.group_dims(g)] for g in self.prescribed}
+        return GroupedSpace(self.layout.space, self.groups, 2 * self.h - 1, prescribed)
 
     def group_point(self, W: np.ndarray, g: int) -> np.ndarray:
         """Path-space point of group g: its values at the h-2 intermediate steps, flat ((h-2) k_g,)."""

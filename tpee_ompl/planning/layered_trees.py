@@ -2,8 +2,11 @@
 
 Before the first valid path the search grows a forward tree from the start and a backward tree from
 the goal.  A node is the planned DOFs' values at one fake-time step (the other DOFs are those of
-the base path at that step); every node is valid and reached from its parent by a valid motion.
-See :mod:`tpee_ompl.planning.dimension_rrt` for how samples are placed.
+the base path at that step); every node is valid.  Motions are checked *lazily* (as in LazyRRT):
+a node may hang on an unchecked motion, and the motions of a candidate path are checked only when
+the path is complete (:meth:`LayeredTrees.path` names the node each segment leads into, so a failed
+segment kills that node and its subtree).  See :mod:`tpee_ompl.planning.dimension_rrt` for how
+samples are placed.
 
 *Holding* (only without prescribed groups, where a node's configuration does not depend on its
 step): a node of step s also serves every later step (forward tree) or earlier step (backward tree)
@@ -21,11 +24,16 @@ __all__ = ["Tree", "LayeredTrees", "spread_waypoints"]
 
 
 class Tree:
-    """Nodes of one layered tree: values (N, k), fake-time step and parent index of each."""
+    """Nodes of one layered tree: values (N, k), fake-time step, parent index and liveness of each.
+
+    A node is *dead* once the motion into it (or into one of its ancestors) failed a check; dead
+    nodes are never nearest neighbours, anchors or parents again.
+    """
 
     def __init__(self, k: int) -> None:
         self.values = np.empty((16, k))
         self.steps = np.empty(16, dtype=int)
+        self.alive = np.zeros(16, dtype=bool)
         self.parents: list[int] = []
 
     def __len__(self) -> int:
@@ -36,19 +44,30 @@ class Tree:
         if n == len(self.values):
             self.values = np.concatenate([self.values, np.empty_like(self.values)])
             self.steps = np.concatenate([self.steps, np.empty_like(self.steps)])
+            self.alive = np.concatenate([self.alive, np.zeros_like(self.alive)])
         self.values[n] = x
         self.steps[n] = step
+        self.alive[n] = True
         self.parents.append(parent)
         return n
+
+    def kill(self, i: int) -> None:
+        """Mark node i and all its descendants dead (a child's index is always above its parent's)."""
+        alive, parents = self.alive, self.parents
+        alive[i] = False
+        for j in range(i + 1, len(parents)):
+            if alive[j] and not alive[parents[j]]:
+                alive[j] = False
 
     def sq_dist(self, x: np.ndarray, delta: Callable[[np.ndarray, np.ndarray], np.ndarray]) -> np.ndarray:
         D = delta(self.values[: len(self.parents)], x)
         return np.einsum("ij,ij->i", D, D)
 
     def layer_sizes(self) -> list[tuple[int, np.ndarray]]:
-        """(step, node indices) of each non-empty step, steps ascending."""
-        st = self.steps[: len(self.parents)]
-        return [(int(s), np.flatnonzero(st == s)) for s in np.unique(st)]
+        """(step, live node indices) of each step with live nodes, steps ascending."""
+        n = len(self.parents)
+        st, live = self.steps[:n], self.alive[:n]
+        return [(int(s), np.flatnonzero((st == s) & live)) for s in np.unique(st[live])]
 
 
 def _nearest(d2: np.ndarray, ok: np.ndarray) -> int:
@@ -85,36 +104,49 @@ class LayeredTrees:
         (step t-1, or any step <= t-1 when holding) and the nearest backward node that can follow
         it (step t+1, or >= t+1); -1 where there is none."""
         df, db = self.fwd.sq_dist(c, self.delta), self.bwd.sq_dist(c, self.delta)
-        sf, sb = self.fwd.steps[: len(self.fwd)], self.bwd.steps[: len(self.bwd)]
+        nf, nb = len(self.fwd), len(self.bwd)
+        sf, sb = self.fwd.steps[:nf], self.bwd.steps[:nb]
+        af, ab = self.fwd.alive[:nf], self.bwd.alive[:nb]
         fi, bi = [], []
         for t in range(1, self.h - 1):
-            fi.append(_nearest(df, sf <= t - 1 if self.hold else sf == t - 1))
-            bi.append(_nearest(db, sb >= t + 1 if self.hold else sb == t + 1))
+            fi.append(_nearest(df, af & (sf <= t - 1 if self.hold else sf == t - 1)))
+            bi.append(_nearest(db, ab & (sb >= t + 1 if self.hold else sb == t + 1)))
         return fi, bi
 
     def anchor(self, u: float) -> np.ndarray:
-        """Values of a tree node picked by u in [0, 1): a uniform non-empty step of either tree, then a uniform node."""
+        """Values of a live tree node picked by u in [0, 1): a uniform step of either tree, then a uniform node."""
         layers = [(tree, idx) for tree in (self.fwd, self.bwd) for _, idx in tree.layer_sizes()]
         x = u * len(layers)
         tree, idx = layers[int(x)]
         return tree.values[idx[int((x - int(x)) * len(idx))]]
 
-    def path(self, t: int, c: np.ndarray, f: int, b: int) -> np.ndarray:
-        """The waypoints (h, n) through forward node f, c at step t, backward node b (held nodes repeated)."""
+    def path(self, t: int, c: np.ndarray, f: int, b: int) -> tuple[np.ndarray, dict[int, tuple[str, int]]]:
+        """The waypoints (h, n) through forward node f, c at step t, backward node b (held nodes repeated).
+
+        Also returns, for each segment k (W[k] -> W[k+1]) that is a tree motion, the node it leads
+        into: ``("f", i)`` forward node i, ``("b", i)`` backward node i (the motion to its parent),
+        ``("c", -1)`` the motions into and out of c (segments t-1 and t).  The other segments join
+        two equal held waypoints (zero length).
+        """
         W = self.base.copy()
         d = self.dims
         W[t, d] = c
+        owners: dict[int, tuple[str, int]] = {t - 1: ("c", -1), t: ("c", -1)}
         end = t  # fill steps [node step, end) with the node's values, walking back to the start
         while f >= 0:
             s = int(self.fwd.steps[f])
             W[s:end, d] = self.fwd.values[f]
+            if s > 0:
+                owners[s - 1] = ("f", f)
             end, f = s, self.fwd.parents[f]
         begin = t + 1  # fill steps [begin, node step] walking on to the goal
         while b >= 0:
             s = int(self.bwd.steps[b])
             W[begin : s + 1, d] = self.bwd.values[b]
+            if s < self.h - 1:
+                owners[s] = ("b", b)
             begin, b = s + 1, self.bwd.parents[b]
-        return W
+        return W, owners
 
 
 def spread_waypoints(W: np.ndarray, interpolate: Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray],

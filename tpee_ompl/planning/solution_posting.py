@@ -31,7 +31,7 @@ class SolutionPoster:
 
     def __init__(self, planner: ob.Planner, si: ob.SpaceInformation, pdef: ob.ProblemDefinition, t0: float,
                  to_path: Callable[[ob.SpaceInformation, np.ndarray], og.PathGeometric],
-                 notify: Callable[[og.PathGeometric, float], None]) -> None:
+                 notify: Callable[[og.PathGeometric, float], None], passed: set[bytes] | None = None) -> None:
         self.planner, self.si, self.pdef, self.t0 = planner, si, pdef, t0
         self.to_path, self.notify = to_path, notify
         self.opt = pdef.getOptimizationObjective() if pdef.hasOptimizationObjective() else None
@@ -42,7 +42,9 @@ class SolutionPoster:
         self.satisfied = False
         self._pending: tuple[np.ndarray, float] | None = None
         self._spent = 0.0
-        self._passed: set[bytes] = set()
+        self._passed: set[bytes] = set() if passed is None else passed
+        """Segments (two waypoint rows as bytes) that already passed ``si.checkMotion``, shared with the
+        search's checker so a motion it checked that way is not checked again."""
 
     def offer(self, W: np.ndarray, cost: float, now: float) -> None:
         self.found_cost = cost

@@ -1,0 +1,147 @@
+"""Time to a first exact path: dimension-RRT vs RRTConnect at home, and dimension-RRT's per-sample overhead.
+
+    PYTHONPATH=. .venv/bin/python experiments/first_path.py                       # both parts, ~2 min
+    PYTHONPATH=. .venv/bin/python experiments/first_path.py --queries planning_necessary --max-queries 24
+    PYTHONPATH=. .venv/bin/python experiments/first_path.py --skip-home           # overhead only
+
+Home: for every query of each named set (the wearer, ``make_simple_setup`` with its batched motion
+validator), RRTConnect and dimension-RRT (``tpee_dimension_rrt``, seed = query index) run one after the
+other in this process, each stopped by ``exactSolnPlannerTerminationCondition`` or --limit s; prints the
+median and p95 time to the first exact path of each, the ratio of the medians and the median
+number of configurations checked (dimension-RRT's is deterministic under its seed).
+
+Overhead: dimension-RRT on a 6-D box with a wall and a hole (straight path blocked), a plain Python
+validity checker that returns at once (no batched call), capped at --samples samples; prints the time
+per sample outside the checker (planner overhead) and inside it, and the checker calls per sample.
+"""
+
+from __future__ import annotations
+
+import argparse
+import gc
+import math
+import statistics
+import time
+
+import numpy as np
+from ompl import base as ob
+from ompl import geometric as og
+from ompl import util as ou
+
+from tpee_ompl.model.queries import load_queries
+from tpee_ompl.model.wearer_arm import WearerArm
+from tpee_ompl.planning.dimension_rrt import DimensionRRT
+from tpee_ompl.planning.setup import make_simple_setup
+from tpee_ompl.planning.tpee import tpee_dimension_rrt
+
+
+def get_argument_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--queries", nargs="+", default=["planning_necessary", "paper_random"])
+    p.add_argument("--max-queries", type=int, default=None, help="first N queries of each set")
+    p.add_argument("--limit", type=float, default=1.0, help="time limit per first-path run, s")
+    p.add_argument("--samples", type=int, default=2000, help="sample cap of the overhead run")
+    p.add_argument("--skip-home", action="store_true")
+    p.add_argument("--skip-overhead", action="store_true")
+    return p
+
+
+def _first(ss: og.SimpleSetup, planner: ob.Planner, limit: float) -> float | None:
+    ss.clear()
+    ss.setPlanner(planner)
+    ptc = ob.plannerOrTerminationCondition(ob.exactSolnPlannerTerminationCondition(ss.getProblemDefinition()),
+                                           ob.timedPlannerTerminationCondition(limit))
+    t = time.perf_counter()
+    ss.solve(ptc)
+    dt = time.perf_counter() - t
+    return dt if ss.haveExactSolutionPath() else None
+
+
+def _p95(v: list[float]) -> float:
+    return float(np.percentile(v, 95)) if v else math.nan
+
+
+def home(args: argparse.Namespace) -> None:
+    robot = WearerArm()
+    for name in args.queries:
+        qs = load_queries(name, robot)[: args.max_queries]
+        rc, dr, rc_checks, dr_checks = [], [], [], []
+        for k, q in enumerate(qs):
+            ss = make_simple_setup(robot, q.start, q.goal)
+            si = ss.getSpaceInformation()
+            c0 = robot.collision_checks
+            rc.append(_first(ss, og.RRTConnect(si), args.limit))
+            c1 = robot.collision_checks
+            dr.append(_first(ss, tpee_dimension_rrt(si, q.from_sector, q.to_sector, seed=k), args.limit))
+            rc_checks.append(c1 - c0)
+            dr_checks.append(robot.collision_checks - c1)
+        r = [x for x in rc if x is not None]
+        d = [x for x in dr if x is not None]
+        print(f"home {name:20s} queries {len(qs):4d}  solved D/R {len(d)}/{len(r)}  "
+              f"median D {1e3 * statistics.median(d):6.1f} ms  R {1e3 * statistics.median(r):6.1f} ms  "
+              f"ratio {statistics.median(d) / statistics.median(r):5.2f}  p95 D {1e3 * _p95(d):6.1f} ms  "
+              f"R {1e3 * _p95(r):6.1f} ms  median checks D {statistics.median(dr_checks):.0f} "
+              f"R {statistics.median(rc_checks):.0f}", flush=True)
+
+
+def overhead(args: argparse.Namespace) -> None:
+    n = 6
+    space = ob.RealVectorStateSpace(n)
+    space.setBounds(0.0, 1.0)
+    ss = og.SimpleSetup(space)
+    si = ss.getSpaceInformation()
+    spent = [0.0, 0]
+
+    def valid(s: ob.State) -> bool:
+        t = time.perf_counter()
+        x0, x1 = s[0], s[1]
+        ok = not (0.45 < x0 < 0.55) or (0.4 < x1 < 0.6)
+        spent[0] += time.perf_counter() - t
+        spent[1] += 1
+        return ok
+
+    ss.setStateValidityChecker(valid)
+    ss.setOptimizationObjective(ob.PathLengthOptimizationObjective(si))
+    a, b = si.allocState(), si.allocState()
+    for i in range(n):
+        a[i], b[i] = 0.1, 0.9
+    a[1], b[1] = 0.05, 0.2
+    ss.setStartAndGoalStates(a, b)
+    si.setup()
+    # the cost of one call of the checker from C++ (outside the timed body) measured on its own
+    probe = si.allocState()
+    m = 20000
+    t = time.perf_counter()
+    for _ in range(m):
+        si.isValid(probe)
+    call = (time.perf_counter() - t) / m
+    rows = []
+    for seed in range(3):
+        ss.clear()
+        p = DimensionRRT(si, groups=[[0, 1], [2, 3], [4, 5]], seed=seed, max_samples=args.samples)
+        ss.setPlanner(p)
+        spent[0], spent[1] = 0.0, 0
+        t = time.perf_counter()
+        ss.solve(60.0)
+        total = time.perf_counter() - t
+        st = p.last_run_stats()
+        calls = spent[1]
+        rows.append(((total - calls * call) / st["samples"], calls * call / st["samples"], calls / st["samples"]))
+    med = [statistics.median(r[i] for r in rows) for i in range(3)]
+    print(f"overhead 6-D box, no batched call, {args.samples} samples: {1e3 * med[0]:.3f} ms/sample outside the "
+          f"checker, {1e3 * med[1]:.3f} ms/sample in checker calls ({med[2]:.1f} calls/sample, "
+          f"{1e6 * call:.2f} us/call)", flush=True)
+
+
+def main(argv: list[str] | None = None) -> None:
+    args = get_argument_parser().parse_args(argv)
+    ou.setLogLevel(ou.LOG_NONE)
+    if not args.skip_home:
+        home(args)
+    if not args.skip_overhead:
+        overhead(args)
+
+
+if __name__ == "__main__":
+    main()
+    gc.collect()

@@ -1,0 +1,41 @@
+"""tpee_ompl.planning.layered_trees: lazily checked layered trees of the feasibility phase."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from tpee_ompl.planning.layered_trees import LayeredTrees, Tree
+
+
+def _delta(A: np.ndarray, B: np.ndarray) -> np.ndarray:
+    return np.asarray(B, dtype=float) - np.asarray(A, dtype=float)
+
+
+def test_killing_a_node_kills_its_subtree_and_hides_it_from_nearest() -> None:
+    W = np.linspace([0.0, 0.0], [1.0, 0.0], 5)
+    V = np.array([True, False, False, False, True])
+    E = np.zeros(4, dtype=bool)
+    trees = LayeredTrees(W, V, E, np.array([0, 1]), hold=True, delta=_delta)
+    a = trees.fwd.add(np.array([0.2, 0.5]), 1, 0)
+    b = trees.fwd.add(np.array([0.4, 0.5]), 2, a)
+    other = trees.fwd.add(np.array([0.2, -0.5]), 1, 0)
+    fi, _ = trees.nearest(np.array([0.45, 0.5]))
+    assert fi[-1] == b
+    trees.fwd.kill(a)
+    assert not trees.fwd.alive[a] and not trees.fwd.alive[b] and trees.fwd.alive[other]
+    fi, _ = trees.nearest(np.array([0.45, 0.5]))
+    assert b not in fi and a not in fi
+    assert all(len(idx) and trees.fwd.alive[idx].all() for _, idx in trees.fwd.layer_sizes())
+
+
+def test_candidate_path_names_the_node_each_segment_leads_into() -> None:
+    W = np.linspace([0.0, 0.0], [1.0, 0.0], 7)
+    V = np.array([True] + [False] * 5 + [True])
+    trees = LayeredTrees(W, V, np.zeros(6, dtype=bool), np.array([0, 1]), hold=True, delta=_delta)
+    f = trees.fwd.add(np.array([0.1, 0.3]), 1, 0)
+    b = trees.bwd.add(np.array([0.8, 0.3]), 4, 0)
+    path, owners = trees.path(2, np.array([0.5, 0.4]), f, b)
+    np.testing.assert_allclose(path[[1, 2, 4]], [[0.1, 0.3], [0.5, 0.4], [0.8, 0.3]])
+    np.testing.assert_allclose(path[[0, -1]], W[[0, -1]])
+    assert owners[0] == ("f", f) and owners[1] == ("c", -1) and owners[2] == ("c", -1)
+    assert owners[4] == ("b", b) and 3 not in owners  # steps 3 and 4 both hold b (a zero-length motion)
