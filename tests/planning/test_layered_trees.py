@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from tpee_ompl.planning.layered_trees import LayeredTrees, Tree
+from tpee_ompl.planning.layered_trees import LayeredTrees
 
 
 def _delta(A: np.ndarray, B: np.ndarray) -> np.ndarray:
