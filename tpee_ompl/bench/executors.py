@@ -97,6 +97,11 @@ def _child_main(fn: TaskFn, task: dict, conn) -> None:
         conn.send(msg)
     finally:
         conn.close()
+    # Leave without interpreter finalisation: the result is sent and every log written, and
+    # finalisation only makes the nanobind-based bindings (OMPL) list their "leaked" instances on stderr.
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os._exit(0)
 
 
 def _death_reason(exitcode: int | None) -> str:
