@@ -32,7 +32,7 @@ bench: $(STAMP)
 
 # Full campaign, both named query sets: Table 4 (500..2500 samples, one run per ladder) on all 120
 # queries of each; OMPL's per-state validator on 12 stratified queries per set at 500 and 2500;
-# the anytime comparison (0.1..2 s, separate runs) on 2 stratified queries per set.
+# the anytime comparison (0.1..2 s; one run per budget ladder where exact) on 2 stratified queries per set.
 bench-full: $(STAMP)
 	MPLBACKEND=Agg $(PY) experiments/run_benchmark.py --queries planning_necessary --name full --workers 2 \
 		--alt-checker-queries 12 --alt-checker-samples 500 2500 --anytime-queries 2
@@ -40,12 +40,12 @@ bench-full: $(STAMP)
 		--alt-checker-queries 12 --alt-checker-samples 500 2500 --anytime-queries 2
 
 # The generic problems (plain OMPL + numpy set-ups), each in its own campaign with short settings:
-# 4 queries, 500 samples, anytime 0.1/0.5/1 s (tpee-ompl bench --list-problems lists them).
+# all 10 queries, 500 samples, anytime 0.1/0.5/1 s (tpee-ompl bench --list-problems lists them).
 # panda-shelf (7 joints, hard: shelf compartments) runs last, on 6 queries at 1 and 5 s.
 GENERIC_PROBLEMS := arm4 arm6 arm7 arm8 arm5-so2 point4-hole narrow3
 bench-generic: $(STAMP)
 	for p in $(GENERIC_PROBLEMS); do \
-		MPLBACKEND=Agg $(PY) experiments/run_benchmark.py --problem $$p --name $$p --max-queries 4 \
+		MPLBACKEND=Agg $(PY) experiments/run_benchmark.py --problem $$p --name $$p \
 			--samples 500 --anytime 0.1 0.5 1 --workers 2 --no-progress || exit 1; \
 	done
 	MPLBACKEND=Agg $(PY) experiments/run_benchmark.py --problem panda-shelf --name panda-shelf --max-queries 6 \

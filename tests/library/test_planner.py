@@ -131,3 +131,25 @@ def test_a_query_near_the_joint_limits_keeps_its_library_path(robot):
     assert status == ob.PlannerStatus.EXACT_SOLUTION
     assert planner.last_run_stats()["library_outcome"] in ("dmp", "repaired", "straight", "planned")
     assert path_passes_motion_checks(ss.getSpaceInformation(), ss.getSolutionPath())
+
+
+def test_a_free_direct_motion_ends_the_run_as_the_shortest_path(robot, library):
+    q = next(q for q in load_queries("paper_random") if (q.from_sector, q.to_sector) == (1, 2))
+    ss = make_simple_setup(robot, q.start, q.goal)
+    si = ss.getSpaceInformation()
+    direct_free = path_passes_motion_checks(si, np.stack([q.start, q.goal]))
+    ss, planner, status = _solve(robot, library, q.start, q.goal, seed=0)
+    stats = planner.last_run_stats()
+    assert status == ob.PlannerStatus.EXACT_SOLUTION
+    assert stats["direct_motion"] == direct_free
+    if direct_free:
+        assert stats["samples"] == 0 and ss.getSolutionPath().getStateCount() == 2
+        assert ss.getSolutionPath().length() == pytest.approx(float(np.linalg.norm(q.goal - q.start)))
+
+
+def test_a_colliding_direct_motion_changes_nothing(robot, library):
+    q = _stored("planning_necessary", 1, 2)  # every planning_necessary direct motion collides
+    ss, planner, status = _solve(robot, library, q.start, q.goal, max_samples=100, seed=0)
+    stats = planner.last_run_stats()
+    assert status == ob.PlannerStatus.EXACT_SOLUTION and not stats["direct_motion"]
+    assert stats["samples"] > 0
