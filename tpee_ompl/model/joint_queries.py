@@ -17,8 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from ..files import atomic_write_text
-from ..resources import query_set_path
-from .queries import QuerySetError
+from .queries import QuerySetError, read_query_document
 from .robot_checker import RobotChecker
 
 __all__ = ["JOINT_FORMAT", "JointQuery", "load_joint_query_set", "save_joint_queries"]
@@ -98,17 +97,7 @@ def load_joint_query_set(name_or_path: str | os.PathLike,
 
     Raises FileNotFoundError (no such set or file) or :class:`QuerySetError` (a ValueError: not
     JSON, another format, malformed or duplicate queries, another model)."""
-    if isinstance(name_or_path, bool) or not isinstance(name_or_path, (str, os.PathLike)):
-        raise ValueError(f"query set must be a name or a path, got {name_or_path!r}")
-    p = Path(name_or_path)
-    if not p.suffix and not p.exists():
-        p = query_set_path(str(name_or_path))
-    if not p.is_file():
-        raise FileNotFoundError(f"query set {str(name_or_path)!r} not found (looked at {p})")
-    try:
-        doc = json.loads(p.read_text(encoding="utf-8"))
-    except (UnicodeDecodeError, json.JSONDecodeError, RecursionError) as exc:
-        raise QuerySetError(f"{p}: not a JSON query set (truncated or corrupt?): {exc}") from exc
+    p, doc = read_query_document(name_or_path)
     if not isinstance(doc, dict) or doc.get("format") != JOINT_FORMAT:
         got = doc.get("format") if isinstance(doc, dict) else type(doc).__name__
         raise QuerySetError(f"{p}: not a joint query set (format {got!r}, expected {JOINT_FORMAT!r})")

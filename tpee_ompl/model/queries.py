@@ -36,6 +36,7 @@ __all__ = [
     "QuerySetError",
     "load_queries",
     "load_query_set",
+    "read_query_document",
     "save_queries",
     "straight_motion",
 ]
@@ -158,8 +159,12 @@ def save_queries(
     return atomic_write_text(path, json.dumps(doc, indent=1) + "\n")
 
 
-def load_query_set(name_or_path: str | os.PathLike, robot: WearerArm | None = None) -> tuple[list[Query], dict]:
-    """Queries and the file's header (everything but ``queries``); see :func:`load_queries`."""
+def read_query_document(name_or_path: str | os.PathLike) -> tuple[Path, object]:
+    """The file of a named query set (packaged) or a JSON path, and its parsed JSON (any type).
+
+    Raises ValueError (not a name or path), FileNotFoundError (no such set or file) or
+    :class:`QuerySetError` (not JSON).  Shared by the sector sets and the joint sets
+    (:mod:`tpee_ompl.model.joint_queries`)."""
     if isinstance(name_or_path, bool) or not isinstance(name_or_path, (str, os.PathLike)):
         raise ValueError(f"query set must be a name or a path, got {name_or_path!r}")
     p = Path(name_or_path)
@@ -168,9 +173,14 @@ def load_query_set(name_or_path: str | os.PathLike, robot: WearerArm | None = No
     if not p.is_file():
         raise FileNotFoundError(f"query set {str(name_or_path)!r} not found (looked at {p})")
     try:
-        doc = json.loads(p.read_text(encoding="utf-8"))
+        return p, json.loads(p.read_text(encoding="utf-8"))
     except (UnicodeDecodeError, json.JSONDecodeError, RecursionError) as exc:
         raise QuerySetError(f"{p}: not a JSON query set (truncated or corrupt?): {exc}") from exc
+
+
+def load_query_set(name_or_path: str | os.PathLike, robot: WearerArm | None = None) -> tuple[list[Query], dict]:
+    """Queries and the file's header (everything but ``queries``); see :func:`load_queries`."""
+    p, doc = read_query_document(name_or_path)
     if not isinstance(doc, dict):
         raise QuerySetError(f"{p}: expected a JSON object at the top level, got {type(doc).__name__}")
     version = doc.get("format_version")

@@ -116,15 +116,21 @@ def load_wearer_model(urdf: Path, srdf: Path | None) -> LoadedModel:
     return loaded
 
 
-def _parse_urdf(urdf: Path) -> ET.Element:
-    if not urdf.is_file():
-        raise FileNotFoundError(f"URDF file not found: {urdf}")
+def _read_robot_xml(path: Path, kind: str) -> ET.Element:
+    """The ``<robot>`` root of a URDF or SRDF file, or FileNotFoundError / ValueError naming the file."""
+    if not path.is_file():
+        raise FileNotFoundError(f"{kind} file not found: {path}")
     try:
-        root = ET.fromstring(_read_text(urdf, "URDF"))
+        root = ET.fromstring(_read_text(path, kind))
     except ET.ParseError as exc:
-        raise ValueError(f"malformed URDF {urdf}: {exc}") from exc
+        raise ValueError(f"malformed {kind} {path}: {exc}") from exc
     if root.tag != "robot":
-        raise ValueError(f"malformed URDF {urdf}: root element is <{root.tag}>, expected <robot>")
+        raise ValueError(f"malformed {kind} {path}: root element is <{root.tag}>, expected <robot>")
+    return root
+
+
+def _parse_urdf(urdf: Path) -> ET.Element:
+    root = _read_robot_xml(urdf, "URDF")
     if any(c.tag == "capsule" for c in root.iter()):
         raise ValueError(f"URDF {urdf} uses <capsule>, which urdfdom drops silently; use <cylinder> (loaded as capsules)")
     return root
@@ -267,14 +273,7 @@ def is_prismatic(joint: pin.JointModel) -> bool:
 
 def _apply_srdf(model: pin.Model, gmodel: pin.GeometryModel, srdf: Path) -> None:
     """Remove the SRDF's disabled pairs, after checking that it names only links of the model."""
-    if not srdf.is_file():
-        raise FileNotFoundError(f"SRDF file not found: {srdf}")
-    try:
-        root = ET.fromstring(_read_text(srdf, "SRDF"))
-    except ET.ParseError as exc:
-        raise ValueError(f"malformed SRDF {srdf}: {exc}") from exc
-    if root.tag != "robot":
-        raise ValueError(f"malformed SRDF {srdf}: root element is <{root.tag}>, expected <robot>")
+    root = _read_robot_xml(srdf, "SRDF")
     links = {f.name for f in model.frames}
     for dc in root.iter("disable_collisions"):
         for key in ("link1", "link2"):
