@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from ..files import atomic_write_text
-from .queries import QuerySetError, read_query_document
+from .queries import QuerySetError, query_entries, read_query_document
 from .robot_checker import RobotChecker
 
 __all__ = ["JOINT_FORMAT", "JointQuery", "load_joint_query_set", "save_joint_queries"]
@@ -101,18 +101,7 @@ def load_joint_query_set(name_or_path: str | os.PathLike,
     if not isinstance(doc, dict) or doc.get("format") != JOINT_FORMAT:
         got = doc.get("format") if isinstance(doc, dict) else type(doc).__name__
         raise QuerySetError(f"{p}: not a joint query set (format {got!r}, expected {JOINT_FORMAT!r})")
-    entries = doc.get("queries")
-    if not isinstance(entries, list):
-        raise QuerySetError(f"{p}: 'queries' must be a list, got {type(entries).__name__}")
-    queries = []
-    for k, d in enumerate(entries):
-        try:
-            queries.append(JointQuery.from_dict(d))
-        except ValueError as exc:
-            raise QuerySetError(f"{p}: query {k} is malformed: {exc}") from exc
-    ids = [q.id for q in queries]
-    if len(set(ids)) != len(ids):
-        raise QuerySetError(f"{p}: query id {next(i for i in ids if ids.count(i) > 1)} appears twice")
+    queries = query_entries(p, doc, JointQuery.from_dict)
     if len({q.start.size for q in queries}) > 1:
         raise QuerySetError(f"{p}: queries have different numbers of joints")
     header = {k: v for k, v in doc.items() if k != "queries"}

@@ -19,9 +19,10 @@ from __future__ import annotations
 import json
 import logging
 import os
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -36,6 +37,7 @@ __all__ = [
     "QuerySetError",
     "load_queries",
     "load_query_set",
+    "query_entries",
     "read_query_document",
     "save_queries",
     "straight_motion",
@@ -178,6 +180,24 @@ def read_query_document(name_or_path: str | os.PathLike) -> tuple[Path, object]:
         raise QuerySetError(f"{p}: not a JSON query set (truncated or corrupt?): {exc}") from exc
 
 
+def query_entries(p: Path, doc: dict, from_dict: Callable[[object], Any]) -> list:
+    """The document's ``queries`` list parsed by ``from_dict``, or QuerySetError naming the file and the
+    entry (not a list, a malformed entry, an id that appears twice)."""
+    entries = doc.get("queries")
+    if not isinstance(entries, list):
+        raise QuerySetError(f"{p}: 'queries' must be a list, got {type(entries).__name__}")
+    queries = []
+    for k, d in enumerate(entries):
+        try:
+            queries.append(from_dict(d))
+        except ValueError as exc:
+            raise QuerySetError(f"{p}: query {k} is malformed: {exc}") from exc
+    ids = [q.id for q in queries]
+    if len(set(ids)) != len(ids):
+        raise QuerySetError(f"{p}: query id {next(i for i in ids if ids.count(i) > 1)} appears twice")
+    return queries
+
+
 def load_query_set(name_or_path: str | os.PathLike, robot: WearerArm | None = None) -> tuple[list[Query], dict]:
     """Queries and the file's header (everything but ``queries``); see :func:`load_queries`."""
     p, doc = read_query_document(name_or_path)
@@ -186,19 +206,8 @@ def load_query_set(name_or_path: str | os.PathLike, robot: WearerArm | None = No
     version = doc.get("format_version")
     if isinstance(version, bool) or version != FORMAT_VERSION:
         raise QuerySetError(f"{p}: unsupported format_version {version!r} (expected {FORMAT_VERSION})")
-    entries = doc.get("queries")
-    if not isinstance(entries, list):
-        raise QuerySetError(f"{p}: 'queries' must be a list, got {type(entries).__name__}")
-    queries = []
-    for k, d in enumerate(entries):
-        try:
-            queries.append(Query.from_dict(d))
-        except ValueError as exc:
-            raise QuerySetError(f"{p}: query {k} is malformed: {exc}") from exc
+    queries = query_entries(p, doc, Query.from_dict)
     header = {k: v for k, v in doc.items() if k != "queries"}
-    ids = [q.id for q in queries]
-    if len(set(ids)) != len(ids):
-        raise QuerySetError(f"{p}: query id {next(i for i in ids if ids.count(i) > 1)} appears twice")
     if robot is not None and header.get("model_hash") != robot.model_hash:
         raise QuerySetError(
             f"{p}: made for model_hash {header.get('model_hash')!r}, but the robot's is {robot.model_hash!r} "
