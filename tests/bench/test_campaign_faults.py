@@ -116,7 +116,9 @@ def test_database_build_skips_a_corrupt_log_by_name(query_file, tmp_path, caplog
 def _launch(query_file: Path, out: Path) -> subprocess.Popen:
     code = ("import sys; sys.path.insert(0, sys.argv[1]); from tpee_ompl.cli.bench import main; "
             "sys.exit(main(sys.argv[2:]))")
-    args = ["--queries", str(query_file), "--name", "sig", "--samples", "30", "60", "--anytime", "0.05",
+    # a 1 s budget per query keeps the campaign running well after its first log (the signal must not
+    # arrive after the end: workers that exit at once made that race visible)
+    args = ["--queries", str(query_file), "--name", "sig", "--samples", "30", "60", "--anytime", "0.05", "1",
             "--planners", STANDIN, "RRTstar",
             "--anytime-planners", STANDIN, "RRTConnect",
             "--checkers", "batched", "--workers", "1", "--seed", "5", "--out", str(out), "--no-progress"]

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import time
 
 import pytest
 from ompl import base as ob
@@ -22,15 +23,18 @@ def _solve(planner_cls, seconds: float, cap: int | None = None) -> dict:
     w = RecordingPlanner(si, planner_cls(si), max_iterations=cap)
     w.setProblemDefinition(pdef)
     w.setup()
+    t0 = time.perf_counter()
     status = w.solve(ob.timedPlannerTerminationCondition(seconds))
-    return dict(w.last, status=str(status), exact=pdef.hasExactSolution(), keep=(si, checker, start, goal))
+    return dict(w.last, status=str(status), exact=pdef.hasExactSolution(), elapsed=time.perf_counter() - t0,
+                keep=(si, checker, start, goal))
 
 
 @pytest.mark.parametrize("planner_cls", [og.RRTstar, og.AORRTC])
 def test_native_anytime_planners_record_their_first_exact_solution_before_the_run_ends(planner_cls):
     rec = _solve(planner_cls, 0.5)
     assert rec["exact"] and rec["first_solution_time"] is not None
-    assert 0.0 < rec["first_solution_time"] < 0.4  # found in a few ms on this problem, then improved to the end
+    # found early (milliseconds on this problem), then improved until the time limit: not the run's end
+    assert 0.0 < rec["first_solution_time"] < rec["elapsed"] / 2
 
 
 def test_rrtconnect_first_solution_is_the_end_of_its_run():
