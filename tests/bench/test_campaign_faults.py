@@ -122,8 +122,11 @@ def _launch(query_file: Path, out: Path) -> subprocess.Popen:
             "--planners", STANDIN, "RRTstar",
             "--anytime-planners", STANDIN, "RRTConnect",
             "--checkers", "batched", "--workers", "1", "--seed", "5", "--out", str(out), "--no-progress"]
+    # SIGINT back to its default in the child: a test run started in the background of a non-interactive
+    # shell inherits SIGINT ignored, and Python then never raises KeyboardInterrupt
     return subprocess.Popen([sys.executable, "-c", code, str(TESTS), *args], cwd=str(TESTS.parent),
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
 
 
 def _wait_for(pred, timeout: float = 60.0) -> None:
