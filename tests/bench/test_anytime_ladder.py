@@ -7,6 +7,7 @@ import multiprocessing as mp
 import sqlite3
 
 import pytest
+from helpers.bench_databases import assert_same_shape
 from helpers.bench_standins import write_query_file
 from ompl import base as ob
 from ompl import geometric as og
@@ -142,14 +143,7 @@ def test_anytime_ladder_gives_the_database_of_separate_runs(tmp_path, robot):
         assert res.database is not None and not res.failed_tasks
         dbs[ladder] = sqlite3.connect(res.database)
 
-    def schema(con):
-        tables = [r[0] for r in con.execute("SELECT name FROM sqlite_master WHERE type IN ('table','view') ORDER BY name")]
-        return {t: [r[1] for r in con.execute(f"PRAGMA table_info({t})")] for t in tables}
-
-    assert schema(dbs[True]) == schema(dbs[False])
-    for t in ("experiments", "runs", "plannerConfigs"):
-        counts = [dbs[k].execute(f"SELECT count(*) FROM {t}").fetchone()[0] for k in (True, False)]
-        assert counts[0] == counts[1] > 0, t
+    assert_same_shape(dbs[True], dbs[False])
     assert [r[0] for r in dbs[True].execute("SELECT name FROM experiments ORDER BY name")] == \
         [r[0] for r in dbs[False].execute("SELECT name FROM experiments ORDER BY name")]
     query = ("SELECT e.time_budget, e.timelimit, p.name, r.status, r.solved, r.time, r.time <= e.time_budget + 0.01 "

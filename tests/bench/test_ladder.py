@@ -9,6 +9,7 @@ import sqlite3
 from pathlib import Path
 
 import pytest
+from helpers.bench_databases import assert_same_shape
 from helpers.bench_standins import write_query_file
 from ompl import base as ob
 from ompl import geometric as og
@@ -136,14 +137,7 @@ def test_one_run_ladders_give_the_database_of_separate_runs(tmp_path, robot):
         assert res.database is not None and not res.failed_tasks
         dbs[ladder] = sqlite3.connect(res.database)
 
-    def schema(con):
-        tables = [r[0] for r in con.execute("SELECT name FROM sqlite_master WHERE type IN ('table','view') ORDER BY name")]
-        return {t: [r[1] for r in con.execute(f"PRAGMA table_info({t})")] for t in tables}
-
-    assert schema(dbs[True]) == schema(dbs[False])
-    for t in ("experiments", "runs", "plannerConfigs"):
-        counts = [dbs[k].execute(f"SELECT count(*) FROM {t}").fetchone()[0] for k in (True, False)]
-        assert counts[0] == counts[1] > 0, t
+    assert_same_shape(dbs[True], dbs[False])
     query = ("SELECT e.sample_cap, p.name, r.iterations, r.solved, r.path_valid_dense, r.reaches_goal, r.best_cost "
              "FROM runs r JOIN experiments e ON r.experimentid = e.id JOIN plannerConfigs p ON r.plannerid = p.id "
              "ORDER BY e.sample_cap, p.name")
