@@ -33,7 +33,7 @@ from collections.abc import Callable
 import numpy as np
 from ompl import tools as ot
 
-from .ladder import CheckpointPlanner, derived_run, log_text, run_seconds, set_runs
+from .ladder import CheckpointPlanner, derive_planner_runs, log_text, run_seconds
 from .planners import PlannerContext, RecordingPlanner
 from .results import format_value
 
@@ -205,19 +205,10 @@ class AnytimeLadder:
                     total += sum(run_seconds(r.to_dict()) for r in pl.runs)
                     planners.append(pl)
                     continue
-                w, recs = self.wrappers[pname], records.get(pname, [])
                 pl = copy_planner(pl0)
-                rows, progress = [], []
-                for i, run in enumerate(pl0.runs):
-                    snap = w.snapshots[i].get(b) if i < len(w.snapshots) else None
-                    rec = recs[i] if i < len(recs) else {"props": {}, "progress": []}
-                    row, prog, props = derived_run(si, pdef, w, i, run.to_dict(), rec, snap, simplify, start, goal,
-                                                   path_properties)
-                    rows.append(row)
-                    total += run_seconds(row)
-                    progress.append(prog)
-                    extras.setdefault(pname, []).append({k.rsplit(" ", 1)[0]: v for k, v in props.items()})
-                set_runs(pl, rows, progress)
+                extras[pname], seconds = derive_planner_runs(pl0, pl, self.wrappers[pname], records.get(pname, []), b,
+                                                             si, pdef, simplify, start, goal, path_properties)
+                total += seconds
                 planners.append(pl)
             ed.planners = planners
             ed.totalDuration = total

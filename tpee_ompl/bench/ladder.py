@@ -247,18 +247,9 @@ class Ladder:
             extras, total = {}, 0.0
             for pl in ed.planners:
                 pname = _planner_name(pl.name)
-                w, recs = self.wrappers[pname], records.get(pname, [])
-                runs, progress = [], []
-                for i, run in enumerate(pl.runs):
-                    snap = w.snapshots[i].get(n) if i < len(w.snapshots) else None
-                    rec = recs[i] if i < len(recs) else {"props": {}, "progress": []}
-                    row, prog, props = derived_run(si, pdef, w, i, run.to_dict(), rec, snap, simplify, start, goal,
-                                                   path_properties)
-                    runs.append(row)
-                    total += run_seconds(row)
-                    progress.append(prog)
-                    extras.setdefault(pname, []).append({k.rsplit(" ", 1)[0]: v for k, v in props.items()})
-                set_runs(pl, runs, progress)
+                extras[pname], seconds = derive_planner_runs(pl, pl, self.wrappers[pname], records.get(pname, []), n,
+                                                             si, pdef, simplify, start, goal, path_properties)
+                total += seconds
                 pl.common["iteration_cap"] = str(n)
             ed.totalDuration = total
             out.append((log_text(bench), extras, None))
@@ -376,6 +367,22 @@ def derived_run(si, pdef, w: CheckpointPlanner, i: int, row: dict, rec: dict, sn
         prog = [p for p in rec["progress"] if p[0] <= snap["time"]]
         prog.append((snap["time"], snap["best_cost"], snap["iterations"]))
     return row, prog, props
+
+
+def derive_planner_runs(source, target, w: CheckpointPlanner, recs: list[dict], key, si, pdef, simplify: bool,
+                        start: np.ndarray, goal: np.ndarray, path_properties) -> tuple[list[dict], float]:
+    """Write into ``target`` (an ``ot.PlannerExperiment``) the runs of ``source`` as they stood at checkpoint
+    ``key`` (a cap or a budget; :func:`derived_run` per run); return the runs' extra columns and their seconds."""
+    rows, progress, extras = [], [], []
+    for i, run in enumerate(source.runs):
+        snap = w.snapshots[i].get(key) if i < len(w.snapshots) else None
+        rec = recs[i] if i < len(recs) else {"props": {}, "progress": []}
+        row, prog, props = derived_run(si, pdef, w, i, run.to_dict(), rec, snap, simplify, start, goal, path_properties)
+        rows.append(row)
+        progress.append(prog)
+        extras.append({k.rsplit(" ", 1)[0]: v for k, v in props.items()})
+    set_runs(target, rows, progress)
+    return extras, sum(run_seconds(r) for r in rows)
 
 
 def run_seconds(row: dict) -> float:

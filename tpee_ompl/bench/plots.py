@@ -68,7 +68,6 @@ def make_plots(db_path: str | Path, directory: str | Path, planner: str | None =
             fig.tight_layout()
             p = directory / f"fig15_ratios_{chk}.png"
             _save(fig, p)
-            plt.close(fig)
             out.append(p)
         for col, label, fname in (("time", "time (s)", "box_time.png"), ("solution_length", "raw path length (rad)", "box_length.png")):
             groups = defaultdict(list)
@@ -88,7 +87,6 @@ def make_plots(db_path: str | Path, directory: str | Path, planner: str | None =
             fig.tight_layout()
             p = directory / fname
             _save(fig, p)
-            plt.close(fig)
             out.append(p)
     any_runs = [r for r in runs if r["comparison"] == "anytime"]
     if any_runs:
@@ -114,7 +112,6 @@ def make_plots(db_path: str | Path, directory: str | Path, planner: str | None =
         fig.tight_layout()
         p = directory / "anytime_cost.png"
         _save(fig, p)
-        plt.close(fig)
         out.append(p)
         out.append(_within_best_plot(db_path, runs, directory, plt))
     return out
@@ -142,7 +139,6 @@ def _within_best_plot(db_path, runs: list[dict], directory: Path, plt) -> Path:
     fig.tight_layout()
     p = directory / "anytime_within_best.png"
     _save(fig, p)
-    plt.close(fig)
     return p
 
 
@@ -225,6 +221,11 @@ def _progress_median(db_path, planner: str):
 
 
 def _save(fig, path: Path) -> None:
-    """Save ``fig`` as PNG at ``path`` atomically (a temporary file, then ``os.replace``)."""
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=120, format="png")
+    """Save ``fig`` as PNG at ``path`` atomically (a temporary file, then ``os.replace``), then close it."""
+    import matplotlib.pyplot as plt
+
+    try:
+        with atomic_path(path) as tmp:
+            fig.savefig(tmp, dpi=120, format="png")
+    finally:
+        plt.close(fig)
