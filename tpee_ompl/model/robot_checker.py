@@ -19,6 +19,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..validation import as_float_array, check_bool, check_int, check_number
+from .clearance_balls import BallScreen, separated_pairs
 from .obstacles import Obstacle
 from .urdf_loading import LoadedModel, ModelFiles, bounding_radius, is_prismatic, load_urdf_model
 
@@ -141,9 +142,9 @@ class RobotChecker:
             raise ValueError(f"extra_points names unknown frame(s) {unknown}")
         self._extra_frames = tuple(self.model.getFrameId(f) for f in extra_points)
         self._prune_unreachable_pairs()
-        self._rebuild_geometry_data()
         self.lower = self.model.lowerPositionLimit.copy()
         self.upper = self.model.upperPositionLimit.copy()
+        self._rebuild_geometry_data()
         self._lower_list = self.lower.tolist()
         self._upper_list = self.upper.tolist()
         log.debug("loaded %s: %d geometries, %d pairs", files.urdf, self.gmodel.ngeoms, len(self.gmodel.collisionPairs))
@@ -212,11 +213,30 @@ class RobotChecker:
         wide = np.maximum(link_margin[:, None], link_margin[None, :])
         return np.where(moving_static, wide, self.security_margin)
 
-    def _rebuild_geometry_data(self) -> None:
-        self.gdata = pin.GeometryData(self.gmodel)
-        self.gdata.setSecurityMargins(self.gmodel, self._margin_matrix())
-        for req in self.gdata.collisionRequests:
+    def new_check_data(self) -> pin.GeometryData:
+        """A fresh ``GeometryData`` set up as the checks use it: per-pair margins, contacts enabled, and
+        the pairs proven separated (:attr:`separated_pairs`) not checked."""
+        gdata = pin.GeometryData(self.gmodel)
+        gdata.setSecurityMargins(self.gmodel, self._margin_matrix())
+        for req in gdata.collisionRequests:
             req.enable_contact = True  # Coal misses edge/corner contacts otherwise
+        for p in self.separated_pairs:
+            gdata.deactivateCollisionPair(p)
+        return gdata
+
+    def ball_screen(self) -> BallScreen:
+        """The robot's :class:`~tpee_ompl.model.clearance_balls.BallScreen` (built on first use)."""
+        if self._ball_screen is None:
+            self._ball_screen = BallScreen(self)
+        return self._ball_screen
+
+    def _rebuild_geometry_data(self) -> None:
+        self._ball_screen: BallScreen | None = None
+        self.separated_pairs = tuple(separated_pairs(self))
+        """Pairs (``gmodel.collisionPairs`` indices) proven never within their margin, so not checked
+        (:func:`~tpee_ompl.model.clearance_balls.separated_pairs`); :meth:`clearance` still measures them."""
+        self.gdata = self.new_check_data()
+        self._distance_data = pin.GeometryData(self.gmodel)
         self.pool = pin.GeometryPool(self.model, self.gmodel, self.n_threads)
         self.pool.update(self.gdata)
 
@@ -441,13 +461,13 @@ class RobotChecker:
     def clearance(self, q: np.ndarray) -> float:
         """Smallest distance (m, negative when penetrating) over all checked pairs at q."""
         q = self.check_config(q)
-        k = pin.computeDistances(self.model, self.data, self.gmodel, self.gdata, q)
-        return float(self.gdata.distanceResults[k].min_distance)
+        k = pin.computeDistances(self.model, self.data, self.gmodel, self._distance_data, q)
+        return float(self._distance_data.distanceResults[k].min_distance)
 
     def closest_pair(self, q: np.ndarray) -> tuple[str, str, float]:
         """The two geometry names of the closest checked pair at q, and their distance (m)."""
         q = self.check_config(q)
-        k = pin.computeDistances(self.model, self.data, self.gmodel, self.gdata, q)
+        k = pin.computeDistances(self.model, self.data, self.gmodel, self._distance_data, q)
         cp = self.gmodel.collisionPairs[k]
         names = self.gmodel.geometryObjects
-        return names[cp.first].name, names[cp.second].name, float(self.gdata.distanceResults[k].min_distance)
+        return names[cp.first].name, names[cp.second].name, float(self._distance_data.distanceResults[k].min_distance)

@@ -23,6 +23,7 @@ import numpy as np
 from ompl import base as ob
 from ompl import geometric as og
 
+from ..model.clearance_balls import SCREEN_LEVELS, screened_all_valid
 from ..model.robot_checker import RobotChecker
 from ..validation import check_number
 from .paths import MIN_JOINT_STEP, motion_states, set_state, state_to_array
@@ -69,15 +70,21 @@ WearerValidityChecker = RobotValidityChecker
 
 
 class BatchedMotionValidator(ob.MotionValidator):
-    """Checks a whole straight motion with one batched Pinocchio call.
+    """Checks a whole straight motion with batched Pinocchio calls.
 
-    Same states as OMPL's ``DiscreteMotionValidator`` at the same resolution, so results agree;
-    native planners call it through ``si.checkMotion``.  Like that validator it honours the
-    space's ``validSegmentCountFactor``: OMPL's Benchmark sets it to 4 for its
+    The verdict is that of OMPL's ``DiscreteMotionValidator`` at the same resolution (every state a
+    step apart valid); native planners call it through ``si.checkMotion``.  Like that validator it
+    honours the space's ``validSegmentCountFactor``: OMPL's Benchmark sets it to 4 for its
     ``correct_solution_strict`` column, which then really checks 4x more densely.
+
+    By default the states are screened first (``screen_levels``,
+    :func:`~tpee_ompl.model.clearance_balls.screened_all_valid`): one state checked at margins
+    inflated for a ball of a few steps certifies its neighbours, and only states no ball covers are
+    checked one by one; the verdict is the same.  ``screen_levels=()`` checks every state.
     """
 
-    def __init__(self, si: ob.SpaceInformation, robot: RobotChecker, step: float) -> None:
+    def __init__(self, si: ob.SpaceInformation, robot: RobotChecker, step: float,
+                 screen_levels: Sequence[float] = SCREEN_LEVELS) -> None:
         super().__init__(si)
         self.robot = robot
         self.step = float(step)
@@ -85,6 +92,8 @@ class BatchedMotionValidator(ob.MotionValidator):
         self._space = si.getStateSpace()
         self._n = robot.nq
         self.motions_checked = 0
+        self.screen_levels = tuple(check_number("screen_levels (motion-check steps)", h, low=0.5, high=1e3)
+                                   for h in screen_levels)
 
     def effective_step(self) -> float:
         """Step (radians) between checked states now: ``step / validSegmentCountFactor``."""
@@ -94,16 +103,22 @@ class BatchedMotionValidator(ob.MotionValidator):
         """True if every state along s1 -> s2 (excluding s1) is valid."""
         a, b = state_to_array(s1, self._n), state_to_array(s2, self._n)
         self.motions_checked += 1
-        return bool(self.robot.are_valid(motion_states(a, b, self.effective_step())).all())
+        return bool(self.all_valid([motion_states(a, b, self.effective_step())])[0])
 
     def check_motions(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
-        """Validity of many motions A[k] -> B[k] (each excluding its start), one batched call."""
+        """Validity of many motions A[k] -> B[k] (each excluding its start), batched together."""
         A, B = np.atleast_2d(A), np.atleast_2d(B)
         step = self.effective_step()
         chunks = [motion_states(a, b, step) for a, b in zip(A, B)]
         self.motions_checked += len(chunks)
+        return self.all_valid(chunks)
+
+    def all_valid(self, chunks: list[np.ndarray]) -> np.ndarray:
+        """Per chunk of evenly spaced states along a line (a motion's dense states), True iff all are valid."""
         if not chunks:
             return np.zeros(0, dtype=bool)
+        if self.screen_levels:
+            return screened_all_valid(self.robot, self.robot.ball_screen(), chunks, self.step, self.screen_levels)
         ok = self.robot.are_valid(np.concatenate(chunks))
         bounds = np.cumsum([0] + [len(c) for c in chunks])
         return np.array([ok[bounds[k] : bounds[k + 1]].all() for k in range(len(chunks))], dtype=bool)

@@ -1,0 +1,165 @@
+"""Clearance balls (tpee_ompl.model.clearance_balls): pairs proven apart and screened motion checks change
+no verdict, only the number of states checked."""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from ompl import base as ob
+from ompl import geometric as og
+from ompl import util as ou
+
+from tests.helpers.panda import needs_panda
+from tpee_ompl.model.clearance_balls import screened_all_valid
+from tpee_ompl.model.queries import load_queries
+from tpee_ompl.planning.paths import motion_states, state_to_array
+from tpee_ompl.planning.setup import BatchedMotionValidator, make_simple_setup
+
+
+@pytest.fixture(scope="module")
+def panda():
+    from tpee_ompl.model.robots import panda_shelf
+
+    return panda_shelf()
+
+
+def _all_pairs_collide(robot, Q: np.ndarray) -> np.ndarray:
+    """Collision (margins, contacts) of every pair the model has, none skipped: the unpruned check."""
+    gd = pin.GeometryData(robot.gmodel)
+    gd.setSecurityMargins(robot.gmodel, robot._margin_matrix())
+    for req in gd.collisionRequests:
+        req.enable_contact = True
+    data = robot.model.createData()
+    return np.array([pin.computeCollisions(robot.model, data, robot.gmodel, gd, q, True) for q in Q])
+
+
+def _uniform(robot, n: int, seed: int) -> np.ndarray:
+    return np.random.default_rng(seed).uniform(robot.lower, robot.upper, (n, robot.nq))
+
+
+def _check_separated(robot, n: int) -> None:
+    Q = _uniform(robot, n, 5)
+    gd = pin.GeometryData(robot.gmodel)
+    data = robot.model.createData()
+    margins = robot.pair_margins()
+    pairs = list(robot.separated_pairs)
+    assert pairs
+    for q in Q:
+        pin.computeDistances(robot.model, data, robot.gmodel, gd, q)
+        assert all(gd.distanceResults[p].min_distance >= margins[p] for p in pairs)
+    np.testing.assert_array_equal(robot.are_valid(Q), ~_all_pairs_collide(robot, Q))
+
+
+def test_wearer_pairs_proven_apart_never_come_within_their_margin_and_change_no_verdict(robot):
+    _check_separated(robot, 1500)
+    names = robot.gmodel.geometryObjects
+    separated = {frozenset((names[robot.gmodel.collisionPairs[p].first].name,
+                            names[robot.gmodel.collisionPairs[p].second].name)) for p in robot.separated_pairs}
+    # the boom and the barrel under the tilt joint: 3.5 cm apart at the closest, the margin is 2 cm
+    assert frozenset(("link2_1", "link4_0")) in separated
+
+
+@needs_panda
+def test_panda_pairs_proven_apart_never_come_within_their_margin_and_change_no_verdict(panda):
+    _check_separated(panda, 1500)
+
+
+def test_clearance_still_measures_the_pairs_that_are_not_checked(robot):
+    q = load_queries("planning_necessary", robot)[0].start
+    gd = pin.GeometryData(robot.gmodel)
+    k = pin.computeDistances(robot.model, robot.model.createData(), robot.gmodel, gd, q)
+    assert robot.clearance(q) == pytest.approx(gd.distanceResults[k].min_distance)
+
+
+def test_a_state_clear_at_a_radius_keeps_its_whole_ball_valid(robot):
+    rng = np.random.default_rng(8)
+    radius = 2 * robot.max_joint_step()
+    C = _uniform(robot, 400, 9)
+    clear = robot.ball_screen().clear(C, radius)
+    assert 0 < clear.sum() < len(C)
+    for c in C[clear]:
+        D = rng.normal(size=(20, robot.nq))
+        D *= (radius * rng.uniform(0, 1, (20, 1)) ** (1 / robot.nq)) / np.linalg.norm(D, axis=1)[:, None]
+        ball = c + D
+        ball = ball[np.all((ball >= robot.lower) & (ball <= robot.upper), axis=1)]
+        assert robot.are_valid(ball).all()
+
+
+def _random_motions(robot, n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    rng = np.random.default_rng(seed)
+    A = _uniform(robot, 3 * n, seed)
+    A = A[robot.are_valid(A)][:n]
+    D = rng.normal(size=A.shape)
+    D /= np.linalg.norm(D, axis=1)[:, None]
+    return A, A + D * rng.uniform(0.005, 1.0, (len(A), 1))  # some leave the joint limits
+
+
+def _check_screened_verdicts(robot, n: int, seed: int) -> None:
+    screen, step = robot.ball_screen(), robot.max_joint_step()
+    A, B = _random_motions(robot, n, seed)
+    for s in (step, step / 4):  # OMPL Benchmark's strict re-check: 4x denser
+        chunks = [motion_states(a, b, s) for a, b in zip(A, B)]
+        c0 = robot.collision_checks
+        dense = np.array([robot.are_valid(c).all() for c in chunks])
+        c1 = robot.collision_checks
+        one_by_one = np.array([screened_all_valid(robot, screen, [c], step)[0] for c in chunks])
+        c2 = robot.collision_checks
+        together = screened_all_valid(robot, screen, chunks, step)
+        np.testing.assert_array_equal(one_by_one, dense)
+        np.testing.assert_array_equal(together, dense)
+        assert 0 < dense.sum() < len(dense)
+        assert c2 - c1 < 0.8 * (c1 - c0)
+
+
+@pytest.mark.parametrize("n", [300, pytest.param(3000, marks=pytest.mark.slow)])
+def test_screened_wearer_motions_get_the_dense_verdict_with_fewer_checks(robot, n):
+    _check_screened_verdicts(robot, n, 31)
+
+
+@needs_panda
+@pytest.mark.parametrize("n", [300, pytest.param(3000, marks=pytest.mark.slow)])
+def test_screened_panda_motions_get_the_dense_verdict_with_fewer_checks(panda, n):
+    _check_screened_verdicts(panda, n, 32)
+
+
+def test_a_motion_leaving_the_joint_limits_is_invalid_without_a_check(robot):
+    a = (robot.lower + robot.upper) / 2
+    b = a.copy()
+    b[0] = robot.upper[0] + 0.1
+    c0 = robot.collision_checks
+    assert not screened_all_valid(robot, robot.ball_screen(), [motion_states(a, b, robot.max_joint_step())],
+                                  robot.max_joint_step())[0]
+    assert robot.collision_checks == c0
+
+
+class _RecordingValidator(BatchedMotionValidator):
+    """The default validator, keeping every motion a planner asked about and its verdict."""
+
+    def __init__(self, si, robot, step) -> None:
+        super().__init__(si, robot, step)
+        self.seen: list[tuple[np.ndarray, np.ndarray, bool]] = []
+
+    def checkMotion(self, s1, s2) -> bool:  # noqa: N802 (OMPL override)
+        ok = super().checkMotion(s1, s2)
+        self.seen.append((state_to_array(s1, self._n), state_to_array(s2, self._n), ok))
+        return ok
+
+
+@pytest.mark.slow
+def test_every_motion_rrtstar_asks_about_gets_the_dense_verdict(robot):
+    ou.setLogLevel(ou.LOG_ERROR)
+    q = load_queries("planning_necessary", robot)[0]
+    ss = make_simple_setup(robot, q.start, q.goal)
+    si = ss.getSpaceInformation()
+    step = si.getMotionValidator().step
+    recorder = _RecordingValidator(si, robot, step)
+    si.setMotionValidator(recorder)
+    planner = og.RRTstar(si)
+    ss.setPlanner(planner)
+    ss.setup()
+    ss.solve(ob.PlannerTerminationCondition(lambda: planner.numIterations() >= 300))
+    verdicts = np.array([ok for _, _, ok in recorder.seen])
+    dense = np.array([robot.are_valid(motion_states(a, b, step)).all() for a, b, _ in recorder.seen])
+    assert len(verdicts) > 300 and 0 < verdicts.sum() < len(verdicts)
+    np.testing.assert_array_equal(verdicts, dense)

@@ -1,0 +1,221 @@
+"""Clearance balls with boolean checks: prove pairs apart for good, and certify joint-space balls with
+one batched collision call at inflated margins.
+
+A pair's distance changes at most ``sum_i |dq_i| R[p, i] <= ||dq|| ||R[p]||`` along a joint step dq
+(:meth:`RobotChecker.pair_lever_arms`).  Two uses of that bound, both exact (no answer of the checker
+changes, only its cost):
+
+* :func:`separated_pairs`: a pair whose two bodies have at most one joint between them has a distance
+  that is a function of that joint alone; sampled over the joint's whole range densely enough, its
+  lower bound above the margin proves the pair never collides, so it need not be checked (the
+  wearer's first link spinning about its own axis, its boom and barrel under the tilt joint).
+* :class:`BallScreen`: a state that passes the collision check with every pair's margin raised by
+  ``radius * ||R[p]||`` keeps every pair at least its own margin apart at *every* state within
+  ``radius`` of it (Euclidean, joint space).  A motion's dense states near such a state need no check
+  of their own (:func:`screened_all_valid`).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+import numpy as np
+import pinocchio as pin
+
+if TYPE_CHECKING:
+    from .robot_checker import RobotChecker
+
+__all__ = ["BallScreen", "SCREEN_LEVELS", "separated_pairs", "screened_all_valid"]
+
+SEPARATION_TOLERANCE = 1e-5
+"""Metres taken off every Coal distance (and added to every inflated margin) before it proves anything."""
+SEPARATION_SAMPLE_GAP = 0.001
+"""Metres: the grid over a joint's range is fine enough that the lever bound between samples is this."""
+MAX_SEPARATION_SAMPLES = 20000
+SCREEN_LEVELS = (2.0, 1.0)
+"""Ball radii tried in turn, in motion-check steps: states 2 steps (then 1 step) either side are
+certified by one state checked at the inflated margins; what no ball covers is checked densely.
+Measured on RRT* motions of the wearer and the Panda (``experiments/screened_motions.py``)."""
+
+
+def separated_pairs(robot: RobotChecker) -> list[int]:
+    """Indices (``gmodel.collisionPairs`` order) of pairs proven never closer than their margin.
+
+    Only pairs with no joint between their bodies (one distance decides) or one bounded joint (the
+    distance over a grid of its range, minus the lever bound between grid points) are tried.
+    """
+    R, margins = robot.pair_lever_arms(), robot.pair_margins()
+    model, gmodel = robot.model, robot.gmodel
+    data, gd = model.createData(), pin.GeometryData(gmodel)
+    gd.deactivateAllCollisionPairs()
+    q0 = pin.neutral(model)
+    out = []
+    for p in range(len(R)):
+        joints = np.flatnonzero(R[p])
+        if len(joints) > 1:
+            continue
+        if len(joints) == 0:
+            grid, gap = q0[None, :], 0.0
+        else:
+            j = int(joints[0])
+            lo, hi = float(robot.lower[j]), float(robot.upper[j])
+            if not (math.isfinite(lo) and math.isfinite(hi)) or hi <= lo:
+                continue
+            n = int(math.ceil(R[p, j] * (hi - lo) / (2 * SEPARATION_SAMPLE_GAP))) + 1
+            if n > MAX_SEPARATION_SAMPLES:
+                continue
+            values = np.linspace(lo, hi, max(n, 2))
+            grid = np.repeat(q0[None, :], len(values), axis=0)
+            grid[:, j] = values
+            gap = R[p, j] * (values[1] - values[0]) / 2
+        gd.activateCollisionPair(p)
+        lowest = math.inf
+        for q in grid:
+            pin.computeDistances(model, data, gmodel, gd, q)
+            lowest = min(lowest, gd.distanceResults[p].min_distance)
+        gd.deactivateCollisionPair(p)
+        if lowest - gap - SEPARATION_TOLERANCE >= margins[p]:
+            out.append(p)
+    return out
+
+
+class BallScreen:
+    """Batched checks at margins inflated for a joint-space radius (module docstring).
+
+    ``clear(Q, radius)[k]`` True proves every state within ``radius`` (rad, Euclidean) of Q[k] valid
+    (every checked pair at least its margin apart); False proves nothing.  One Pinocchio pool per
+    radius, built on first use; pairs the robot does not check stay unchecked.
+    """
+
+    def __init__(self, robot: RobotChecker) -> None:
+        self.robot = robot
+        R = robot.pair_lever_arms()
+        self._lever_norms = np.linalg.norm(R, axis=1)
+        checked = np.ones(len(R), dtype=bool)
+        checked[list(robot.separated_pairs)] = False
+        checked &= self._lever_norms > 0
+        self._R, self._norms = R[checked], self._lever_norms[checked]
+        self._pools: dict[float, pin.GeometryPool] = {}
+
+    def reach(self, direction: np.ndarray) -> float:
+        """How far along ``direction`` (any non-zero joint vector) a ball of radius 1 reaches, >= 1.
+
+        A pool inflates pair p by ``radius * ||R[p]||``; along a unit direction u the pair's distance
+        changes at most ``R[p] . |u|`` per radian, so the certified stretch is ``radius * min_p
+        ||R[p]|| / (R[p] . |u|)`` either side."""
+        u = np.abs(np.asarray(direction, dtype=float))
+        norm = math.sqrt(float(u @ u))
+        if not len(self._R) or norm == 0:
+            return 1.0
+        speeds = self._R @ (u / norm)
+        moving = speeds > 0
+        return max(1.0, float(np.min(self._norms[moving] / speeds[moving]))) if moving.any() else 1.0
+
+    def _pool(self, radius: float) -> pin.GeometryPool:
+        pool = self._pools.get(radius)
+        if pool is None:
+            robot = self.robot
+            gd = robot.new_check_data()
+            for k, req in enumerate(gd.collisionRequests):
+                req.security_margin += radius * self._lever_norms[k] + SEPARATION_TOLERANCE
+            pool = pin.GeometryPool(robot.model, robot.gmodel, robot.n_threads)
+            pool.update(gd)
+            self._pools[radius] = pool
+        return pool
+
+    def clear(self, Q: np.ndarray, radius: float) -> np.ndarray:
+        """bool (N,): True where every state within ``radius`` of Q[k] is collision-free with the margins
+        (joint limits are the caller's to check)."""
+        Q = np.asarray(Q, dtype=float)
+        if len(Q) == 0:
+            return np.zeros(0, dtype=bool)
+        self.robot.collision_checks += len(Q)
+        hits = pin.computeCollisionsInParallel(self.robot.n_threads, self._pool(float(radius)),
+                                               np.ascontiguousarray(Q.T), True, False)
+        return ~np.asarray(hits, dtype=bool)
+
+
+def screened_all_valid(robot: RobotChecker, screen: BallScreen, chunks: list[np.ndarray], step: float,
+                       levels: tuple[float, ...] = SCREEN_LEVELS) -> np.ndarray:
+    """Per chunk (the dense states of one straight motion, evenly spaced along it), True iff every
+    state of it is valid: the same answer as ``robot.are_valid(chunk).all()``, with fewer checks.
+
+    For each level h the states not yet covered are cut, run by run of consecutive states, into blocks
+    of at most 2H+1 (H: how many states h*``step`` spans); each block's middle state is checked at
+    :meth:`BallScreen.clear` radius h*``step``, and where it passes the whole block is covered.  One
+    batched call per level over all chunks; the states left go to one dense ``robot.are_valid`` call.
+    A chunk with a state outside the joint limits is invalid at once (as in ``are_valid``); the others
+    lie inside, so the states a ball covers do too.
+    """
+    K = len(chunks)
+    if K == 0:
+        return np.zeros(0, dtype=bool)
+    if K == 1:
+        return np.array([_one_motion_valid(robot, screen, np.asarray(chunks[0], dtype=float), step, levels)])
+    sizes = np.array([len(c) for c in chunks])
+    S = np.concatenate(chunks)
+    cid = np.repeat(np.arange(K), sizes)
+    inside = np.bincount(cid[~np.all((S >= robot.lower) & (S <= robot.upper), axis=1)], minlength=K) == 0
+    spacing = np.array([float(np.linalg.norm(c[1] - c[0])) / screen.reach(c[1] - c[0]) if len(c) > 1 else 0.0
+                        for c in chunks])
+    todo = _screen(screen, S, cid, spacing, np.flatnonzero(inside[cid]), step, levels)
+    if not len(todo):
+        return inside
+    bad = ~robot.are_valid(S[todo])
+    return inside & (np.bincount(cid[todo][bad], minlength=K) == 0)
+
+
+def _screen(screen: BallScreen, S: np.ndarray, cid: np.ndarray, spacing: np.ndarray, todo: np.ndarray,
+            step: float, levels: tuple[float, ...]) -> np.ndarray:
+    """The indices of ``todo`` (into S, sorted) that no ball of the levels covers (see :func:`screened_all_valid`).
+
+    ``spacing[k]``: chunk k's distance between consecutive states divided by :meth:`BallScreen.reach` of
+    its direction, so a ball of radius r covers the states within r / spacing steps."""
+    for h in levels:
+        if len(todo) < 3:
+            break
+        radius = h * step
+        with np.errstate(divide="ignore"):
+            H = np.floor(radius / spacing * (1 + 1e-12))
+        H = np.where(np.isfinite(H), H, 0).astype(np.int64)[cid[todo]]
+        n = len(todo)
+        new_run = np.ones(n, dtype=bool)
+        new_run[1:] = (np.diff(todo) != 1) | (np.diff(cid[todo]) != 0)
+        run_start = np.maximum.accumulate(np.where(new_run, np.arange(n), 0))
+        block = (np.arange(n) - run_start) // (2 * H + 1)
+        new_block = new_run.copy()
+        new_block[1:] |= block[1:] != block[:-1]
+        starts = np.flatnonzero(new_block)
+        lengths = np.diff(np.append(starts, n))
+        use = (lengths >= 3) & (H[starts] >= 1)
+        if not use.any():
+            continue
+        passed = np.zeros(len(starts), dtype=bool)
+        passed[use] = screen.clear(S[todo[starts[use] + (lengths[use] - 1) // 2]], radius)
+        todo = todo[~np.repeat(passed, lengths)]
+    return todo
+
+
+def _one_motion_valid(robot: RobotChecker, screen: BallScreen, S: np.ndarray, step: float,
+                      levels: tuple[float, ...]) -> bool:
+    """:func:`screened_all_valid` for one chunk (``si.checkMotion``'s case), with less numpy overhead
+    on the first level, where every state is still to cover."""
+    n = len(S)
+    if not ((S >= robot.lower).all() and (S <= robot.upper).all()):
+        return False
+    d = S[1] - S[0] if n > 1 else S[0]
+    spacing = math.sqrt(float(d @ d)) / screen.reach(d) if n > 1 else 0.0  # in units the balls reach
+    for k, h in enumerate(levels):
+        H = int(math.floor(h * step / spacing * (1 + 1e-12))) if spacing > 0 else 0
+        if H < 1 or n < 3:
+            continue
+        starts = np.arange(0, n, 2 * H + 1)
+        lengths = np.minimum(2 * H + 1, n - starts)
+        passed = screen.clear(S[starts + (lengths - 1) // 2], h * step)
+        if passed.all():
+            return True
+        todo = _screen(screen, S, np.zeros(n, dtype=np.int64), np.array([spacing]),
+                       np.flatnonzero(~np.repeat(passed, lengths)), step, levels[k + 1 :])
+        return bool(robot.are_valid(S[todo]).all()) if len(todo) else True
+    return bool(robot.are_valid(S).all())
