@@ -7,7 +7,8 @@ in from both ends, at each state take the longest step along the segment that ke
 least its security margin m_p, and repeat until the two fronts meet.  Pairs are grouped by the
 joints between their bodies (and their margin), each group with its own lever bound and one
 Pinocchio ``computeDistances`` call over its pairs only; a pair whose distance cannot change
-(no joint between its bodies) is checked once at construction and then skipped.
+(no joint between its bodies) is checked once at construction and then skipped, and the pairs the
+robot proved never within their margin (``robot.separated_pairs``) are left out.
 
 Guarantee (stronger than the dense check's): **every** state of a certified motion, not only the
 states a joint step apart, keeps every checked pair at least its margin apart, so a dense re-check at
@@ -77,7 +78,10 @@ class ClearanceGroups:
         self._data = robot.model.createData()
         keys: dict[tuple, list[int]] = {}
         constant = []
+        separated = set(robot.separated_pairs)  # proven never within their margin: nothing to certify
         for p in range(len(R)):
+            if p in separated:
+                continue
             if not R[p].any():
                 constant.append(p)
                 continue
