@@ -141,81 +141,54 @@ def screened_all_valid(robot: RobotChecker, screen: BallScreen, chunks: list[np.
     """Per chunk (the dense states of one straight motion, evenly spaced along it), True iff every
     state of it is valid: the same answer as ``robot.are_valid(chunk).all()``, with fewer checks.
 
-    For each level h the states not yet covered are cut, run by run of consecutive states, into blocks
-    of at most 2H+1 (H: how many states h*``step`` spans); each block's middle state is checked at
-    :meth:`BallScreen.clear` radius h*``step``, and where it passes the whole block is covered.  One
-    batched call per level over all chunks; the states left go to one dense ``robot.are_valid`` call.
-    A chunk with a state outside the joint limits is invalid at once (as in ``are_valid``); the others
-    lie inside, so the states a ball covers do too.
+    Each chunk starts as one block of states to cover.  At each level h, every block is cut into
+    blocks of at most 2H+1 consecutive states (H: how many states a ball of radius h*``step`` reaches
+    either side, :meth:`BallScreen.reach` of the motion's direction included); the middle state of
+    each block of 3 or more is checked by :meth:`BallScreen.clear`, and a block whose middle passes is
+    covered.  One batched call per level over all chunks; the states left go to one dense
+    ``robot.are_valid`` call.  A chunk with a state outside the joint limits is invalid at once (as in
+    ``are_valid``); the others lie inside, so the states a ball covers do too.
     """
     K = len(chunks)
     if K == 0:
         return np.zeros(0, dtype=bool)
+    sizes = np.array([len(c) for c in chunks], dtype=np.int64)
+    S = np.concatenate(chunks) if K > 1 else np.asarray(chunks[0], dtype=float)
+    offsets = np.cumsum(sizes) - sizes
+    limits_ok = np.all((S >= robot.lower) & (S <= robot.upper), axis=1)
     if K == 1:
-        return np.array([_one_motion_valid(robot, screen, np.asarray(chunks[0], dtype=float), step, levels)])
-    sizes = np.array([len(c) for c in chunks])
-    S = np.concatenate(chunks)
-    cid = np.repeat(np.arange(K), sizes)
-    inside = np.bincount(cid[~np.all((S >= robot.lower) & (S <= robot.upper), axis=1)], minlength=K) == 0
-    spacing = np.array([float(np.linalg.norm(c[1] - c[0])) / screen.reach(c[1] - c[0]) if len(c) > 1 else 0.0
-                        for c in chunks])
-    todo = _screen(screen, S, cid, spacing, np.flatnonzero(inside[cid]), step, levels)
-    if not len(todo):
-        return inside
-    bad = ~robot.are_valid(S[todo])
-    return inside & (np.bincount(cid[todo][bad], minlength=K) == 0)
-
-
-def _screen(screen: BallScreen, S: np.ndarray, cid: np.ndarray, spacing: np.ndarray, todo: np.ndarray,
-            step: float, levels: tuple[float, ...]) -> np.ndarray:
-    """The indices of ``todo`` (into S, sorted) that no ball of the levels covers (see :func:`screened_all_valid`).
-
-    ``spacing[k]``: chunk k's distance between consecutive states divided by :meth:`BallScreen.reach` of
-    its direction, so a ball of radius r covers the states within r / spacing steps."""
+        inside = np.array([bool(limits_ok.all())])
+    else:
+        inside = np.bincount(np.repeat(np.arange(K), sizes)[~limits_ok], minlength=K) == 0
+    spacing = np.zeros(K)
+    for k, c in enumerate(chunks):
+        if len(c) > 1:
+            d = c[1] - c[0]
+            spacing[k] = math.sqrt(float(d @ d)) / screen.reach(d)  # in units the balls reach
+    live = np.flatnonzero(inside & (sizes > 0))
+    starts, lengths, owner = offsets[live], sizes[live], live
     for h in levels:
-        if len(todo) < 3:
+        if not len(starts):
             break
         radius = h * step
-        with np.errstate(divide="ignore"):
-            H = np.floor(radius / spacing * (1 + 1e-12))
-        H = np.where(np.isfinite(H), H, 0).astype(np.int64)[cid[todo]]
-        n = len(todo)
-        new_run = np.ones(n, dtype=bool)
-        new_run[1:] = (np.diff(todo) != 1) | (np.diff(cid[todo]) != 0)
-        run_start = np.maximum.accumulate(np.where(new_run, np.arange(n), 0))
-        block = (np.arange(n) - run_start) // (2 * H + 1)
-        new_block = new_run.copy()
-        new_block[1:] |= block[1:] != block[:-1]
-        starts = np.flatnonzero(new_block)
-        lengths = np.diff(np.append(starts, n))
-        use = (lengths >= 3) & (H[starts] >= 1)
-        if not use.any():
-            continue
-        passed = np.zeros(len(starts), dtype=bool)
-        passed[use] = screen.clear(S[todo[starts[use] + (lengths[use] - 1) // 2]], radius)
-        todo = todo[~np.repeat(passed, lengths)]
-    return todo
-
-
-def _one_motion_valid(robot: RobotChecker, screen: BallScreen, S: np.ndarray, step: float,
-                      levels: tuple[float, ...]) -> bool:
-    """:func:`screened_all_valid` for one chunk (``si.checkMotion``'s case), with less numpy overhead
-    on the first level, where every state is still to cover."""
-    n = len(S)
-    if not ((S >= robot.lower).all() and (S <= robot.upper).all()):
-        return False
-    d = S[1] - S[0] if n > 1 else S[0]
-    spacing = math.sqrt(float(d @ d)) / screen.reach(d) if n > 1 else 0.0  # in units the balls reach
-    for k, h in enumerate(levels):
-        H = int(math.floor(h * step / spacing * (1 + 1e-12))) if spacing > 0 else 0
-        if H < 1 or n < 3:
-            continue
-        starts = np.arange(0, n, 2 * H + 1)
-        lengths = np.minimum(2 * H + 1, n - starts)
-        passed = screen.clear(S[starts + (lengths - 1) // 2], h * step)
-        if passed.all():
-            return True
-        todo = _screen(screen, S, np.zeros(n, dtype=np.int64), np.array([spacing]),
-                       np.flatnonzero(~np.repeat(passed, lengths)), step, levels[k + 1 :])
-        return bool(robot.are_valid(S[todo]).all()) if len(todo) else True
-    return bool(robot.are_valid(S).all())
+        sp = spacing[owner]
+        H = np.zeros(len(sp), dtype=np.int64)
+        H[sp > 0] = np.floor(radius / sp[sp > 0] * (1 + 1e-12))
+        width = np.where(H >= 1, 2 * H + 1, lengths)
+        pieces = -(-lengths // width)
+        block = np.repeat(np.arange(len(starts)), pieces)
+        k = np.arange(len(block)) - np.repeat(np.cumsum(pieces) - pieces, pieces)
+        sub_start = starts[block] + k * width[block]
+        sub_len = np.minimum(width[block], starts[block] + lengths[block] - sub_start)
+        use = (sub_len >= 3) & (H[block] >= 1)
+        passed = np.zeros(len(block), dtype=bool)
+        if use.any():
+            passed[use] = screen.clear(S[sub_start[use] + (sub_len[use] - 1) // 2], radius)
+        starts, lengths, owner = sub_start[~passed], sub_len[~passed], owner[block[~passed]]
+    out = inside.copy()
+    if len(starts):
+        idx = np.repeat(starts - (np.cumsum(lengths) - lengths), lengths) + np.arange(int(lengths.sum()))
+        bad = ~robot.are_valid(S[idx])
+        if bad.any():
+            out[np.unique(np.repeat(owner, lengths)[bad])] = False
+    return out

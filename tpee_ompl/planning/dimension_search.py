@@ -61,6 +61,9 @@ class Checker:
                 self.euclid = layout.is_plain
         self.batched = self.step is not None
         self._are_valid = are_valid if self.batched else None
+        all_valid = getattr(mv, "all_valid", None)
+        # the project's validator screens a motion's evenly spaced states (straight lines only: no SO2 wrap)
+        self._all_valid = all_valid if self.batched and callable(all_valid) and layout.is_plain else None
         if self.step is None:  # only for the coarse screening of motions (si.checkMotion decides)
             factor = max(1, int(si.getStateSpace().getValidSegmentCountFactor()))
             self._coarse_step = float(si.getStateSpace().getLongestValidSegmentLength()) / factor
@@ -160,6 +163,13 @@ class Checker:
             goL &= both | ~strict
             goR &= both | ~strict
             # pass 2: the remaining interior states of motions still in question
+            if self._all_valid is not None:  # screened by the motion validator: the same verdicts
+                bL, bR = np.searchsorted(iL, np.arange(m + 1)), np.searchsorted(iR, np.arange(m + 1))
+                kL, kR = np.flatnonzero(goL), np.flatnonzero(goR)
+                ok2 = self._all_valid([SL[bL[k] : bL[k + 1]] for k in kL] + [SR[bR[k] : bR[k + 1]] for k in kR])
+                left, right = goL.copy(), goR.copy()
+                left[kL], right[kR] = ok2[: len(kL)], ok2[len(kL) :]
+                return vc, left, right
             fL, fR = ~cL & goL[iL], ~cR & goR[iR]
             ok2 = self.states(np.concatenate([SL[fL], SR[fR]]))
             nl2 = int(fL.sum())
