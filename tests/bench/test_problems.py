@@ -101,6 +101,14 @@ def test_robot_problems_run_the_certified_validator_only_when_asked():
     assert type(ss.getSpaceInformation().getMotionValidator()).__name__ == "CertifiedMotionValidator"
 
 
+def test_robot_problems_run_the_unscreened_batched_validator_as_dense():
+    query = get_problem("wearer").queries()[1][0]
+    screened = get_problem("wearer").make_setup(query, "batched")[0].getSpaceInformation().getMotionValidator()
+    dense = get_problem("wearer").make_setup(query, "dense")[0].getSpaceInformation().getMotionValidator()
+    assert screened.screen_levels and dense.screen_levels == ()
+    assert CampaignConfig(checkers=("batched", "dense")).checkers == ("batched", "dense")
+
+
 def test_configuration_refuses_what_a_problem_cannot_run():
     with pytest.raises(ValueError, match="checkers: problem arm4 has no 'batched'"):
         CampaignConfig(problem="arm4", anytime_planners=("RRTConnect",))

@@ -139,7 +139,7 @@ def test_check_motion_and_check_motions_agree_and_count(robot):
 
 def test_bad_validator_settings_raise_naming_the_setting(robot):
     with pytest.raises(ValueError, match="motion_validator"):
-        make_simple_setup(robot, motion_validator="dense")
+        make_simple_setup(robot, motion_validator="sparse")
     with pytest.raises(ValueError, match="contradicts"):
         make_simple_setup(robot, batched_motion_validator=False, motion_validator="certified")
     with pytest.raises(ValueError, match="certified_options"):

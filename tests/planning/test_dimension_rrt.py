@@ -105,6 +105,20 @@ def test_batched_and_per_state_checks_agree(robot: WearerArm) -> None:
     np.testing.assert_array_equal(path_to_array(a, 4), path_to_array(b, 4))
 
 
+def test_screened_motion_checks_give_the_same_path_with_fewer_checks(robot: WearerArm) -> None:
+    q0, q1 = cross_sector_query(robot, 2, 3, np.random.default_rng(3))
+    out = []
+    for levels in ((2.0, 1.0), ()):
+        ss = make_simple_setup(robot, q0, q1)
+        ss.getSpaceInformation().getMotionValidator().screen_levels = levels
+        ss.setPlanner(tpee_dimension_rrt(ss.getSpaceInformation(), 2, 3, max_samples=300, seed=5))
+        c0 = robot.collision_checks
+        assert ss.solve(30.0) == ob.PlannerStatus.EXACT_SOLUTION
+        out.append((path_to_array(ss.getSolutionPath(), 4), robot.collision_checks - c0))
+    np.testing.assert_array_equal(out[0][0], out[1][0])
+    assert out[0][1] < out[1][1]
+
+
 def test_runs_inside_ompl_benchmark(robot: WearerArm, tmp_path) -> None:
     q0, q1 = cross_sector_query(robot, 3, 2, np.random.default_rng(4))
     ss = make_simple_setup(robot, q0, q1)

@@ -47,9 +47,11 @@ KNOWN_PLANNERS: tuple[str, ...] = (*ANYTIME_PLANNERS, "RRT", "PRMstar")
 """Every built-in planner name (:data:`tpee_ompl.bench.planners.PLANNER_FACTORIES`); ``module:function`` names a factory elsewhere."""
 NOT_ITERATION_CAPPED: tuple[str, ...] = ("RRTConnectSimplify",)
 """Planners that cannot be stopped at a sample count, so they never join the iteration-matched comparison."""
-CHECKERS = ("batched", "discrete", "certified")
-"""Motion validators: one batched Pinocchio call per motion, OMPL's DiscreteMotionValidator, or clearance
-certificates (a few Coal distances per motion; robot-checker problems only)."""
+CHECKERS = ("batched", "discrete", "certified", "dense")
+"""Motion validators: batched Pinocchio calls screened by clearance balls, OMPL's DiscreteMotionValidator,
+clearance certificates (a few Coal distances per motion), or the batched one checking every state
+(``dense``: the same verdicts as ``batched``, to measure the screening); the last two on robot-checker
+problems only."""
 DEFAULT_CHECKERS = ("batched", "discrete")
 """The validators a campaign runs unless told (``certified`` is chosen explicitly: ``--checkers``)."""
 PROGRESS_PROPERTIES = ["best cost REAL", "iterations INTEGER", "time REAL"]  # sorted, as OMPL's map

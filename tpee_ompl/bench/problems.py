@@ -8,8 +8,9 @@ pickled), builds its dimension-RRT, and says which planners and motion validator
 Importing this module imports no OMPL (:mod:`tpee_ompl.bench.config` and the command-line parser
 read :data:`PROBLEM_NAMES` from it); each problem imports what it needs when it is used.
 
-Motion validators (``CampaignConfig.checkers``): ``batched`` is one batched call per motion through
-the robot's checker (:func:`tpee_ompl.planning.setup.make_simple_setup`), ``certified`` the
+Motion validators (``CampaignConfig.checkers``): ``batched`` checks each motion in batched calls through
+the robot's checker, screened by clearance balls (:func:`tpee_ompl.planning.setup.make_simple_setup`),
+``dense`` the same validator checking every state (the same verdicts), ``certified`` the
 clearance-certificate validator (:mod:`tpee_ompl.planning.certified`: a few Coal distances per motion,
 dense batched checks near contact), ``discrete`` OMPL's ``DiscreteMotionValidator`` calling the
 validity checker per state.  The generic problems have
@@ -127,7 +128,7 @@ def _wearer(name: str, queries: str, what: str) -> Problem:
     return Problem(name=name, description=f"TPEE wearer's 4-DOF arm, query set {queries} ({what})", dimension=4,
                    load_queries=_wearer_queries(queries), build=_wearer_setup,
                    build_dimension_rrt=_wearer_dimension_rrt, groups=((0, 1), (2, 3)), planners=ANYTIME_PLANNERS,
-                   checkers=("batched", "discrete", "certified"), library=True, query_sets=True, default_queries=queries)
+                   checkers=("batched", "discrete", "certified", "dense"), library=True, query_sets=True, default_queries=queries)
 
 
 # ----------------------------------------------------------------- generic problems
@@ -210,7 +211,7 @@ def _robot_problem(name: str, dimension: int, description: str, robot: str, quer
 
     return Problem(name=name, description=description, dimension=dimension, load_queries=load, build=build,
                    build_dimension_rrt=dimension_rrt, groups=((0, 1, 2), (3, 4, 5, 6)),
-                   checkers=("batched", "discrete", "certified"), query_sets=True, default_queries=query_set)
+                   checkers=("batched", "discrete", "certified", "dense"), query_sets=True, default_queries=query_set)
 
 
 PROBLEMS: dict[str, Problem] = {p.name: p for p in (

@@ -90,27 +90,8 @@ class BallScreen:
 
     def __init__(self, robot: RobotChecker) -> None:
         self.robot = robot
-        R = robot.pair_lever_arms()
-        self._lever_norms = np.linalg.norm(R, axis=1)
-        checked = np.ones(len(R), dtype=bool)
-        checked[list(robot.separated_pairs)] = False
-        checked &= self._lever_norms > 0
-        self._R, self._norms = R[checked], self._lever_norms[checked]
+        self._lever_norms = np.linalg.norm(robot.pair_lever_arms(), axis=1)
         self._pools: dict[float, pin.GeometryPool] = {}
-
-    def reach(self, direction: np.ndarray) -> float:
-        """How far along ``direction`` (any non-zero joint vector) a ball of radius 1 reaches, >= 1.
-
-        A pool inflates pair p by ``radius * ||R[p]||``; along a unit direction u the pair's distance
-        changes at most ``R[p] . |u|`` per radian, so the certified stretch is ``radius * min_p
-        ||R[p]|| / (R[p] . |u|)`` either side."""
-        u = np.abs(np.asarray(direction, dtype=float))
-        norm = math.sqrt(float(u @ u))
-        if not len(self._R) or norm == 0:
-            return 1.0
-        speeds = self._R @ (u / norm)
-        moving = speeds > 0
-        return max(1.0, float(np.min(self._norms[moving] / speeds[moving]))) if moving.any() else 1.0
 
     def _pool(self, radius: float) -> pin.GeometryPool:
         pool = self._pools.get(radius)
@@ -143,7 +124,7 @@ def screened_all_valid(robot: RobotChecker, screen: BallScreen, chunks: list[np.
 
     Each chunk starts as one block of states to cover.  At each level h, every block is cut into
     blocks of at most 2H+1 consecutive states (H: how many states a ball of radius h*``step`` reaches
-    either side, :meth:`BallScreen.reach` of the motion's direction included); the middle state of
+    either side); the middle state of
     each block of 3 or more is checked by :meth:`BallScreen.clear`, and a block whose middle passes is
     covered.  One batched call per level over all chunks; the states left go to one dense
     ``robot.are_valid`` call.  A chunk with a state outside the joint limits is invalid at once (as in
@@ -152,6 +133,8 @@ def screened_all_valid(robot: RobotChecker, screen: BallScreen, chunks: list[np.
     K = len(chunks)
     if K == 0:
         return np.zeros(0, dtype=bool)
+    if K == 1:
+        return np.array([_one_motion_valid(robot, screen, np.asarray(chunks[0], dtype=float), step, levels)])
     sizes = np.array([len(c) for c in chunks], dtype=np.int64)
     S = np.concatenate(chunks) if K > 1 else np.asarray(chunks[0], dtype=float)
     offsets = np.cumsum(sizes) - sizes
@@ -160,11 +143,7 @@ def screened_all_valid(robot: RobotChecker, screen: BallScreen, chunks: list[np.
         inside = np.array([bool(limits_ok.all())])
     else:
         inside = np.bincount(np.repeat(np.arange(K), sizes)[~limits_ok], minlength=K) == 0
-    spacing = np.zeros(K)
-    for k, c in enumerate(chunks):
-        if len(c) > 1:
-            d = c[1] - c[0]
-            spacing[k] = math.sqrt(float(d @ d)) / screen.reach(d)  # in units the balls reach
+    spacing = np.array([float(np.linalg.norm(c[1] - c[0])) if len(c) > 1 else 0.0 for c in chunks])
     live = np.flatnonzero(inside & (sizes > 0))
     starts, lengths, owner = offsets[live], sizes[live], live
     for h in levels:
@@ -192,3 +171,39 @@ def screened_all_valid(robot: RobotChecker, screen: BallScreen, chunks: list[np.
         if bad.any():
             out[np.unique(np.repeat(owner, lengths)[bad])] = False
     return out
+
+
+def _one_motion_valid(robot: RobotChecker, screen: BallScreen, S: np.ndarray, step: float,
+                      levels: tuple[float, ...]) -> bool:
+    """:func:`screened_all_valid` for one chunk (``si.checkMotion``'s case): the same blocks, with plain
+    Python over the few failed blocks instead of array bookkeeping (this runs once per motion)."""
+    n = len(S)
+    if n == 0:
+        return True
+    # the states lie on a segment, and the joint box is convex: its two ends decide the limits
+    lower, upper = robot.lower, robot.upper
+    if not ((S[0] >= lower).all() and (S[0] <= upper).all() and (S[-1] >= lower).all() and (S[-1] <= upper).all()):
+        return False
+    d = S[1] - S[0] if n > 1 else S[0] * 0.0
+    spacing = math.sqrt(float(d @ d))
+    blocks = [(0, n)]  # (start, length) still to cover
+    for h in levels:
+        if spacing <= 0 or not blocks:
+            break
+        H = int(math.floor(h * step / spacing * (1 + 1e-12)))
+        if H < 1:
+            continue
+        width = 2 * H + 1
+        pieces = [(b, min(width, a + m - b)) for a, m in blocks for b in range(a, a + m, width)]
+        use = [k for k, (_, m) in enumerate(pieces) if m >= 3]
+        if not use:
+            continue
+        passed = screen.clear(S[[pieces[k][0] + (pieces[k][1] - 1) // 2 for k in use]], h * step)
+        covered = {k for k, ok in zip(use, passed.tolist()) if ok}
+        blocks = [p for k, p in enumerate(pieces) if k not in covered]
+    if not blocks:
+        return True
+    if len(blocks) == 1:
+        a, m = blocks[0]
+        return bool(robot.are_valid(S[a : a + m]).all())
+    return bool(robot.are_valid(S[np.concatenate([np.arange(a, a + m) for a, m in blocks])]).all())

@@ -16,6 +16,7 @@ checked links.**
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
@@ -41,7 +42,7 @@ __all__ = [
     "MOTION_VALIDATORS",
 ]
 
-MOTION_VALIDATORS = ("batched", "certified", "discrete")
+MOTION_VALIDATORS = ("batched", "certified", "dense", "discrete")
 """Names accepted by ``make_simple_setup(motion_validator=...)``."""
 
 
@@ -103,7 +104,9 @@ class BatchedMotionValidator(ob.MotionValidator):
         """True if every state along s1 -> s2 (excluding s1) is valid."""
         a, b = state_to_array(s1, self._n), state_to_array(s2, self._n)
         self.motions_checked += 1
-        return bool(self.all_valid([motion_states(a, b, self.effective_step())])[0])
+        d = b - a  # motion_states' states, without its input checks (OMPL's states are finite vectors)
+        n = max(1, math.ceil(math.sqrt(float(d @ d)) / self.effective_step()))
+        return bool(self.all_valid([a + (np.arange(1, n + 1) / n)[:, None] * d])[0])
 
     def check_motions(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
         """Validity of many motions A[k] -> B[k] (each excluding its start), batched together."""
@@ -160,9 +163,10 @@ def make_simple_setup(
         Old switch: True is ``motion_validator="batched"``, False is ``"discrete"``.
     check_endpoints : bool
         Raise ValueError when start or goal is out of limits or in collision.
-    motion_validator : {"batched", "certified", "discrete"}, optional
-        ``"batched"`` (default): :class:`BatchedMotionValidator`, each motion's states in one batched
-        call; ``"discrete"``: OMPL's per-state ``DiscreteMotionValidator`` (the same states);
+    motion_validator : {"batched", "certified", "dense", "discrete"}, optional
+        ``"batched"`` (default): :class:`BatchedMotionValidator`, each motion's states screened by
+        clearance balls in batched calls; ``"dense"``: the same validator checking every state (no
+        screening, the same verdicts; kept to measure the screening against); ``"discrete"``: OMPL's per-state ``DiscreteMotionValidator`` (the same states);
         ``"certified"``: :class:`~tpee_ompl.planning.certified.CertifiedMotionValidator` (clearance
         certificates, falling back to the batched check near contact; a stronger guarantee).
     certified_options : CertifiedMotionOptions, optional
@@ -186,8 +190,8 @@ def make_simple_setup(
     kind = _motion_validator_kind(motion_validator, batched_motion_validator)
     if certified_options is not None and kind != "certified":
         raise ValueError(f"certified_options needs motion_validator='certified', got {kind!r}")
-    if kind == "batched":
-        si.setMotionValidator(BatchedMotionValidator(si, robot, step))
+    if kind in ("batched", "dense"):
+        si.setMotionValidator(BatchedMotionValidator(si, robot, step, SCREEN_LEVELS if kind == "batched" else ()))
     elif kind == "certified":
         from .certified import CertifiedMotionValidator  # certified builds on this module
 
