@@ -23,7 +23,7 @@ test: $(STAMP)
 test-fast: $(STAMP)
 	MPLBACKEND=Agg $(PY) -m pytest -q -m "not slow"
 
-# Default campaign (about 3 min on 2 cores): 24 queries at 500 and 2500 samples (batched motion
+# Default campaign (about 2 min on 2 cores): 24 queries at 500 and 2500 samples (batched motion
 # validator; OMPL's per-state validator on 4 queries at 500 beside it) plus a short anytime run.
 bench: $(STAMP)
 	MPLBACKEND=Agg $(PY) experiments/run_benchmark.py --queries planning_necessary --name bench \
