@@ -205,5 +205,5 @@ def _one_motion_valid(robot: RobotChecker, screen: BallScreen, S: np.ndarray, st
         return True
     if len(blocks) == 1:
         a, m = blocks[0]
-        return bool(robot.are_valid(S[a : a + m]).all())
-    return bool(robot.are_valid(S[np.concatenate([np.arange(a, a + m) for a, m in blocks])]).all())
+        return bool(robot.collision_free(S[a : a + m]).all())
+    return bool(robot.collision_free(S[np.concatenate([np.arange(a, a + m) for a, m in blocks])]).all())

@@ -452,11 +452,15 @@ class RobotChecker:
         Q = as_config_batch(Q, self.nq)
         ok = np.all((Q >= self.lower) & (Q <= self.upper), axis=1)
         if ok.any():
-            Qin = np.ascontiguousarray(Q[ok].T)  # Pinocchio wants (nq, N)
-            self.collision_checks += Qin.shape[1]
-            collides = pin.computeCollisionsInParallel(self.n_threads, self.pool, Qin, True, False)
-            ok[ok] = ~np.asarray(collides, dtype=bool)
+            ok[ok] = self.collision_free(Q[ok])
         return ok
+
+    def collision_free(self, Q: np.ndarray) -> np.ndarray:
+        """:meth:`are_valid` for a float array Q (N >= 1, nq) already known finite and inside the joint
+        limits (a motion's states between two checked ends): the collision check alone, no input checks."""
+        self.collision_checks += len(Q)
+        collides = pin.computeCollisionsInParallel(self.n_threads, self.pool, np.ascontiguousarray(Q.T), True, False)
+        return ~np.asarray(collides, dtype=bool)
 
     def clearance(self, q: np.ndarray) -> float:
         """Smallest distance (m, negative when penetrating) over all checked pairs at q."""
