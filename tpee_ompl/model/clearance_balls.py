@@ -136,13 +136,10 @@ def screened_all_valid(robot: RobotChecker, screen: BallScreen, chunks: list[np.
     if K == 1:
         return np.array([_one_motion_valid(robot, screen, np.asarray(chunks[0], dtype=float), step, levels)])
     sizes = np.array([len(c) for c in chunks], dtype=np.int64)
-    S = np.concatenate(chunks) if K > 1 else np.asarray(chunks[0], dtype=float)
+    S = np.concatenate(chunks)
     offsets = np.cumsum(sizes) - sizes
     limits_ok = np.all((S >= robot.lower) & (S <= robot.upper), axis=1)
-    if K == 1:
-        inside = np.array([bool(limits_ok.all())])
-    else:
-        inside = np.bincount(np.repeat(np.arange(K), sizes)[~limits_ok], minlength=K) == 0
+    inside = np.bincount(np.repeat(np.arange(K), sizes)[~limits_ok], minlength=K) == 0
     spacing = np.array([float(np.linalg.norm(c[1] - c[0])) if len(c) > 1 else 0.0 for c in chunks])
     live = np.flatnonzero(inside & (sizes > 0))
     starts, lengths, owner = offsets[live], sizes[live], live

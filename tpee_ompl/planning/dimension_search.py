@@ -166,6 +166,7 @@ class Checker:
             if self._all_valid is not None:  # screened by the motion validator: the same verdicts
                 bL, bR = np.searchsorted(iL, np.arange(m + 1)), np.searchsorted(iR, np.arange(m + 1))
                 kL, kR = np.flatnonzero(goL), np.flatnonzero(goR)
+                self.own_checks += int((bL[kL + 1] - bL[kL]).sum() + (bR[kR + 1] - bR[kR]).sum())  # at most
                 ok2 = self._all_valid([SL[bL[k] : bL[k + 1]] for k in kL] + [SR[bR[k] : bR[k + 1]] for k in kR])
                 left, right = goL.copy(), goR.copy()
                 left[kL], right[kR] = ok2[: len(kL)], ok2[len(kL) :]
