@@ -124,11 +124,11 @@ def screened_all_valid(robot: RobotChecker, screen: BallScreen, chunks: list[np.
 
     Each chunk starts as one block of states to cover.  At each level h, every block is cut into
     blocks of at most 2H+1 consecutive states (H: how many states a ball of radius h*``step`` reaches
-    either side); the middle state of
-    each block of 3 or more is checked by :meth:`BallScreen.clear`, and a block whose middle passes is
-    covered.  One batched call per level over all chunks; the states left go to one dense
-    ``robot.are_valid`` call.  A chunk with a state outside the joint limits is invalid at once (as in
-    ``are_valid``); the others lie inside, so the states a ball covers do too.
+    either side); the middle state of each block of 3 or more is checked by :meth:`BallScreen.clear`,
+    and a block whose middle passes is covered.  One batched call per level over all chunks; the states
+    left go to one :meth:`RobotChecker.collision_free` call.  A chunk with a state outside the joint
+    limits is invalid at once (as in ``are_valid``); the others lie inside, so the states a ball covers
+    do too.
     """
     K = len(chunks)
     if K == 0:
@@ -164,7 +164,7 @@ def screened_all_valid(robot: RobotChecker, screen: BallScreen, chunks: list[np.
     out = inside.copy()
     if len(starts):
         idx = np.repeat(starts - (np.cumsum(lengths) - lengths), lengths) + np.arange(int(lengths.sum()))
-        bad = ~robot.are_valid(S[idx])
+        bad = ~robot.collision_free(S[idx])
         if bad.any():
             out[np.unique(np.repeat(owner, lengths)[bad])] = False
     return out
@@ -181,7 +181,9 @@ def _one_motion_valid(robot: RobotChecker, screen: BallScreen, S: np.ndarray, st
     lower, upper = robot.lower, robot.upper
     if not ((S[0] >= lower).all() and (S[0] <= upper).all() and (S[-1] >= lower).all() and (S[-1] <= upper).all()):
         return False
-    d = S[1] - S[0] if n > 1 else S[0] * 0.0
+    if n < 3:
+        return bool(robot.collision_free(S).all())
+    d = S[1] - S[0]
     spacing = math.sqrt(float(d @ d))
     blocks = [(0, n)]  # (start, length) still to cover
     for h in levels:

@@ -32,6 +32,7 @@ __all__ = [
     "resample_waypoints",
     "set_state",
     "state_to_array",
+    "unchecked_motion_states",
 ]
 
 
@@ -170,9 +171,15 @@ def motion_states(a: np.ndarray, b: np.ndarray, step: float, include_start: bool
         raise ValueError(f"motion ends must be finite, got {a} -> {b}")
     if not (isinstance(step, (int, float, np.integer, np.floating)) and math.isfinite(step) and step > 0):
         raise ValueError(f"step must be a finite number > 0, got {step!r}")
-    n = max(1, math.ceil(float(np.linalg.norm(b - a)) / step))
-    t = np.arange(0 if include_start else 1, n + 1) / n
-    return a + t[:, None] * (b - a)
+    return unchecked_motion_states(a, b, step, include_start)
+
+
+def unchecked_motion_states(a: np.ndarray, b: np.ndarray, step: float, include_start: bool = False) -> np.ndarray:
+    """:func:`motion_states` without its input checks, for inner loops whose ends are known finite
+    float vectors of one length (a motion validator's OMPL states)."""
+    d = b - a
+    n = max(1, math.ceil(math.sqrt(float(d @ d)) / step))
+    return a + (np.arange(0 if include_start else 1, n + 1) / n)[:, None] * d
 
 
 def motion_interior_states(

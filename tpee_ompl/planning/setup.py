@@ -16,7 +16,6 @@ checked links.**
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
@@ -27,7 +26,7 @@ from ompl import geometric as og
 from ..model.clearance_balls import SCREEN_LEVELS, screened_all_valid
 from ..model.robot_checker import RobotChecker
 from ..validation import check_number
-from .paths import MIN_JOINT_STEP, motion_states, set_state, state_to_array
+from .paths import MIN_JOINT_STEP, motion_states, set_state, state_to_array, unchecked_motion_states
 
 if TYPE_CHECKING:
     from .certified import CertifiedMotionOptions
@@ -80,8 +79,8 @@ class BatchedMotionValidator(ob.MotionValidator):
 
     By default the states are screened first (``screen_levels``,
     :func:`~tpee_ompl.model.clearance_balls.screened_all_valid`): one state checked at margins
-    inflated for a ball of a few steps certifies its neighbours, and only states no ball covers are
-    checked one by one; the verdict is the same.  ``screen_levels=()`` checks every state.
+    inflated for a ball of a few steps certifies its neighbours, and only the states no ball covers
+    are checked themselves; the verdict is the same.  ``screen_levels=()`` checks every state.
     """
 
     def __init__(self, si: ob.SpaceInformation, robot: RobotChecker, step: float,
@@ -104,9 +103,7 @@ class BatchedMotionValidator(ob.MotionValidator):
         """True if every state along s1 -> s2 (excluding s1) is valid."""
         a, b = state_to_array(s1, self._n), state_to_array(s2, self._n)
         self.motions_checked += 1
-        d = b - a  # motion_states' states, without its input checks (OMPL's states are finite vectors)
-        n = max(1, math.ceil(math.sqrt(float(d @ d)) / self.effective_step()))
-        return bool(self.all_valid([a + (np.arange(1, n + 1) / n)[:, None] * d])[0])
+        return bool(self.all_valid([unchecked_motion_states(a, b, self.effective_step())])[0])
 
     def check_motions(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
         """Validity of many motions A[k] -> B[k] (each excluding its start), batched together."""
@@ -166,7 +163,8 @@ def make_simple_setup(
     motion_validator : {"batched", "certified", "dense", "discrete"}, optional
         ``"batched"`` (default): :class:`BatchedMotionValidator`, each motion's states screened by
         clearance balls in batched calls; ``"dense"``: the same validator checking every state (no
-        screening, the same verdicts; kept to measure the screening against); ``"discrete"``: OMPL's per-state ``DiscreteMotionValidator`` (the same states);
+        screening, the same verdicts; kept to measure the screening against); ``"discrete"``:
+        OMPL's per-state ``DiscreteMotionValidator`` (the same states);
         ``"certified"``: :class:`~tpee_ompl.planning.certified.CertifiedMotionValidator` (clearance
         certificates, falling back to the batched check near contact; a stronger guarantee).
     certified_options : CertifiedMotionOptions, optional
