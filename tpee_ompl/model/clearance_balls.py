@@ -111,10 +111,7 @@ class BallScreen:
         Q = np.asarray(Q, dtype=float)
         if len(Q) == 0:
             return np.zeros(0, dtype=bool)
-        self.robot.collision_checks += len(Q)
-        hits = pin.computeCollisionsInParallel(self.robot.n_threads, self._pool(float(radius)),
-                                               np.ascontiguousarray(Q.T), True, False)
-        return ~np.asarray(hits, dtype=bool)
+        return self.robot.collision_free(Q, self._pool(float(radius)))
 
 
 def screened_all_valid(robot: RobotChecker, screen: BallScreen, chunks: list[np.ndarray], step: float,

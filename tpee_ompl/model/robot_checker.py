@@ -455,11 +455,13 @@ class RobotChecker:
             ok[ok] = self.collision_free(Q[ok])
         return ok
 
-    def collision_free(self, Q: np.ndarray) -> np.ndarray:
+    def collision_free(self, Q: np.ndarray, pool: pin.GeometryPool | None = None) -> np.ndarray:
         """:meth:`are_valid` for a float array Q (N >= 1, nq) already known finite and inside the joint
-        limits (a motion's states between two checked ends): the collision check alone, no input checks."""
+        limits (a motion's states between two checked ends): the collision check alone, no input checks.
+        ``pool``: another pool of this model with other margins (default: the checks' own)."""
         self.collision_checks += len(Q)
-        collides = pin.computeCollisionsInParallel(self.n_threads, self.pool, np.ascontiguousarray(Q.T), True, False)
+        collides = pin.computeCollisionsInParallel(self.n_threads, self.pool if pool is None else pool,
+                                                   np.ascontiguousarray(Q.T), True, False)
         return ~np.asarray(collides, dtype=bool)
 
     def clearance(self, q: np.ndarray) -> float:
