@@ -105,6 +105,10 @@ _REFINE_AFTER = 500
 _PROGRESS_PERIOD = 0.01
 """Seconds between progress-trace entries (OMPL's benchmark records progress about as often)."""
 
+_PASS_BATCH = 64
+"""Most samples per :meth:`Search.iterate` call on a valid path (those the cost test rejects are passed
+over in one vectorised step; the termination condition is asked between calls)."""
+
 
 @dataclass(frozen=True)
 class DimensionRRTOptions:
@@ -384,7 +388,10 @@ class DimensionRRT(PythonPlanner):
                                 self._ranges, None)
                 log.info("DimensionRRT: no path after %d samples, h raised to %d", done, grouped.h)
                 continue
-            accepted = search.iterate()
+            limit = _PASS_BATCH if cap is None else min(_PASS_BATCH, cap - done - search.samples)
+            if stall is not None:
+                limit = min(limit, stall - (search.samples - improved_at))
+            accepted = search.iterate(max(1, limit))
             now = time.perf_counter()
             if accepted and search.valid and search.cost < poster.found_cost:
                 poster.offer(search.W, search.cost, now)

@@ -287,13 +287,19 @@ class Search:
             hi = np.minimum(hi, vals.max(axis=0) + pad)
         return lo + u[3:] * (hi - lo)
 
-    def iterate(self) -> int:
-        """Draw one sample and try it at every intermediate step.
+    def iterate(self, limit: int = 1) -> int:
+        """Draw one sample and try it at every intermediate step (up to ``limit`` samples on a valid path).
 
         On a valid path the sample is the current group's (paper's rule); before, it covers all
         planned groups at once and grows the layered trees.  Returns the number of waypoints
         changed (feasibility phase: 1 when the layered trees connected, 0 otherwise).
+
+        With ``limit > 1`` on a valid path, the samples that the cost test rejects at every step are
+        first passed over in one vectorised step (at most ``limit - 1`` of them): they change nothing
+        but the counters, so the result is that of as many single calls, with the same random numbers.
         """
+        if limit > 1 and self.valid:
+            self._pass_rejected(limit - 1)
         gi = self.current_group()
         valid = self.valid
         if not valid and self._tree is None:
@@ -302,6 +308,51 @@ class Search:
         self.samples += 1
         self.group_samples[gi] += 1
         return self._improve(gi, c) if valid else self._grow(c)
+
+    def _pass_rejected(self, limit: int) -> None:
+        """Advance past the next samples (at most ``limit``, within the current group's block and the
+        random buffer) that :meth:`_improve` would reject on cost alone, stopping before the first one it
+        would not: :meth:`draw` and the cost test of :meth:`_improve` for many samples at once."""
+        gi = self.current_group()
+        d = self._dims[gi]
+        k = len(d)
+        if self._ui >= len(self._uniform) or self._uniform.shape[1] != k + 3:
+            self._uniform = self.rng.random((1024, k + 3))
+            self._normal = self.rng.standard_normal((1024, k))
+            self._ui = 0
+        n = min(limit, _GROUP_BLOCK - self.samples % _GROUP_BLOCK, len(self._uniform) - self._ui)
+        if n <= 0:
+            return
+        U = self._uniform[self._ui : self._ui + n]
+        lo, hi = self._bounds[gi]
+        span = hi - lo
+        C = lo + U[:, 3:] * (hi - lo)
+        g0 = self.group_samples[gi]
+        n0 = self.narrow_start[gi]
+        if n0 is None and g0 + n - 1 >= self.narrow_after:
+            n0 = max(g0, self.narrow_after)
+        if n0 is not None:
+            g = g0 + np.arange(n)
+            narrow = np.flatnonzero((g >= n0) & (U[:, 0] >= _UNIFORM_FRACTION))
+            if len(narrow):
+                scale = np.array([self.narrowing ** ((int(m) - n0) / _NARROWING_UNIT) for m in g[narrow]])
+                pad = np.maximum(self.range_[gi], span * scale[:, None])
+                vals = self.W[:, d]
+                nlo = np.maximum(lo, vals.min(axis=0) - pad)
+                nhi = np.minimum(hi, vals.max(axis=0) + pad)
+                C[narrow] = nlo + U[narrow, 3:] * (nhi - nlo)
+        W, L = self.W, self.L
+        X = np.broadcast_to(W[1:-1], (n,) + W[1:-1].shape).copy()
+        X[:, :, d] = C[:, None, :]
+        shorter = (self.dist(W[:-2], X) + self.dist(X, W[2:]) < L[:-1] + L[1:] - 1e-12).any(axis=1)
+        j = int(np.argmax(shorter)) if shorter.any() else n
+        if j == 0:
+            return
+        self._ui += j
+        self.samples += j
+        self.group_samples[gi] = g0 + j
+        if self.narrow_start[gi] is None and n0 is not None and g0 + j - 1 >= n0:
+            self.narrow_start[gi] = n0
 
     def _grow(self, c: np.ndarray) -> int:
         """Feasibility phase: grow the layered trees with the sample c, motions checked lazily.
