@@ -60,6 +60,31 @@ def test_search_finds_a_valid_path_around_the_box_and_only_shortens_it(batch: bo
     np.testing.assert_array_equal(search.W[[0, -1]], [start, goal])
 
 
+@pytest.mark.parametrize("limit", [2, 7, 64])
+def test_iterate_passing_over_rejected_samples_matches_one_sample_per_call(limit: int) -> None:
+    si, _ = box_problem(lo=(-0.2, -1.0), hi=(0.2, 0.6))
+    grouped = GroupedSpace(si, [[0], [1]], 7)  # two groups: blocks of 100 samples each, narrowing after 50
+    start, goal = np.array([-0.8, 0.0]), np.array([0.8, 0.0])
+
+    def search() -> Search:
+        return Search(grouped, Checker(si, grouped.layout, True), np.random.default_rng(5), start, goal,
+                      narrow_after=50, narrowing=0.5, range_={0: np.full(1, 0.02), 1: np.full(1, 0.02)})
+
+    one, many = search(), search()
+    trace_one, trace_many = [], []
+    while one.samples < 1500:
+        one.iterate()
+        trace_one.append((one.samples, one.W.tobytes()))
+    while many.samples < 1500:
+        many.iterate(min(limit, 1500 - many.samples))
+        trace_many.append((many.samples, many.W.tobytes()))
+    assert many.valid and len(trace_many) < len(trace_one)
+    np.testing.assert_array_equal(many.W, one.W)
+    seen = dict(trace_one)
+    assert all(seen[n] == w for n, w in trace_many)  # the same path after the same number of samples
+    assert many.narrow_start == one.narrow_start and many.group_samples == one.group_samples
+
+
 class _Band(ob.StateValidityChecker):
     """Two continuous joints; invalid where the first is within 0.5 rad of 0 (so never near +-pi)."""
 
