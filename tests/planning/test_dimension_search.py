@@ -7,9 +7,10 @@ import pytest
 from helpers.planning_spaces import box_problem
 from ompl import base as ob
 
-from tpee_ompl.planning.dimension_search import Checker, Search
+from tpee_ompl.planning.dimension_search import Checker, Search, segment_key
 from tpee_ompl.planning.grouped_space import GroupedSpace
 from tpee_ompl.planning.paths import path_passes_motion_checks, set_state
+from tpee_ompl.planning.setup import make_simple_setup
 
 
 def _valid_pairs(si, rng: np.random.Generator, m: int) -> tuple[np.ndarray, np.ndarray]:
@@ -37,6 +38,22 @@ def test_batched_and_per_state_checkers_agree_with_check_motion(rng: np.random.G
         vp, lp, rp = plain.candidates(C, A, B, yes, yes, strict)
         np.testing.assert_array_equal(vb, vp)
         np.testing.assert_array_equal(lb & rb, lp & rp)  # strict: the second motion may be skipped
+
+
+def test_checker_motions_match_check_motion_and_remember_those_that_passed(robot, rng: np.random.Generator) -> None:
+    si = make_simple_setup(robot).getSpaceInformation()
+    grouped = GroupedSpace(si, [[0, 1], [2, 3]], 7)
+    checker = Checker(si, grouped.layout, batch=True)
+    Q = robot.lower + rng.random((400, robot.nq)) * (robot.upper - robot.lower)
+    Q = Q[robot.are_valid(Q)]
+    A, B = Q[:40], Q[40:80]
+    B[:20] = A[:20] + 0.05 * (B[:20] - A[:20])  # short motions too, most of them valid
+    a, b = si.allocState(), si.allocState()
+    want = np.array([si.checkMotion(set_state(a, p), set_state(b, q)) for p, q in zip(A, B)])
+    assert want.any() and not want.all()
+    np.testing.assert_array_equal(checker.check_motions(A, B), want)
+    np.testing.assert_array_equal(checker.motions(A, B), want)
+    assert checker.passed == {segment_key(p, q) for p, q, w in zip(A, B, want) if w}
 
 
 @pytest.mark.parametrize("batch", [True, False])

@@ -17,7 +17,7 @@ from ompl import base as ob
 
 from .grouped_space import GroupedSpace, RealVectorLayout
 from .layered_trees import LayeredTrees, spread_waypoints
-from .paths import motion_interior_states
+from .paths import motion_interior_states, unchecked_motion_states
 
 __all__ = ["Checker", "Search", "segment_key"]
 
@@ -120,11 +120,22 @@ class Checker:
 
     def motions(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
         """Validity of the motions A[k] -> B[k] (valid ends assumed): :meth:`coarse`, then
-        :meth:`check_motion` for the motions still in question."""
+        :meth:`check_motions` for the motions still in question."""
         out = np.zeros(len(A), dtype=bool)
-        for k in np.flatnonzero(self.coarse(A, B)):
-            out[k] = self.check_motion(A[k], B[k])
+        go = np.flatnonzero(self.coarse(A, B))
+        out[go] = self.check_motions(A[go], B[go])
         return out
+
+    def check_motions(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
+        """:meth:`check_motion` of each motion A[k] -> B[k]; with the project's validator, in one
+        screened call over the very states ``si.checkMotion`` would check (end state included)."""
+        if self._all_valid is None or len(A) < 2:
+            return np.array([self.check_motion(a, b) for a, b in zip(A, B)], dtype=bool)
+        chunks = [unchecked_motion_states(a, b, self.step) for a, b in zip(A, B)]
+        self.own_checks += sum(len(c) for c in chunks)  # at most
+        ok = np.asarray(self._all_valid(chunks), dtype=bool)
+        self.passed.update(segment_key(A[k], B[k]) for k in np.flatnonzero(ok))
+        return ok
 
     def check_motion(self, a: np.ndarray, b: np.ndarray) -> bool:
         """``si.checkMotion`` of a -> b (n,); a motion that passes is remembered in :attr:`passed`."""
@@ -470,10 +481,11 @@ class Search:
             known[keys[k]] = False
         if bad:
             return bad
-        for k in todo:  # all of them: a motion the coarse test missed may not be the only one
-            if not checker.check_motion(W[k], W[k + 1]):
+        # all of them: a motion the coarse test missed may not be the only one
+        for k, ok in zip(todo, checker.check_motions(W[ends], W[ends + 1])):
+            if not ok:
                 bad.append(k)
-            known[keys[k]] = k not in bad
+            known[keys[k]] = bool(ok)
         return bad
 
     def _adopt(self, W: np.ndarray) -> None:
