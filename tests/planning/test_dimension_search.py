@@ -1,4 +1,4 @@
-"""tpee_ompl.planning.dimension_search without a planner: the batched checker and the search on a waypoint array."""
+"""tpee_ompl.planning.dimension_search and search_checker without a planner: the batched checker and the search on a waypoint array."""
 
 from __future__ import annotations
 
@@ -7,9 +7,10 @@ import pytest
 from helpers.planning_spaces import box_problem
 from ompl import base as ob
 
-from tpee_ompl.planning.dimension_search import Checker, Search, segment_key
+from tpee_ompl.planning.dimension_search import Search
 from tpee_ompl.planning.grouped_space import GroupedSpace
 from tpee_ompl.planning.paths import path_passes_motion_checks, set_state
+from tpee_ompl.planning.search_checker import Checker, segment_key
 from tpee_ompl.planning.setup import make_simple_setup
 
 

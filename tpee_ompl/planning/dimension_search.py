@@ -1,28 +1,22 @@
 """The dimension-RRT search on a waypoint array, in numpy: what :class:`~tpee_ompl.planning.dimension_rrt.DimensionRRT` runs.
 
-:class:`Checker` answers validity of states and motions for one ``SpaceInformation`` (one batched
-``are_valid`` call per pass when the setup offers it, else ``si.isValid`` / ``si.checkMotion``);
 :class:`Search` holds the current path ``W`` (h, n) and does one sample per :meth:`Search.iterate`
 (improvement on a valid path, else the feasibility phase's :class:`LayeredTrees`).  The algorithm is
 described in :mod:`tpee_ompl.planning.dimension_rrt`; nothing here touches the planner's OMPL problem
-definition, so it can be driven and tested without one.
+definition, so it can be driven and tested without one; validity comes from
+:class:`~tpee_ompl.planning.search_checker.Checker`.
 """
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
-from ompl import base as ob
 
-from .grouped_space import GroupedSpace, RealVectorLayout
+from .grouped_space import GroupedSpace
 from .layered_trees import LayeredTrees, spread_waypoints
-from .paths import motion_interior_states, unchecked_motion_states
+from .search_checker import Checker
 
-__all__ = ["Checker", "Search", "segment_key"]
+__all__ = ["Search"]
 
-_COARSE_STRIDE = 8
-"""First pass over a motion checks every 8th interior state (collisions span many states)."""
 _UNIFORM_FRACTION = 0.1
 """Share of samples drawn uniformly over the bounds once the sampling region has narrowed."""
 _NARROWING_UNIT = 100
@@ -33,171 +27,6 @@ _REPAIR_FRACTION = 0.5
 """Share of repair samples while no valid path exists."""
 _REPAIR_SIGMA = (0.01, 0.1)
 """Repair samples: Gaussian around a waypoint, sigma log-uniform in this range times the bound widths."""
-
-
-def segment_key(a: np.ndarray, b: np.ndarray) -> bytes:
-    """Key of the motion a -> b (n,): the bytes of its two float64 ends, as ``W[k : k + 2].tobytes()``."""
-    return np.ascontiguousarray(a, dtype=float).tobytes() + np.ascontiguousarray(b, dtype=float).tobytes()
-
-
-class Checker:
-    """Validity of states and motions for one SpaceInformation, batched when the setup allows it."""
-
-    def __init__(self, si: ob.SpaceInformation, layout: RealVectorLayout, batch: bool) -> None:
-        self.si = si
-        self.layout = layout
-        svc = si.getStateValidityChecker()
-        mv = si.getMotionValidator()
-        are_valid = getattr(svc, "are_valid", None)
-        self.step: float | None = None
-        self.euclid = True
-        if batch and callable(are_valid):
-            factor = max(1, int(si.getStateSpace().getValidSegmentCountFactor()))
-            if isinstance(getattr(mv, "step", None), float) and callable(getattr(mv, "check_motions", None)):
-                # BatchedMotionValidator: Euclidean, ceil(|b-a| / step) segments (step / factor)
-                self.step = float(mv.effective_step()) if callable(getattr(mv, "effective_step", None)) else mv.step
-            elif type(mv) is ob.MotionValidator:  # the C++ default, DiscreteMotionValidator
-                self.step = float(si.getStateSpace().getLongestValidSegmentLength()) / factor
-                self.euclid = layout.is_plain
-        self.batched = self.step is not None
-        self._are_valid = are_valid if self.batched else None
-        all_valid = getattr(mv, "all_valid", None)
-        # the project's validator screens a motion's evenly spaced states (straight lines only: no SO2 wrap)
-        self._all_valid = all_valid if self.batched and callable(all_valid) and layout.is_plain else None
-        if self.step is None:  # only for the coarse screening of motions (si.checkMotion decides)
-            factor = max(1, int(si.getStateSpace().getValidSegmentCountFactor()))
-            self._coarse_step = float(si.getStateSpace().getLongestValidSegmentLength()) / factor
-            self.euclid = layout.is_plain
-        else:
-            self._coarse_step = self.step
-        counter_owner = getattr(svc, "robot", svc)
-        self._counter_owner = counter_owner if isinstance(getattr(counter_owner, "collision_checks", None), int) else None
-        self.own_checks = 0
-        self._longest = float(si.getStateSpace().getLongestValidSegmentLength())
-        self._s1, self._s2 = si.allocState(), si.allocState()
-        self.passed: set[bytes] = set()
-        """Keys (:func:`segment_key`) of the motions that passed ``si.checkMotion`` here."""
-
-    def counter(self) -> int:
-        """Configurations checked so far (the robot's counter when available, else our own count)."""
-        return self._counter_owner.collision_checks if self._counter_owner is not None else self.own_checks
-
-    def states(self, Q: np.ndarray) -> np.ndarray:
-        """Validity of configurations Q (m, n)."""
-        if len(Q) == 0:
-            return np.zeros(0, dtype=bool)
-        self.own_checks += len(Q)
-        if self._are_valid is not None:
-            return np.asarray(self._are_valid(Q), dtype=bool)
-        s = self._s1
-        out = np.empty(len(Q), dtype=bool)
-        for k, q in enumerate(Q):
-            self.layout.write(s, q)
-            out[k] = self.si.isValid(s)
-        return out
-
-    def interior(self, A: np.ndarray, B: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Interior states of motions A[k] -> B[k]: (states (M, n), motion index (M,), step index j >= 1).
-
-        SO2 entries move the short way round and are wrapped into [-pi, pi), as ``SO2StateSpace``
-        interpolates."""
-        lay = self.layout
-        if not lay.has_circular:
-            return motion_interior_states(A, B, self._coarse_step, None if self.euclid else lay.distance(A, B))
-        S, idx, j = motion_interior_states(A, A + lay.delta(A, B), self._coarse_step, lay.distance(A, B))
-        return lay.wrap(S), idx, j
-
-    def coarse(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
-        """Whether every 8th interior state of the motions A[k] -> B[k] is valid (one batched call, or
-        per-state checks): most invalid motions already fail here (not all: a thin wall can fit
-        between two of those states)."""
-        K = len(A)
-        if K == 0:
-            return np.ones(0, dtype=bool)
-        S, idx, j = self.interior(A, B)
-        c = j % _COARSE_STRIDE == 0
-        return np.bincount(idx[c][~self.states(S[c])], minlength=K) == 0
-
-    def motions(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
-        """Validity of the motions A[k] -> B[k] (valid ends assumed): :meth:`coarse`, then
-        :meth:`check_motions` for the motions still in question."""
-        out = np.zeros(len(A), dtype=bool)
-        go = np.flatnonzero(self.coarse(A, B))
-        out[go] = self.check_motions(A[go], B[go])
-        return out
-
-    def check_motions(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
-        """:meth:`check_motion` of each motion A[k] -> B[k]; with the project's validator, in one
-        screened call over the very states ``si.checkMotion`` would check (end state included)."""
-        if self._all_valid is None or len(A) < 2:
-            return np.array([self.check_motion(a, b) for a, b in zip(A, B)], dtype=bool)
-        chunks = [unchecked_motion_states(a, b, self.step) for a, b in zip(A, B)]
-        self.own_checks += sum(len(c) for c in chunks)  # at most
-        ok = np.asarray(self._all_valid(chunks), dtype=bool)
-        self.passed.update(segment_key(A[k], B[k]) for k in np.flatnonzero(ok))
-        return ok
-
-    def check_motion(self, a: np.ndarray, b: np.ndarray) -> bool:
-        """``si.checkMotion`` of a -> b (n,); a motion that passes is remembered in :attr:`passed`."""
-        self.layout.write(self._s1, a)
-        self.layout.write(self._s2, b)
-        self.own_checks += max(1, math.ceil(float(self.layout.distance(a, b)) / self._longest))
-        ok = bool(self.si.checkMotion(self._s1, self._s2))
-        if ok:
-            self.passed.add(segment_key(a, b))
-        return ok
-
-    def candidates(
-        self, C: np.ndarray, A: np.ndarray, B: np.ndarray, left_known: np.ndarray, right_known: np.ndarray, strict: np.ndarray
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Evaluate candidate waypoints C (m, n) between neighbours A and B (m, n).
-
-        ``left_known[k]`` / ``right_known[k]`` false means that neighbour is invalid, so that motion is
-        invalid without a check.  For ``strict[k]`` candidates only all-valid matters, so the second
-        motion is not finished once one fails.  Returns validity of C, of A->C and of C->B (ends incl.).
-        """
-        m = len(C)
-        vc = self.states(C) if not self.batched else None
-        if self.batched:
-            # pass 1: candidate states + every 8th interior state of motions whose other end is valid
-            SL, iL, jL = self.interior(A, C)
-            SR, iR, jR = self.interior(C, B)
-            cL, cR = (jL % _COARSE_STRIDE == 0) & left_known[iL], (jR % _COARSE_STRIDE == 0) & right_known[iR]
-            ok = self.states(np.concatenate([C, SL[cL], SR[cR]]))
-            vc = ok[:m]
-            nl = int(cL.sum())
-            badL = np.bincount(iL[cL][~ok[m : m + nl]], minlength=m) > 0
-            badR = np.bincount(iR[cR][~ok[m + nl :]], minlength=m) > 0
-            goL = vc & left_known & ~badL
-            goR = vc & right_known & ~badR
-            both = goL & goR
-            goL &= both | ~strict
-            goR &= both | ~strict
-            # pass 2: the remaining interior states of motions still in question
-            if self._all_valid is not None:  # screened by the motion validator: the same verdicts
-                bL, bR = np.searchsorted(iL, np.arange(m + 1)), np.searchsorted(iR, np.arange(m + 1))
-                kL, kR = np.flatnonzero(goL), np.flatnonzero(goR)
-                self.own_checks += int((bL[kL + 1] - bL[kL]).sum() + (bR[kR + 1] - bR[kR]).sum())  # at most
-                ok2 = self._all_valid([SL[bL[k] : bL[k + 1]] for k in kL] + [SR[bR[k] : bR[k + 1]] for k in kR])
-                left, right = goL.copy(), goR.copy()
-                left[kL], right[kR] = ok2[: len(kL)], ok2[len(kL) :]
-                return vc, left, right
-            fL, fR = ~cL & goL[iL], ~cR & goR[iR]
-            ok2 = self.states(np.concatenate([SL[fL], SR[fR]]))
-            nl2 = int(fL.sum())
-            left = goL & (np.bincount(iL[fL][~ok2[:nl2]], minlength=m) == 0)
-            right = goR & (np.bincount(iR[fR][~ok2[nl2:]], minlength=m) == 0)
-            return vc, left, right
-        left = np.zeros(m, dtype=bool)
-        right = np.zeros(m, dtype=bool)
-        for k in range(m):
-            if not vc[k]:
-                continue
-            if left_known[k]:
-                left[k] = self.check_motion(A[k], C[k])
-            if right_known[k] and (left[k] or not strict[k]):
-                right[k] = self.check_motion(C[k], B[k])
-        return vc, left, right
 
 
 class Search:
@@ -373,8 +202,8 @@ class Search:
         steps with both, the one with the shortest motions completes a candidate path, whose not yet
         checked motions are checked now: all pass and it is the path; a failed motion kills the node
         it leads into (and its subtree), and c joins the trees through those of its motions that
-        passed in full.  At the other steps c joins the trees on unchecked motions that pass
-        :meth:`Checker.coarse`; when holding, once per tree instead, at the lowest forward / highest
+        passed in full.  At the other steps c joins the trees on unchecked motions (checked once a
+        candidate path uses them); when holding, once per tree instead, at the lowest forward / highest
         backward step whose motion passes in full (coarse screening alone let trees grow through
         thin walls there).  Returns 1 when the path is complete, else 0.
         """
@@ -423,8 +252,8 @@ class Search:
             if passed[1] and tree.bwd.alive[b]:
                 tree.bwd.add(c, t, b)
                 joined.add(id(tree.bwd))
-        # the other steps: c joins on unchecked motions that pass the coarse test; holding, once per
-        # tree, at the lowest step (forward) or highest (backward) whose motion passes in full
+        # the other steps: c joins on unchecked motions; holding, once per tree, at the lowest step
+        # (forward) or highest (backward) whose motion passes in full
         if self._hold:
             if not vc[0]:
                 return 0
@@ -438,28 +267,16 @@ class Search:
         else:
             adds = [(tr, int(p[k]), ts[k]) for k in range(len(ts)) if k != tried and vc[k]
                     for tr, p in ((tree.fwd, fi), (tree.bwd, bi)) if p[k] >= 0]
-        if not adds:
-            return 0
-        E = np.empty((2 * len(adds), self.g.n))
-        for m, (tr, p, t) in enumerate(adds):
-            ct = base[t].copy()
-            ct[d] = c
-            pt = base[int(tr.steps[p])].copy()
-            pt[d] = tr.values[p]
-            E[2 * m], E[2 * m + 1] = (pt, ct) if tr is tree.fwd else (ct, pt)
-        checker = self.checker
-        # one call when batched; per state, in order, skipping what holding makes useless
-        ok = checker.coarse(E[0::2], E[1::2]) if checker.batched and not self._hold else None
-        for m, (tr, p, t) in enumerate(adds):
-            if self._hold and id(tr) in joined:
+        for tr, p, t in adds:
+            if not tr.alive[p] or id(tr) in joined:  # a node killed above; holding: joined already
                 continue
-            if self._hold:  # checked in full: coarse screening alone let motions through thin walls
-                good = self._check_segments(E[2 * m : 2 * m + 2]) == []
-            else:
-                good = ok[m] if ok is not None else checker.coarse(E[2 * m : 2 * m + 1], E[2 * m + 1 : 2 * m + 2])[0]
-            if good:
-                tr.add(c, t, p)
+            if self._hold:  # checked in full: coarse screening let the trees through thin walls
+                ct, pt = base[t].copy(), base[int(tr.steps[p])].copy()
+                ct[d], pt[d] = c, tr.values[p]
+                if self._check_segments(np.stack([pt, ct] if tr is tree.fwd else [ct, pt])):
+                    continue
                 joined.add(id(tr))
+            tr.add(c, t, p)  # not holding: lazily, the motion is checked once a candidate path uses it
         return 0
 
     def _check_segments(self, W: np.ndarray) -> list[int]:

@@ -1,0 +1,187 @@
+"""Validity of states and motions for dimension-RRT's search: :class:`Checker`, batched when the setup allows it.
+
+One ``SpaceInformation``; one batched ``are_valid`` call per pass when its validity checker offers it
+(else ``si.isValid`` / ``si.checkMotion``), and the project's motion validator's screened
+``all_valid`` for whole motions when it is the validator (:mod:`tpee_ompl.planning.dimension_search`
+runs the search on top of it).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from ompl import base as ob
+
+from .grouped_space import RealVectorLayout
+from .paths import motion_interior_states, unchecked_motion_states
+
+__all__ = ["Checker", "segment_key"]
+
+_COARSE_STRIDE = 8
+"""First pass over a motion checks every 8th interior state (collisions span many states)."""
+
+
+def segment_key(a: np.ndarray, b: np.ndarray) -> bytes:
+    """Key of the motion a -> b (n,): the bytes of its two float64 ends, as ``W[k : k + 2].tobytes()``."""
+    return np.ascontiguousarray(a, dtype=float).tobytes() + np.ascontiguousarray(b, dtype=float).tobytes()
+
+
+class Checker:
+    """Validity of states and motions for one SpaceInformation, batched when the setup allows it."""
+
+    def __init__(self, si: ob.SpaceInformation, layout: RealVectorLayout, batch: bool) -> None:
+        self.si = si
+        self.layout = layout
+        svc = si.getStateValidityChecker()
+        mv = si.getMotionValidator()
+        are_valid = getattr(svc, "are_valid", None)
+        self.step: float | None = None
+        self.euclid = True
+        if batch and callable(are_valid):
+            factor = max(1, int(si.getStateSpace().getValidSegmentCountFactor()))
+            if isinstance(getattr(mv, "step", None), float) and callable(getattr(mv, "check_motions", None)):
+                # BatchedMotionValidator: Euclidean, ceil(|b-a| / step) segments (step / factor)
+                self.step = float(mv.effective_step()) if callable(getattr(mv, "effective_step", None)) else mv.step
+            elif type(mv) is ob.MotionValidator:  # the C++ default, DiscreteMotionValidator
+                self.step = float(si.getStateSpace().getLongestValidSegmentLength()) / factor
+                self.euclid = layout.is_plain
+        self.batched = self.step is not None
+        self._are_valid = are_valid if self.batched else None
+        all_valid = getattr(mv, "all_valid", None)
+        # the project's validator screens a motion's evenly spaced states (straight lines only: no SO2 wrap)
+        self._all_valid = all_valid if self.batched and callable(all_valid) and layout.is_plain else None
+        if self.step is None:  # only for the coarse screening of motions (si.checkMotion decides)
+            factor = max(1, int(si.getStateSpace().getValidSegmentCountFactor()))
+            self._coarse_step = float(si.getStateSpace().getLongestValidSegmentLength()) / factor
+            self.euclid = layout.is_plain
+        else:
+            self._coarse_step = self.step
+        counter_owner = getattr(svc, "robot", svc)
+        self._counter_owner = counter_owner if isinstance(getattr(counter_owner, "collision_checks", None), int) else None
+        self.own_checks = 0
+        self._longest = float(si.getStateSpace().getLongestValidSegmentLength())
+        self._s1, self._s2 = si.allocState(), si.allocState()
+        self.passed: set[bytes] = set()
+        """Keys (:func:`segment_key`) of the motions that passed ``si.checkMotion`` here."""
+
+    def counter(self) -> int:
+        """Configurations checked so far (the robot's counter when available, else our own count)."""
+        return self._counter_owner.collision_checks if self._counter_owner is not None else self.own_checks
+
+    def states(self, Q: np.ndarray) -> np.ndarray:
+        """Validity of configurations Q (m, n)."""
+        if len(Q) == 0:
+            return np.zeros(0, dtype=bool)
+        self.own_checks += len(Q)
+        if self._are_valid is not None:
+            return np.asarray(self._are_valid(Q), dtype=bool)
+        s = self._s1
+        out = np.empty(len(Q), dtype=bool)
+        for k, q in enumerate(Q):
+            self.layout.write(s, q)
+            out[k] = self.si.isValid(s)
+        return out
+
+    def interior(self, A: np.ndarray, B: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Interior states of motions A[k] -> B[k]: (states (M, n), motion index (M,), step index j >= 1).
+
+        SO2 entries move the short way round and are wrapped into [-pi, pi), as ``SO2StateSpace``
+        interpolates."""
+        lay = self.layout
+        if not lay.has_circular:
+            return motion_interior_states(A, B, self._coarse_step, None if self.euclid else lay.distance(A, B))
+        S, idx, j = motion_interior_states(A, A + lay.delta(A, B), self._coarse_step, lay.distance(A, B))
+        return lay.wrap(S), idx, j
+
+    def coarse(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
+        """Whether every 8th interior state of the motions A[k] -> B[k] is valid (one batched call, or
+        per-state checks): most invalid motions already fail here (not all: a thin wall can fit
+        between two of those states)."""
+        K = len(A)
+        if K == 0:
+            return np.ones(0, dtype=bool)
+        S, idx, j = self.interior(A, B)
+        c = j % _COARSE_STRIDE == 0
+        return np.bincount(idx[c][~self.states(S[c])], minlength=K) == 0
+
+    def motions(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
+        """Validity of the motions A[k] -> B[k] (valid ends assumed): :meth:`coarse`, then
+        :meth:`check_motions` for the motions still in question."""
+        out = np.zeros(len(A), dtype=bool)
+        go = np.flatnonzero(self.coarse(A, B))
+        out[go] = self.check_motions(A[go], B[go])
+        return out
+
+    def check_motions(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
+        """:meth:`check_motion` of each motion A[k] -> B[k]; with the project's validator, in one
+        screened call over the very states ``si.checkMotion`` would check (end state included)."""
+        if self._all_valid is None or len(A) < 2:
+            return np.array([self.check_motion(a, b) for a, b in zip(A, B)], dtype=bool)
+        chunks = [unchecked_motion_states(a, b, self.step) for a, b in zip(A, B)]
+        self.own_checks += sum(len(c) for c in chunks)  # at most
+        ok = np.asarray(self._all_valid(chunks), dtype=bool)
+        self.passed.update(segment_key(A[k], B[k]) for k in np.flatnonzero(ok))
+        return ok
+
+    def check_motion(self, a: np.ndarray, b: np.ndarray) -> bool:
+        """``si.checkMotion`` of a -> b (n,); a motion that passes is remembered in :attr:`passed`."""
+        self.layout.write(self._s1, a)
+        self.layout.write(self._s2, b)
+        self.own_checks += max(1, math.ceil(float(self.layout.distance(a, b)) / self._longest))
+        ok = bool(self.si.checkMotion(self._s1, self._s2))
+        if ok:
+            self.passed.add(segment_key(a, b))
+        return ok
+
+    def candidates(
+        self, C: np.ndarray, A: np.ndarray, B: np.ndarray, left_known: np.ndarray, right_known: np.ndarray, strict: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Evaluate candidate waypoints C (m, n) between neighbours A and B (m, n).
+
+        ``left_known[k]`` / ``right_known[k]`` false means that neighbour is invalid, so that motion is
+        invalid without a check.  For ``strict[k]`` candidates only all-valid matters, so the second
+        motion is not finished once one fails.  Returns validity of C, of A->C and of C->B (ends incl.).
+        """
+        m = len(C)
+        vc = self.states(C) if not self.batched else None
+        if self.batched:
+            # pass 1: candidate states + every 8th interior state of motions whose other end is valid
+            SL, iL, jL = self.interior(A, C)
+            SR, iR, jR = self.interior(C, B)
+            cL, cR = (jL % _COARSE_STRIDE == 0) & left_known[iL], (jR % _COARSE_STRIDE == 0) & right_known[iR]
+            ok = self.states(np.concatenate([C, SL[cL], SR[cR]]))
+            vc = ok[:m]
+            nl = int(cL.sum())
+            badL = np.bincount(iL[cL][~ok[m : m + nl]], minlength=m) > 0
+            badR = np.bincount(iR[cR][~ok[m + nl :]], minlength=m) > 0
+            goL = vc & left_known & ~badL
+            goR = vc & right_known & ~badR
+            both = goL & goR
+            goL &= both | ~strict
+            goR &= both | ~strict
+            # pass 2: the remaining interior states of motions still in question
+            if self._all_valid is not None:  # screened by the motion validator: the same verdicts
+                bL, bR = np.searchsorted(iL, np.arange(m + 1)), np.searchsorted(iR, np.arange(m + 1))
+                kL, kR = np.flatnonzero(goL), np.flatnonzero(goR)
+                self.own_checks += int((bL[kL + 1] - bL[kL]).sum() + (bR[kR + 1] - bR[kR]).sum())  # at most
+                ok2 = self._all_valid([SL[bL[k] : bL[k + 1]] for k in kL] + [SR[bR[k] : bR[k + 1]] for k in kR])
+                left, right = goL.copy(), goR.copy()
+                left[kL], right[kR] = ok2[: len(kL)], ok2[len(kL) :]
+                return vc, left, right
+            fL, fR = ~cL & goL[iL], ~cR & goR[iR]
+            ok2 = self.states(np.concatenate([SL[fL], SR[fR]]))
+            nl2 = int(fL.sum())
+            left = goL & (np.bincount(iL[fL][~ok2[:nl2]], minlength=m) == 0)
+            right = goR & (np.bincount(iR[fR][~ok2[nl2:]], minlength=m) == 0)
+            return vc, left, right
+        left = np.zeros(m, dtype=bool)
+        right = np.zeros(m, dtype=bool)
+        for k in range(m):
+            if not vc[k]:
+                continue
+            if left_known[k]:
+                left[k] = self.check_motion(A[k], C[k])
+            if right_known[k] and (left[k] or not strict[k]):
+                right[k] = self.check_motion(C[k], B[k])
+        return vc, left, right
