@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from tpee_ompl.planning.layered_trees import LayeredTrees
 
@@ -26,6 +27,34 @@ def test_killing_a_node_kills_its_subtree_and_hides_it_from_nearest() -> None:
     fi, _ = trees.nearest(np.array([0.45, 0.5]))
     assert b not in fi and a not in fi
     assert all(len(idx) and trees.fwd.alive[idx].all() for _, idx in trees.fwd.layer_sizes())
+
+
+@pytest.mark.parametrize("hold", [True, False])
+def test_nearest_is_the_closest_live_node_of_the_allowed_steps_lowest_index_on_ties(hold: bool) -> None:
+    rng = np.random.default_rng(11)
+    h = 7
+    W = np.linspace([0.0, 0.0], [1.0, 0.0], h)
+    trees = LayeredTrees(W, np.r_[True, np.zeros(h - 2, bool), True], np.zeros(h - 1, bool), np.array([0, 1]),
+                         hold=hold, delta=_delta)
+    grid = np.round(rng.uniform(-1, 1, (40, 2)) * 4) / 4  # coarse values: many equal distances
+    for tree, lo, hi in ((trees.fwd, 0, h - 2), (trees.bwd, 2, h)):
+        for x in grid:
+            step = int(rng.integers(lo, hi))
+            parents = np.flatnonzero(tree.steps[: len(tree)] < step) if tree is trees.fwd else \
+                np.flatnonzero(tree.steps[: len(tree)] > step)
+            if len(parents):
+                tree.add(x, step, int(rng.choice(parents)))
+        tree.kill(int(rng.integers(1, len(tree))))
+    for c in np.round(rng.uniform(-1, 1, (30, 2)) * 4) / 4:
+        fi, bi = trees.nearest(c)
+        for t in range(1, h - 1):
+            for tree, got, allowed in ((trees.fwd, fi[t - 1], (lambda s: s <= t - 1) if hold else (lambda s: s == t - 1)),
+                                       (trees.bwd, bi[t - 1], (lambda s: s >= t + 1) if hold else (lambda s: s == t + 1))):
+                n = len(tree)
+                ok = tree.alive[:n] & allowed(tree.steps[:n])
+                d2 = ((tree.values[:n] - c) ** 2).sum(axis=1)
+                want = int(np.argmin(np.where(ok, d2, np.inf))) if ok.any() else -1
+                assert got == want
 
 
 def test_candidate_path_names_the_node_each_segment_leads_into() -> None:

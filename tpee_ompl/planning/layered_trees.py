@@ -16,6 +16,7 @@ waypoints than steps; :func:`spread_waypoints` puts the repeated ones back on it
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 
 import numpy as np
@@ -70,10 +71,31 @@ class Tree:
         return [(int(s), np.flatnonzero((st == s) & live)) for s in np.unique(st[live])]
 
 
-def _nearest(d2: np.ndarray, ok: np.ndarray) -> int:
-    if not ok.any():
-        return -1
-    return int(np.argmin(np.where(ok, d2, np.inf)))
+def _nearest_per_step(tree: Tree, c: np.ndarray, delta: Callable[[np.ndarray, np.ndarray], np.ndarray],
+                      h: int) -> list[tuple[float, int]]:
+    """For each step s < h: (squared distance, index) of the live node of step s nearest to c (the lowest
+    index among equals), or (inf, -1)."""
+    live = np.flatnonzero(tree.alive[: len(tree)])
+    out = [(math.inf, -1)] * h
+    if not len(live):
+        return out
+    d2 = tree.sq_dist(c, delta)[live]
+    steps = tree.steps[live]
+    order = np.lexsort((live, d2, steps))  # by step, then distance, then index
+    first = np.flatnonzero(np.r_[True, steps[order][1:] != steps[order][:-1]])
+    for k in order[first].tolist():
+        out[int(steps[k])] = (float(d2[k]), int(live[k]))
+    return out
+
+
+def _running_best(best: list[tuple[float, int]]) -> list[tuple[float, int]]:
+    """Prefix minimum of (distance, index) pairs: the nearest over steps 0..s, lowest index among equals."""
+    out, cur = [], (math.inf, -1)
+    for d, i in best:
+        if i >= 0 and (d < cur[0] or (d == cur[0] and (cur[1] < 0 or i < cur[1]))):
+            cur = (d, i)
+        out.append(cur)
+    return out
 
 
 class LayeredTrees:
@@ -103,15 +125,12 @@ class LayeredTrees:
         """For each intermediate step t = 1 .. h-2: the nearest forward node that can precede c at t
         (step t-1, or any step <= t-1 when holding) and the nearest backward node that can follow
         it (step t+1, or >= t+1); -1 where there is none."""
-        df, db = self.fwd.sq_dist(c, self.delta), self.bwd.sq_dist(c, self.delta)
-        nf, nb = len(self.fwd), len(self.bwd)
-        sf, sb = self.fwd.steps[:nf], self.bwd.steps[:nb]
-        af, ab = self.fwd.alive[:nf], self.bwd.alive[:nb]
-        fi, bi = [], []
-        for t in range(1, self.h - 1):
-            fi.append(_nearest(df, af & (sf <= t - 1 if self.hold else sf == t - 1)))
-            bi.append(_nearest(db, ab & (sb >= t + 1 if self.hold else sb == t + 1)))
-        return fi, bi
+        h = self.h
+        bf = _nearest_per_step(self.fwd, c, self.delta, h)
+        bb = _nearest_per_step(self.bwd, c, self.delta, h)
+        if self.hold:  # the nearest over all steps before (forward) / after (backward)
+            bf, bb = _running_best(bf), _running_best(bb[::-1])[::-1]
+        return [bf[t - 1][1] for t in range(1, h - 1)], [bb[t + 1][1] for t in range(1, h - 1)]
 
     def anchor(self, u: float) -> np.ndarray:
         """Values of a live tree node picked by u in [0, 1): a uniform step of either tree, then a uniform node."""
