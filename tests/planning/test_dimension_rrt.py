@@ -239,3 +239,24 @@ def test_stall_samples_stop_a_converged_run_before_its_cap(robot: WearerArm) -> 
     assert stats["samples"] == max(improvements, default=0) + 200  # exactly `stall` samples after the last gain
     with pytest.raises(ValueError, match="stall_samples"):
         tpee_dimension_rrt(ss.getSpaceInformation(), 1, 2, stall_samples=0)
+
+
+def test_termination_condition_is_asked_at_each_sample_checkpoint_and_between_batches(robot: WearerArm) -> None:
+    q = load_queries("planning_necessary")[1]
+    ss = make_simple_setup(robot, q.start, q.goal)
+    planner = tpee_dimension_rrt(ss.getSpaceInformation(), q.from_sector, q.to_sector, max_samples=1500, seed=4)
+    planner.set_sample_checkpoints([300, 777, 1000])
+    ss.setPlanner(planner)
+    seen: list[int] = []
+    ptc = ob.PlannerTerminationCondition(lambda: seen.append(planner.samples_drawn()) or False)
+    assert ss.solve(ptc) == ob.PlannerStatus.EXACT_SOLUTION
+    assert {300, 777, 1000} <= set(seen) and seen == sorted(seen)
+    assert len(seen) < 1500 and planner.samples_drawn() == 1500  # rejected samples are passed over in batches
+    cost = planner.last_run_stats()["best_cost"]
+    same = tpee_dimension_rrt(ss.getSpaceInformation(), q.from_sector, q.to_sector, max_samples=1500, seed=4)
+    ss.clear()
+    ss.setPlanner(same)
+    ss.solve(30.0)
+    assert same.last_run_stats()["best_cost"] == cost  # the stops change nothing
+    with pytest.raises(ValueError, match="sample checkpoint"):
+        planner.set_sample_checkpoints([0])

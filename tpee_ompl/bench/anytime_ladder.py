@@ -111,6 +111,9 @@ class TimeCheckpointPlanner(CheckpointPlanner):
             return super()._count()
         return None
 
+    def _sample_stops(self) -> list[int]:
+        return []  # the checkpoints are times
+
     def _due(self, n: int | None, now: float) -> list:
         return [b for b in sorted(self._run["todo"]) if now >= b]
 

@@ -10,8 +10,9 @@ at each smaller cap N what a run stopped there would have returned:
   vertex RRT* marks (its best goal motion).  The path is the goal vertex's chain of parents (each
   vertex of the tree has one incoming edge); without a goal vertex it is RRT*'s approximate solution,
   the vertex nearest the goal (solution difference = that distance).  ``best_cost`` is ``bestCost()``.
-* **dimension-RRT** (a Python planner): its loop evaluates the termination condition once per sample,
-  so the (N+1)-th call sees the search after N samples.  Its best path is the last one it posted
+* **dimension-RRT** (a Python planner): its loop evaluates the termination condition between batches
+  of samples, and exactly after sample N when N is one of its ``set_sample_checkpoints``; the call
+  that sees ``samples_drawn() == N`` sees the search after N samples.  Its best path is the last one it posted
   (its intermediate-solution callback) when that is the best it found (the last cost of its progress
   trace); when the best was still waiting to be posted (posting is throttled by time), the row comes
   from a separate run of a fresh planner capped at N with the same seed, after the benchmark.
@@ -148,9 +149,16 @@ class CheckpointPlanner(RecordingPlanner):
     def _count(self) -> int | None:
         """The search's position at this termination check: samples so far (Python) or RRT*'s iterations."""
         if self.python:
+            drawn = getattr(self.inner, "samples_drawn", None)
+            if callable(drawn):  # dimension-RRT asks once per batch of samples, so count them, not the calls
+                return int(drawn())
             self._run["calls"] += 1
             return self._run["calls"] - 1
         return self.inner.numIterations()
+
+    def _sample_stops(self) -> list[int]:
+        """The sample counts at which a Python planner must ask the termination condition."""
+        return self.checkpoints
 
     def _due(self, n: int | None, now: float) -> list:
         """The checkpoints reached at this termination check."""
@@ -196,6 +204,8 @@ class CheckpointPlanner(RecordingPlanner):
         self._run = {"t0": time.perf_counter(), "calls": 0, "todo": set(self.checkpoints), "snaps": {}}
         if self.python:
             self.inner.set_intermediate_solution_callback(self._on_solution)
+            if callable(getattr(self.inner, "set_sample_checkpoints", None)):
+                self.inner.set_sample_checkpoints(self._sample_stops())
         watched = ob.plannerOrTerminationCondition(ptc, ob.PlannerTerminationCondition(self._watch))
         try:
             return super().solve(watched)

@@ -257,6 +257,8 @@ class DimensionRRT(PythonPlanner):
         self._initial = initial
         self._callback: Callable[[ob.Planner, list[ob.State], ob.Cost], object] | None = None
         self._callback_failed = False
+        self._sample_checkpoints: tuple[int, ...] = ()
+        self._samples_drawn = 0
 
     @staticmethod
     def _check_initial(grouped: GroupedSpace, W: np.ndarray | None) -> np.ndarray | None:
@@ -298,6 +300,18 @@ class DimensionRRT(PythonPlanner):
         if callback is not None and not callable(callback):
             raise ValueError(f"callback must be callable or None, got {type(callback).__name__}")
         self._callback = callback
+
+    def set_sample_checkpoints(self, counts: Sequence[int]) -> None:
+        """Make the termination condition be asked exactly when the run has drawn each of ``counts``
+        samples (the loop otherwise asks it once per batch of samples the cost test rejects, see
+        :meth:`Search.iterate <tpee_ompl.planning.dimension_search.Search.iterate>`); a condition that
+        reads :meth:`samples_drawn` then sees the search as a run capped there would end.  The path
+        found does not depend on it."""
+        self._sample_checkpoints = tuple(sorted({check_int("sample checkpoint", c, minimum=1) for c in counts}))
+
+    def samples_drawn(self) -> int:
+        """Samples drawn so far in the current (or last) solve: what the termination condition sees."""
+        return self._samples_drawn
 
     def _notify(self, path: og.PathGeometric, cost: float) -> None:
         cb = self._callback
@@ -348,6 +362,7 @@ class DimensionRRT(PythonPlanner):
 
     def _start_run(self) -> None:
         super()._start_run()
+        self._samples_drawn = 0
         self._callback_failed = False
 
     def _solve(self, ptc: ob.PlannerTerminationCondition) -> ob.PlannerStatus:
@@ -382,6 +397,7 @@ class DimensionRRT(PythonPlanner):
             poster.offer(search.W, search.cost, time.perf_counter())
         record(time.perf_counter())
         stall, improved_at = self.options.stall_samples, 0
+        stops = self._sample_checkpoints
         while not poster.satisfied and not ptc() and (cap is None or done + search.samples < cap):
             if stall is not None and math.isfinite(poster.found_cost) and search.samples - improved_at >= stall:
                 break  # converged: nothing shorter in the last ``stall`` samples
@@ -392,10 +408,14 @@ class DimensionRRT(PythonPlanner):
                                 self._ranges, None)
                 log.info("DimensionRRT: no path after %d samples, h raised to %d", done, grouped.h)
                 continue
-            limit = _PASS_BATCH if cap is None else min(_PASS_BATCH, cap - done - search.samples)
+            drawn = done + search.samples
+            limit = _PASS_BATCH if cap is None else min(_PASS_BATCH, cap - drawn)
             if stall is not None:
                 limit = min(limit, stall - (search.samples - improved_at))
+            if stops and drawn < stops[-1]:
+                limit = min(limit, next(s for s in stops if s > drawn) - drawn)
             accepted = search.iterate(max(1, limit))
+            self._samples_drawn = done + search.samples
             now = time.perf_counter()
             if accepted and search.valid and search.cost < poster.found_cost:
                 poster.offer(search.W, search.cost, now)
