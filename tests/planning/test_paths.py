@@ -70,6 +70,11 @@ def test_interior_and_polyline_states_are_motion_states(rng: np.random.Generator
         want = motion_states(A[m], B[m], 0.07)[:-1]  # without the end state
         np.testing.assert_array_equal(S[k == m], want)
         np.testing.assert_array_equal(j[k == m], np.arange(1, len(want) + 1))
+    S8, k8, j8 = motion_interior_states(A, B, 0.07, stride=8)  # the multiples of 8 only, the same numbers
+    every8 = j % 8 == 0
+    np.testing.assert_array_equal(S8, S[every8])
+    np.testing.assert_array_equal(k8, k[every8])
+    np.testing.assert_array_equal(j8, j[every8])
     S2, k2, _ = motion_interior_states(A, B, 0.07, lengths=2 * np.sqrt(((B - A) ** 2).sum(-1)))
     assert len(S2) > len(S)  # another metric, other segment counts
     P = rng.uniform(-1, 1, (6, 3))

@@ -183,22 +183,23 @@ def unchecked_motion_states(a: np.ndarray, b: np.ndarray, step: float, include_s
 
 
 def motion_interior_states(
-    A: np.ndarray, B: np.ndarray, step: float, lengths: np.ndarray | None = None
+    A: np.ndarray, B: np.ndarray, step: float, lengths: np.ndarray | None = None, stride: int = 1
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Interior states of the motions A[k] -> B[k] (K, n), as OMPL's discrete motion validator picks them.
 
     Motion k has ``n_k = max(1, ceil(d_k / step))`` segments, ``d_k`` being ``lengths[k]`` (the
     space's metric; default Euclidean ``|B[k] - A[k]|``).  Returns its interior states
-    ``A[k] + (j / n_k)(B[k] - A[k])``, j = 1 .. n_k - 1, for all motions at once, in motion order:
-    ``(states (M, n), motion index k (M,), step index j (M,))``.  Neither end is included (unlike
-    :func:`motion_states`).  Not validated: it runs in planners' inner loops.
+    ``A[k] + (j / n_k)(B[k] - A[k])``, j = 1 .. n_k - 1 (only the multiples of ``stride``), for all
+    motions at once, in motion order: ``(states (M, n), motion index k (M,), step index j (M,))``.
+    Neither end is included (unlike :func:`motion_states`).  Not validated: it runs in planners' inner
+    loops.
     """
     d = np.sqrt(((B - A) ** 2).sum(-1)) if lengths is None else lengths
     nd = np.maximum(1, np.ceil(d / step)).astype(int)
-    cnt = nd - 1
+    cnt = (nd - 1) // stride
     total = int(cnt.sum())
     idx = np.repeat(np.arange(len(A)), cnt)
-    j = np.arange(total) - np.repeat(np.cumsum(cnt) - cnt, cnt) + 1
+    j = (np.arange(total) - np.repeat(np.cumsum(cnt) - cnt, cnt) + 1) * stride
     frac = j / nd[idx]
     return A[idx] + frac[:, None] * (B[idx] - A[idx]), idx, j
 

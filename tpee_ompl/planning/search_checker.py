@@ -83,15 +83,16 @@ class Checker:
             out[k] = self.si.isValid(s)
         return out
 
-    def interior(self, A: np.ndarray, B: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Interior states of motions A[k] -> B[k]: (states (M, n), motion index (M,), step index j >= 1).
+    def interior(self, A: np.ndarray, B: np.ndarray, stride: int = 1) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Interior states of motions A[k] -> B[k]: (states (M, n), motion index (M,), step index j >= 1;
+        only the multiples of ``stride``).
 
         SO2 entries move the short way round and are wrapped into [-pi, pi), as ``SO2StateSpace``
         interpolates."""
         lay = self.layout
         if not lay.has_circular:
-            return motion_interior_states(A, B, self._coarse_step, None if self.euclid else lay.distance(A, B))
-        S, idx, j = motion_interior_states(A, A + lay.delta(A, B), self._coarse_step, lay.distance(A, B))
+            return motion_interior_states(A, B, self._coarse_step, None if self.euclid else lay.distance(A, B), stride)
+        S, idx, j = motion_interior_states(A, A + lay.delta(A, B), self._coarse_step, lay.distance(A, B), stride)
         return lay.wrap(S), idx, j
 
     def coarse(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
@@ -101,9 +102,8 @@ class Checker:
         K = len(A)
         if K == 0:
             return np.ones(0, dtype=bool)
-        S, idx, j = self.interior(A, B)
-        c = j % _COARSE_STRIDE == 0
-        return np.bincount(idx[c][~self.states(S[c])], minlength=K) == 0
+        S, idx, _ = self.interior(A, B, _COARSE_STRIDE)
+        return np.bincount(idx[~self.states(S)], minlength=K) == 0
 
     def motions(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
         """Validity of the motions A[k] -> B[k] (valid ends assumed): :meth:`coarse`, then
