@@ -26,7 +26,9 @@ def test_killing_a_node_kills_its_subtree_and_hides_it_from_nearest() -> None:
     assert not trees.fwd.alive[a] and not trees.fwd.alive[b] and trees.fwd.alive[other]
     fi, _ = trees.nearest(np.array([0.45, 0.5]))
     assert b not in fi and a not in fi
-    assert all(len(idx) and trees.fwd.alive[idx].all() for _, idx in trees.fwd.layer_sizes())
+    live, start, count = trees.fwd.layers()
+    assert trees.fwd.alive[live].all() and (count > 0).all() and count.sum() == len(live)
+    assert (np.diff(trees.fwd.steps[live]) >= 0).all() and len(start) == len(np.unique(trees.fwd.steps[live]))
 
 
 @pytest.mark.parametrize("hold", [True, False])

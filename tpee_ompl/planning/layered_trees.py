@@ -64,11 +64,14 @@ class Tree:
         D = delta(self.values[: len(self.parents)], x)
         return np.einsum("ij,ij->i", D, D)
 
-    def layer_sizes(self) -> list[tuple[int, np.ndarray]]:
-        """(step, live node indices) of each step with live nodes, steps ascending."""
-        n = len(self.parents)
-        st, live = self.steps[:n], self.alive[:n]
-        return [(int(s), np.flatnonzero((st == s) & live)) for s in np.unique(st[live])]
+    def layers(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The live nodes ordered by step, then index, with each step's start in that order and its count."""
+        live = np.flatnonzero(self.alive[: len(self.parents)])
+        st = self.steps[live]
+        order = np.argsort(st, kind="stable")
+        live, st = live[order], st[order]
+        start = np.flatnonzero(np.concatenate(([True], st[1:] != st[:-1]))) if len(st) else np.zeros(0, dtype=int)
+        return live, start, np.diff(np.append(start, len(st)))
 
 
 def _nearest_per_step(tree: Tree, c: np.ndarray, delta: Callable[[np.ndarray, np.ndarray], np.ndarray],
@@ -82,7 +85,8 @@ def _nearest_per_step(tree: Tree, c: np.ndarray, delta: Callable[[np.ndarray, np
     d2 = tree.sq_dist(c, delta)[live]
     steps = tree.steps[live]
     order = np.lexsort((live, d2, steps))  # by step, then distance, then index
-    first = np.flatnonzero(np.r_[True, steps[order][1:] != steps[order][:-1]])
+    so = steps[order]
+    first = np.flatnonzero(np.concatenate(([True], so[1:] != so[:-1])))
     for k in order[first].tolist():
         out[int(steps[k])] = (float(d2[k]), int(live[k]))
     return out
@@ -134,10 +138,15 @@ class LayeredTrees:
 
     def anchor(self, u: float) -> np.ndarray:
         """Values of a live tree node picked by u in [0, 1): a uniform step of either tree, then a uniform node."""
-        layers = [(tree, idx) for tree in (self.fwd, self.bwd) for _, idx in tree.layer_sizes()]
-        x = u * len(layers)
-        tree, idx = layers[int(x)]
-        return tree.values[idx[int((x - int(x)) * len(idx))]]
+        layers = [(tree, live, start, count) for tree in (self.fwd, self.bwd) for live, start, count in [tree.layers()]]
+        total = sum(len(count) for _, _, _, count in layers)
+        x = u * total
+        k = int(x)
+        for tree, live, start, count in layers:
+            if k < len(count):
+                return tree.values[live[start[k] + int((x - int(x)) * count[k])]]
+            k -= len(count)
+        raise AssertionError("a layered tree without live nodes")
 
     def path(self, t: int, c: np.ndarray, f: int, b: int) -> tuple[np.ndarray, dict[int, tuple[str, int]]]:
         """The waypoints (h, n) through forward node f, c at step t, backward node b (held nodes repeated).
