@@ -117,3 +117,15 @@ def test_so2_leaves_wrap_around_like_the_space() -> None:
     np.testing.assert_allclose(lay.interpolate(a, b, 0.25), lay.read(m), atol=1e-12)
     mid = lay.interpolate(a, b, 0.5)
     assert abs(abs(mid[0]) - np.pi) < 1e-9
+
+
+def test_plain_layout_writes_and_reads_a_state_exactly() -> None:
+    space = ob.RealVectorStateSpace(5)
+    space.setBounds(-2.0, 2.0)
+    lay = RealVectorLayout(space)
+    assert lay.is_plain
+    x = ob.SpaceInformation(space).allocState()
+    q = np.array([0.1, -1.9, 1e-17, 2.0, -0.3333333333333333])
+    assert lay.write(x, q) is x
+    np.testing.assert_array_equal(lay.read(x), q)
+    assert [x[i] for i in range(5)] == q.tolist()

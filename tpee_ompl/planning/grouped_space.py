@@ -220,6 +220,9 @@ class RealVectorLayout:
     def write(self, state: ob.State, values: np.ndarray) -> ob.State:
         """Write a flat array (n,) into the state; return the state."""
         values = np.asarray(values, dtype=float)
+        if self.is_plain:  # the state is the RealVector state itself: one slice assignment
+            state[0 : self.n] = values.tolist()
+            return state
         for (path, d, _, so2), sl in zip(self._leaves, self._slices):
             if so2:
                 self._leaf(state, path).value = float(values[sl][0])
