@@ -92,12 +92,16 @@ class Search:
     def cost(self) -> float:
         return float(self.L.sum())
 
-    def _next_random(self, k: int) -> tuple[np.ndarray, np.ndarray]:
-        """Buffered randomness for one sample: 3 + k uniforms and k standard normals."""
+    def _refill(self, k: int) -> None:
+        """A fresh buffer of randomness (1024 samples of k DOFs) when the current one is used up or of another k."""
         if self._ui >= len(self._uniform) or self._uniform.shape[1] != k + 3:
             self._uniform = self.rng.random((1024, k + 3))
             self._normal = self.rng.standard_normal((1024, k))
             self._ui = 0
+
+    def _next_random(self, k: int) -> tuple[np.ndarray, np.ndarray]:
+        """Buffered randomness for one sample: 3 + k uniforms and k standard normals."""
+        self._refill(k)
         i = self._ui
         self._ui += 1
         return self._uniform[i], self._normal[i]
@@ -119,16 +123,33 @@ class Search:
                 sigma = span * _REPAIR_SIGMA[0] * (_REPAIR_SIGMA[1] / _REPAIR_SIGMA[0]) ** u[2]
                 return np.clip(anchor + sigma * z, lo, hi)
             return lo + u[3:] * span
+        C, n0 = self._group_draws(gi, u[None, :])
+        if n0 is not None and self.narrow_start[gi] is None:
+            self.narrow_start[gi] = n0
+        return C[0]
+
+    def _group_draws(self, gi: int, U: np.ndarray) -> tuple[np.ndarray, int | None]:
+        """The next len(U) samples of group gi from the random rows U (m, k + 3), narrowed or uniform as
+        :meth:`draw` draws them one by one (the path W unchanged in between), and the group's narrowing
+        start they imply (None: not narrowing yet)."""
+        lo, hi = self._bounds[gi]
+        span = hi - lo
+        C = lo + U[:, 3:] * span
+        g0 = self.group_samples[gi]
         n0 = self.narrow_start[gi]
-        if n0 is None and self.group_samples[gi] >= self.narrow_after:
-            n0 = self.narrow_start[gi] = self.group_samples[gi]
-        if n0 is not None and u[0] >= _UNIFORM_FRACTION:
-            m = self.group_samples[gi] - n0
-            pad = np.maximum(self.range_[gi], span * self.narrowing ** (m / _NARROWING_UNIT))
-            vals = self.W[:, d]
-            lo = np.maximum(lo, vals.min(axis=0) - pad)
-            hi = np.minimum(hi, vals.max(axis=0) + pad)
-        return lo + u[3:] * (hi - lo)
+        if n0 is None and g0 + len(U) - 1 >= self.narrow_after:
+            n0 = max(g0, self.narrow_after)
+        if n0 is not None:
+            g = g0 + np.arange(len(U))
+            narrow = np.flatnonzero((g >= n0) & (U[:, 0] >= _UNIFORM_FRACTION))
+            if len(narrow):
+                scale = np.array([self.narrowing ** ((int(m) - n0) / _NARROWING_UNIT) for m in g[narrow]])
+                pad = np.maximum(self.range_[gi], span * scale[:, None])
+                vals = self.W[:, self._dims[gi]]
+                nlo = np.maximum(lo, vals.min(axis=0) - pad)
+                nhi = np.minimum(hi, vals.max(axis=0) + pad)
+                C[narrow] = nlo + U[narrow, 3:] * (nhi - nlo)
+        return C, n0
 
     def iterate(self, limit: int = 1) -> int:
         """Draw one sample and try it at every intermediate step (up to ``limit`` samples on a valid path).
@@ -158,32 +179,12 @@ class Search:
         would not: :meth:`draw` and the cost test of :meth:`_improve` for many samples at once."""
         gi = self.current_group()
         d = self._dims[gi]
-        k = len(d)
-        if self._ui >= len(self._uniform) or self._uniform.shape[1] != k + 3:
-            self._uniform = self.rng.random((1024, k + 3))
-            self._normal = self.rng.standard_normal((1024, k))
-            self._ui = 0
+        self._refill(len(d))
         n = min(limit, _GROUP_BLOCK - self.samples % _GROUP_BLOCK, len(self._uniform) - self._ui)
         if n <= 0:
             return
-        U = self._uniform[self._ui : self._ui + n]
-        lo, hi = self._bounds[gi]
-        span = hi - lo
-        C = lo + U[:, 3:] * (hi - lo)
         g0 = self.group_samples[gi]
-        n0 = self.narrow_start[gi]
-        if n0 is None and g0 + n - 1 >= self.narrow_after:
-            n0 = max(g0, self.narrow_after)
-        if n0 is not None:
-            g = g0 + np.arange(n)
-            narrow = np.flatnonzero((g >= n0) & (U[:, 0] >= _UNIFORM_FRACTION))
-            if len(narrow):
-                scale = np.array([self.narrowing ** ((int(m) - n0) / _NARROWING_UNIT) for m in g[narrow]])
-                pad = np.maximum(self.range_[gi], span * scale[:, None])
-                vals = self.W[:, d]
-                nlo = np.maximum(lo, vals.min(axis=0) - pad)
-                nhi = np.minimum(hi, vals.max(axis=0) + pad)
-                C[narrow] = nlo + U[narrow, 3:] * (nhi - nlo)
+        C, n0 = self._group_draws(gi, self._uniform[self._ui : self._ui + n])
         W, L = self.W, self.L
         X = np.broadcast_to(W[1:-1], (n,) + W[1:-1].shape).copy()
         X[:, :, d] = C[:, None, :]
