@@ -103,6 +103,62 @@ def test_iterate_passing_over_rejected_samples_matches_one_sample_per_call(limit
     assert many.narrow_start == one.narrow_start and many.group_samples == one.group_samples
 
 
+class _ThinWalls(ob.StateValidityChecker):
+    """3-D box with three thin walls across x (boxes invalid inside)."""
+
+    WALLS = [((-0.31, -1, -1), (-0.30, 0.7, 1)), ((0.30, -0.7, -1), (0.31, 1, 1)), ((-0.01, -1, -1), (0.0, 0.2, 1))]
+
+    def are_valid(self, Q: np.ndarray) -> np.ndarray:
+        Q = np.atleast_2d(Q)
+        ok = np.ones(len(Q), dtype=bool)
+        for lo, hi in self.WALLS:
+            ok &= ~np.all((Q >= lo) & (Q <= hi), axis=1)
+        return ok
+
+    def isValid(self, state: ob.State) -> bool:  # noqa: N802 (OMPL override)
+        return bool(self.are_valid(np.array([[state[i] for i in range(3)]]))[0])
+
+
+def test_with_a_prescribed_group_a_sample_joins_the_trees_at_every_step_it_can() -> None:
+    space = ob.RealVectorStateSpace(3)
+    space.setBounds(-1.0, 1.0)
+    si = ob.SpaceInformation(space)
+    walls = _ThinWalls(si)
+    si.setStateValidityChecker(walls)
+    si.setStateValidityCheckingResolution(0.002)
+    si.setup()
+    h = 9
+    grouped = GroupedSpace(si, [[0, 1], [2]], h, {1: np.linspace(-0.5, 0.5, h)[:, None]})
+    search = Search(grouped, Checker(si, grouped.layout, True), np.random.default_rng(6), np.array([-0.8, 0, -0.5]),
+                    np.array([0.8, 0, 0.5]), narrow_after=100, narrowing=0.5, range_={0: np.full(2, 0.02)})
+    z = np.linspace(-0.5, 0.5, h)  # the prescribed DOF at each step
+    checked = 0
+    while not search.valid and search.samples < 400:
+        before = [(len(t), t.alive[: len(t)].copy(), t.steps[: len(t)].copy()) for t in (search.trees.fwd, search.trees.bwd)] \
+            if search.trees is not None else None
+        search.iterate()
+        if before is None or search.valid:
+            continue
+        for tree, (n, alive, steps), sgn in zip((search.trees.fwd, search.trees.bwd), before, (-1, 1)):
+            new = np.arange(n, len(tree))
+            if not len(new):
+                continue
+            c = tree.values[new[0]]
+            assert (tree.values[new] == c).all()  # one sample per iteration
+            missing = []
+            d2 = ((tree.values[:n] - c) ** 2).sum(axis=1)
+            for t in range(1, h - 1):
+                at = alive & (steps == t + sgn)
+                nearest = int(np.argmin(np.where(at, d2, np.inf))) if at.any() else -1  # its parent there
+                if nearest >= 0 and tree.alive[nearest] and walls.are_valid(np.r_[c, z[t]])[0]:
+                    checked += 1
+                    if t not in tree.steps[new]:
+                        missing.append(t)
+            # only at the step whose candidate path was tried does c join through checked motions alone
+            assert len(missing) <= 1, f"sample not added at steps {missing}"
+    assert checked > 100  # the property was exercised
+
+
 class _Band(ob.StateValidityChecker):
     """Two continuous joints; invalid where the first is within 0.5 rad of 0 (so never near +-pi)."""
 

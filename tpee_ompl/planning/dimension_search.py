@@ -89,6 +89,12 @@ class Search:
         return bool(self.V.all() and self.E.all())
 
     @property
+    def trees(self) -> LayeredTrees | None:
+        """The feasibility phase's layered trees (None before the first sample without a valid path, and
+        once a path exists): for inspection; the search owns them."""
+        return self._tree
+
+    @property
     def cost(self) -> float:
         return float(self.L.sum())
 
@@ -272,7 +278,7 @@ class Search:
             adds = [(tr, int(p[k]), ts[k]) for k in range(len(ts)) if k != tried and vc[k]
                     for tr, p in ((tree.fwd, fi), (tree.bwd, bi)) if p[k] >= 0]
         for tr, p, t in adds:
-            if not tr.alive[p] or id(tr) in joined:  # a node killed above; holding: joined already
+            if not tr.alive[p] or (self._hold and id(tr) in joined):  # a node killed above; holding: joined already
                 continue
             if self._hold:  # checked in full: coarse screening let the trees through thin walls
                 ct, pt = base[t].copy(), base[int(tr.steps[p])].copy()
