@@ -198,3 +198,38 @@ def test_batched_checker_moves_continuous_joints_the_short_way_round() -> None:
     band.seen.clear()
     assert checker.motions(A, B).all() and checker.coarse(A, B).all()
     assert all(np.all(np.abs(Q[:, 0]) >= 3.0 - 1e-12) for Q in band.seen)
+
+
+class _LowBand(ob.StateValidityChecker):
+    """SO2, SO2, RealVector(2): invalid where the first joint is within 0.5 rad of 0 and x < 0.5."""
+
+    def are_valid(self, Q: np.ndarray) -> np.ndarray:
+        Q = np.atleast_2d(Q)
+        return ~((np.abs(Q[:, 0]) < 0.5) & (Q[:, 2] < 0.5))
+
+    def isValid(self, state: ob.State) -> bool:  # noqa: N802 (OMPL override)
+        return bool(self.are_valid(np.array([[state[0].value, state[1].value, state[2][0], state[2][1]]]))[0])
+
+
+@pytest.mark.parametrize("groups", [[[0], [1], [2], [3]], [[2], [1], [0], [3]]])
+def test_trees_over_continuous_joints_with_a_prescribed_group_find_a_valid_path(groups) -> None:
+    space = ob.CompoundStateSpace()
+    space.addSubspace(ob.SO2StateSpace(), 1.0)
+    space.addSubspace(ob.SO2StateSpace(), 0.5)
+    box = ob.RealVectorStateSpace(2)
+    box.setBounds(-1.0, 1.0)
+    space.addSubspace(box, 2.0)
+    si = ob.SpaceInformation(space)
+    si.setStateValidityChecker(_LowBand(si))
+    si.setup()
+    grouped = GroupedSpace(si, groups, 7, {3: np.zeros((7, 1))})  # the last DOF prescribed: the trees hold 3 of 4
+    search = Search(grouped, Checker(si, grouped.layout, True), np.random.default_rng(0), np.array([-1.0, 3.0, -0.8, 0.0]),
+                    np.array([1.0, -3.0, 0.8, 0.0]), narrow_after=200, narrowing=0.5,
+                    range_={gi: np.full(1, 0.02) for gi in grouped.planned})
+    assert not search.valid
+    while not search.valid and search.samples < 3000:
+        search.iterate()
+    assert search.valid
+    a, b = si.allocState(), si.allocState()
+    lay = grouped.layout
+    assert all(si.checkMotion(lay.write(a, p), lay.write(b, q)) for p, q in zip(search.W[:-1], search.W[1:]))

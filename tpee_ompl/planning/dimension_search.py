@@ -9,6 +9,8 @@ definition, so it can be driven and tested without one; validity comes from
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from .grouped_space import GroupedSpace
@@ -173,7 +175,8 @@ class Search:
         gi = self.current_group()
         valid = self.valid
         if not valid and self._tree is None:
-            self._tree = LayeredTrees(self.W, self.V, self.E, self._fdims, self._hold, self.delta)
+            self._tree = LayeredTrees(self.W, self.V, self.E, self._fdims, self._hold,
+                                      functools.partial(self.delta, dims=self._fdims))  # nodes hold these DOFs
         c = self.draw(gi if valid else None)
         self.samples += 1
         self.group_samples[gi] += 1

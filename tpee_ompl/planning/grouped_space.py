@@ -238,11 +238,13 @@ class RealVectorLayout:
         X[..., self.circular] = np.mod(X[..., self.circular] + math.pi, 2.0 * math.pi) - math.pi
         return X
 
-    def delta(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
-        """B - A, with SO2 entries taken the short way round (in [-pi, pi))."""
+    def delta(self, A: np.ndarray, B: np.ndarray, dims: np.ndarray | None = None) -> np.ndarray:
+        """B - A, with SO2 entries taken the short way round (in [-pi, pi)).  ``dims``: A and B hold only
+        these entries of the flat vector, in this order (default: all of them)."""
         D = np.asarray(B, dtype=float) - np.asarray(A, dtype=float)
         if self.has_circular:
-            D[..., self.circular] = np.mod(D[..., self.circular] + math.pi, 2.0 * math.pi) - math.pi
+            circular = self.circular if dims is None else self.circular[dims]
+            D[..., circular] = np.mod(D[..., circular] + math.pi, 2.0 * math.pi) - math.pi
         return D
 
     def interpolate(self, A: np.ndarray, B: np.ndarray, t: np.ndarray | float) -> np.ndarray:
