@@ -212,6 +212,8 @@ class CheckpointPlanner(RecordingPlanner):
         finally:
             if self.python:
                 self.inner.set_intermediate_solution_callback(None)
+                if callable(getattr(self.inner, "set_sample_checkpoints", None)):
+                    self.inner.set_sample_checkpoints([])
             self.snapshots.append(self._run["snaps"])
 
 
