@@ -65,7 +65,12 @@ checker's batched ``are_valid(Q)`` when it has one (improvement: two calls per s
 candidates plus every 8th interior motion state, then the remaining interior states of the
 survivors); otherwise per-state ``si.isValid`` and per-motion ``si.checkMotion``.  Motion states
 are those OMPL's discrete motion validator checks (SO2 entries the short way round).  A motion
-that passed ``si.checkMotion`` in the search is not checked again when its path is posted.
+that passed ``si.checkMotion`` in the search is not checked again when its path is posted.  Most
+samples on a valid path fail the cost test at every step (94 % in 500 samples on the wearer); up to
+64 of them are drawn and passed over in one vectorised step (the same random numbers and the same
+paths as one sample at a time), and the termination condition is asked between such batches and at
+the sample counts given to :meth:`DimensionRRT.set_sample_checkpoints` (what a benchmark ladder
+reads, with :meth:`DimensionRRT.samples_drawn`).
 
 Stopping like an OMPL planner: each improved path is added to the problem definition as it is found
 (so ``ob.exactSolnPlannerTerminationCondition(pdef)`` stops at the first), after every segment not
