@@ -2,6 +2,7 @@
 
     PYTHONPATH=. .venv/bin/python experiments/first_path.py                       # both parts, ~2 min
     PYTHONPATH=. .venv/bin/python experiments/first_path.py --queries planning_necessary --max-queries 24
+    PYTHONPATH=. .venv/bin/python experiments/first_path.py --skip-overhead --reps 5   # medians over 5 runs per query
     PYTHONPATH=. .venv/bin/python experiments/first_path.py --skip-home           # overhead only
 
 Home: for every query of each named set (the wearer, ``make_simple_setup`` with its batched motion
@@ -41,6 +42,8 @@ def get_argument_parser() -> argparse.ArgumentParser:
     p.add_argument("--max-queries", type=int, default=None, help="first N queries of each set")
     p.add_argument("--limit", type=float, default=1.0, help="time limit per first-path run, s")
     p.add_argument("--samples", type=int, default=2000, help="sample cap of the overhead run")
+    p.add_argument("--reps", type=int, default=1,
+                   help="runs per query and planner at home (RRTConnect is unseeded here: its times vary run to run)")
     p.add_argument("--skip-home", action="store_true")
     p.add_argument("--skip-overhead", action="store_true")
     return p
@@ -69,12 +72,13 @@ def home(args: argparse.Namespace) -> None:
         for k, q in enumerate(qs):
             ss = make_simple_setup(robot, q.start, q.goal)
             si = ss.getSpaceInformation()
-            c0 = robot.collision_checks
-            rc.append(_first(ss, og.RRTConnect(si), args.limit))
-            c1 = robot.collision_checks
-            dr.append(_first(ss, tpee_dimension_rrt(si, q.from_sector, q.to_sector, seed=k), args.limit))
-            rc_checks.append(c1 - c0)
-            dr_checks.append(robot.collision_checks - c1)
+            for _ in range(args.reps):  # alternating, so both planners see the same machine state
+                c0 = robot.collision_checks
+                rc.append(_first(ss, og.RRTConnect(si), args.limit))
+                c1 = robot.collision_checks
+                dr.append(_first(ss, tpee_dimension_rrt(si, q.from_sector, q.to_sector, seed=k), args.limit))
+                rc_checks.append(c1 - c0)
+                dr_checks.append(robot.collision_checks - c1)
         r = [x for x in rc if x is not None]
         d = [x for x in dr if x is not None]
         print(f"home {name:20s} queries {len(qs):4d}  solved D/R {len(d)}/{len(r)}  "
