@@ -138,7 +138,7 @@ class LayeredTrees:
 
     def anchor(self, u: float) -> np.ndarray:
         """Values of a live tree node picked by u in [0, 1): a uniform step of either tree, then a uniform node."""
-        layers = [(tree, live, start, count) for tree in (self.fwd, self.bwd) for live, start, count in [tree.layers()]]
+        layers = [(tree, *tree.layers()) for tree in (self.fwd, self.bwd)]
         total = sum(len(count) for _, _, _, count in layers)
         x = u * total
         k = int(x)
