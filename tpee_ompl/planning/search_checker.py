@@ -14,7 +14,7 @@ import numpy as np
 from ompl import base as ob
 
 from .grouped_space import RealVectorLayout
-from .paths import motion_interior_states, unchecked_motion_states
+from .paths import motion_interior_states
 
 __all__ = ["Checker", "segment_key"]
 
@@ -51,6 +51,8 @@ class Checker:
         all_valid = getattr(mv, "all_valid", None)
         # the project's validator screens a motion's evenly spaced states (straight lines only: no SO2 wrap)
         self._all_valid = all_valid if self.batched and callable(all_valid) and layout.is_plain else None
+        # the project's validators check many straight motions at once, each as its checkMotion would
+        self._check_motions = mv.check_motions if self._all_valid is not None else None
         if self.step is None:  # only for the coarse screening of motions (si.checkMotion decides)
             factor = max(1, int(si.getStateSpace().getValidSegmentCountFactor()))
             self._coarse_step = float(si.getStateSpace().getLongestValidSegmentLength()) / factor
@@ -114,13 +116,12 @@ class Checker:
         return out
 
     def check_motions(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
-        """:meth:`check_motion` of each motion A[k] -> B[k]; with the project's validator, in one
-        screened call over the very states ``si.checkMotion`` would check (end state included)."""
-        if self._all_valid is None or len(A) < 2:
+        """:meth:`check_motion` of each motion A[k] -> B[k]; with the project's validator, through its own
+        ``check_motions`` (all motions batched together, each with ``checkMotion``'s verdict)."""
+        if self._check_motions is None or len(A) < 2:
             return np.array([self.check_motion(a, b) for a, b in zip(A, B)], dtype=bool)
-        chunks = [unchecked_motion_states(a, b, self.step) for a, b in zip(A, B)]
-        self.own_checks += sum(len(c) for c in chunks)  # at most
-        ok = np.asarray(self._all_valid(chunks), dtype=bool)
+        self.own_checks += int(np.maximum(1, np.ceil(np.sqrt(((B - A) ** 2).sum(-1)) / self.step)).sum())  # at most
+        ok = np.asarray(self._check_motions(A, B), dtype=bool)
         self.passed.update(segment_key(A[k], B[k]) for k in np.flatnonzero(ok))
         return ok
 
