@@ -57,13 +57,14 @@ def test_checker_motions_match_check_motion_and_remember_those_that_passed(robot
     assert checker.passed == {segment_key(p, q) for p, q, w in zip(A, B, want) if w}
 
 
+@pytest.mark.parametrize("connect", [True, False])
 @pytest.mark.parametrize("batch", [True, False])
-def test_search_finds_a_valid_path_around_the_box_and_only_shortens_it(batch: bool) -> None:
+def test_search_finds_a_valid_path_around_the_box_and_only_shortens_it(batch: bool, connect: bool) -> None:
     si, _ = box_problem(lo=(-0.2, -1.0), hi=(0.2, 0.6))  # a wall with a gap at the top
     grouped = GroupedSpace(si, [[0, 1]], 7)
     start, goal = np.array([-0.8, 0.0]), np.array([0.8, 0.0])
     search = Search(grouped, Checker(si, grouped.layout, batch), np.random.default_rng(3), start, goal,
-                    narrow_after=200, narrowing=0.5, range_={0: np.full(2, 0.04)})
+                    narrow_after=200, narrowing=0.5, range_={0: np.full(2, 0.04)}, connect=connect)
     assert not search.valid and search.cost == pytest.approx(1.6)
     while not search.valid and search.samples < 3000:
         search.iterate()
@@ -233,3 +234,42 @@ def test_trees_over_continuous_joints_with_a_prescribed_group_find_a_valid_path(
     a, b = si.allocState(), si.allocState()
     lay = grouped.layout
     assert all(si.checkMotion(lay.write(a, p), lay.write(b, q)) for p, q in zip(search.W[:-1], search.W[1:]))
+
+
+class _TwoWalls(ob.StateValidityChecker):
+    """2-D: a wall from the bottom at x in [-0.4, -0.3] (y < 0.6), one from the top at x in [0.3, 0.4] (y > -0.6)."""
+
+    def isValid(self, state: ob.State) -> bool:  # noqa: N802 (OMPL override)
+        x, y = state[0], state[1]
+        return not ((-0.4 < x < -0.3 and y < 0.6) or (0.3 < x < 0.4 and y > -0.6))
+
+
+def _two_walls_search(h: int, seed: int) -> tuple[ob.SpaceInformation, Search]:
+    space = ob.RealVectorStateSpace(2)
+    space.setBounds(-1.0, 1.0)
+    si = ob.SpaceInformation(space)
+    si.setStateValidityChecker(_TwoWalls(si))
+    si.setStateValidityCheckingResolution(0.005)
+    si.setup()
+    grouped = GroupedSpace(si, [[0], [1]], h)
+    return si, Search(grouped, Checker(si, grouped.layout, False), np.random.default_rng(seed), np.array([-0.9, -0.9]),
+                      np.array([0.9, 0.9]), narrow_after=200, narrowing=0.5, range_={0: np.full(1, 0.04), 1: np.full(1, 0.04)})
+
+
+def test_connect_path_is_fitted_to_the_steps_with_every_step_on_it_after_the_next_sample() -> None:
+    si, search = _two_walls_search(7, 0)
+    while not search.valid and search.samples < 3000:
+        search.iterate()
+    assert search.valid and search.trees is None  # found by the connect trees, no layered trees
+    assert path_passes_motion_checks(si, search.W)
+    search.iterate()  # the held waypoints are spread over the path's segments
+    assert path_passes_motion_checks(si, search.W)
+    assert np.all(np.linalg.norm(np.diff(search.W, axis=0), axis=1) > 0)
+
+
+def test_connect_path_with_more_turns_than_steps_seeds_the_layered_trees() -> None:
+    si, search = _two_walls_search(3, 0)  # 2 segments; the walls need 4
+    while search.trees is None and search.samples < 3000:
+        search.iterate()
+    assert not search.valid and search.trees is not None and search.trees.hold
+    assert len(search.trees.fwd) + len(search.trees.bwd) >= 2

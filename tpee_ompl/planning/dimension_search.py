@@ -13,9 +13,10 @@ import functools
 
 import numpy as np
 
+from .connect_trees import RANGE_FRACTION, ConnectTrees
 from .grouped_space import GroupedSpace
 from .layered_trees import LayeredTrees, spread_waypoints
-from .search_checker import Checker
+from .search_checker import Checker, segment_key
 
 __all__ = ["Search"]
 
@@ -45,6 +46,7 @@ class Search:
         narrowing: float,
         range_: np.ndarray,
         initial: np.ndarray | None = None,
+        connect: bool = True,
     ) -> None:
         self.g = grouped
         self.checker = checker
@@ -72,6 +74,9 @@ class Search:
         self._dims = {gi: grouped.group_dims(gi) for gi in grouped.planned}
         self._bounds = {gi: grouped.group_bounds(gi) for gi in grouped.planned}
         self._tree: LayeredTrees | None = None
+        self._connect: ConnectTrees | None = None
+        self._use_connect = connect
+        self._spread_pending = False
         self._known: dict[bytes, bool] = {W[k : k + 2].tobytes(): bool(self.E[k]) for k in range(len(W) - 1)
                                           if self.V[k] and self.V[k + 1]}
         """Segment (two waypoint rows as bytes) -> motion valid, for every motion checked so far."""
@@ -170,13 +175,20 @@ class Search:
         first passed over in one vectorised step (at most ``limit - 1`` of them): they change nothing
         but the counters, so the result is that of as many single calls, with the same random numbers.
         """
-        if limit > 1 and self.valid:
+        if self._spread_pending:
+            self._spread()
+        valid = self.valid
+        if limit > 1 and valid:
             self._pass_rejected(limit - 1)
         gi = self.current_group()
-        valid = self.valid
-        if not valid and self._tree is None:
-            self._tree = LayeredTrees(self.W, self.V, self.E, self._fdims, self._hold,
-                                      functools.partial(self.delta, dims=self._fdims))  # nodes hold these DOFs
+        if not valid and self._tree is None and self._connect is None:
+            if self._hold and self._use_connect and len(self._fdims) == self.g.n:
+                self._use_connect = False  # once per search: a path that does not fit hands over to layered trees
+                span = float(self.checker.si.getMaximumExtent())
+                self._connect = ConnectTrees(self.W, self.V, self.E, self.g.layout, RANGE_FRACTION * span,
+                                             self._tree_motions)
+            else:
+                self._tree = self._layered(self.W, self.V, self.E)
         c = self.draw(gi if valid else None)
         self.samples += 1
         self.group_samples[gi] += 1
@@ -207,6 +219,75 @@ class Search:
         if self.narrow_start[gi] is None and n0 is not None and g0 + j - 1 >= n0:
             self.narrow_start[gi] = n0
 
+    def _layered(self, W: np.ndarray, V: np.ndarray, E: np.ndarray) -> LayeredTrees:
+        return LayeredTrees(W, V, E, self._fdims, self._hold,
+                            functools.partial(self.delta, dims=self._fdims))  # nodes hold these DOFs
+
+    def _tree_motions(self, A: np.ndarray, B: np.ndarray, starts: bool) -> int:
+        """The connect trees' checks of the motions A[k] -> B[k] (and of A[k] when ``starts``), in full:
+        how many pass before the first that does not (batched: every 8th state of all of them first;
+        else in order, stopping at the first failure, as RRTConnect).  Passes are remembered."""
+        checker = self.checker
+        if checker.batched:
+            ok = checker.states(A) if starts else np.ones(len(A), dtype=bool)
+            go = np.flatnonzero(ok)
+            ok[go] = checker.motions(A[go], B[go])
+            n = len(ok) if ok.all() else int(ok.argmin())
+        else:
+            n = 0
+            while n < len(A) and (not starts or checker.states(A[n : n + 1])[0]) and checker.check_motion(A[n], B[n]):
+                n += 1
+        for k in range(n):
+            self._known[segment_key(A[k], B[k])] = True
+        return n
+
+    def _connect_step(self, c: np.ndarray) -> int:
+        """Feasibility phase without prescribed groups: one RRTConnect iteration; once the trees meet,
+        the path is fitted to the h steps (:meth:`_fit`), or handed to the layered trees when it
+        cannot be."""
+        x = self.W[0].copy()
+        x[self._fdims] = c
+        P = self._connect.step(x)
+        if P is None:
+            return 0
+        self._connect = None
+        if self._fit(P):
+            return 1
+        # more turns than steps: its waypoints at h evenly spaced points seed the layered trees
+        lay = self.g.layout
+        s = np.concatenate(([0.0], np.cumsum(lay.distance(P[:-1], P[1:]))))
+        at = np.linspace(0.0, s[-1], self.g.h)
+        k = np.clip(np.searchsorted(s, at, side="right") - 1, 0, len(P) - 2)
+        W = lay.interpolate(P[k], P[k + 1], np.clip((at - s[k]) / np.maximum(s[k + 1] - s[k], 1e-300), 0.0, 1.0))
+        W[0], W[-1] = self.W[0], self.W[-1]
+        V = np.ones(len(W), dtype=bool)
+        V[1:-1] = self.checker.states(W[1:-1])
+        E = V[:-1] & V[1:]
+        E[E] = self.checker.motions(W[:-1][E], W[1:][E])
+        self._tree = self._layered(W, V, E)
+        return 0
+
+    def _fit(self, P: np.ndarray) -> bool:
+        """Take the turning points P (K, n) from start to goal as the path when they fit the h steps.
+
+        While K > h, the interior point whose shortcut saves most and passes in full is dropped; the
+        straight runs are checked as whole motions; the path is adopted with its points held and
+        then spread over its segments (:meth:`_adopt`).  False when it does not fit or a check fails."""
+        h, dist = self.g.h, self.dist
+        while len(P) > h:
+            gain = dist(P[:-2], P[1:-1]) + dist(P[1:-1], P[2:]) - dist(P[:-2], P[2:])
+            for i in (np.argsort(-gain, kind="stable") + 1).tolist():
+                if not self._check_segments(P[[i - 1, i + 1]]):
+                    P = np.delete(P, i, axis=0)
+                    break
+            else:
+                return False
+        W = np.vstack([P, np.repeat(P[-1:], h - len(P), axis=0)])
+        if self._check_segments(W):
+            return False
+        self._adopt(W)
+        return True
+
     def _grow(self, c: np.ndarray) -> int:
         """Feasibility phase: grow the layered trees with the sample c, motions checked lazily.
 
@@ -220,6 +301,8 @@ class Search:
         backward step whose motion passes in full (coarse screening alone let trees grow through
         thin walls there).  Returns 1 when the path is complete, else 0.
         """
+        if self._connect is not None:
+            return self._connect_step(c)
         tree = self._tree
         d = tree.dims
         h = self.g.h
@@ -325,16 +408,23 @@ class Search:
     def _adopt(self, W: np.ndarray) -> None:
         """Take W (h, n), checked by the trees, as the current (valid) path.
 
-        Held (repeated) waypoints are first spread along the path's segments when the spread path
-        passes the checker too, so every fake-time step can take part in the improvement."""
-        if self._hold:
-            S = spread_waypoints(W, self.g.layout.interpolate, self.dist)
-            if S is not W and self.checker.states(S[1:-1]).all() and self.checker.motions(S[:-1], S[1:]).all():
-                W = S
+        Held (repeated) waypoints are spread along the path's segments at the next :meth:`iterate`
+        (:meth:`_spread`), so the path can be posted first and every fake-time step then takes part
+        in the improvement."""
         self.W[:] = W
         self.V[:] = True
         self.E[:] = True
         self.L[:] = self.dist(W[:-1], W[1:])
+        self._spread_pending = self._hold
+
+    def _spread(self) -> None:
+        """Move held waypoints onto the path's segments, kept only when that path passes the checker."""
+        self._spread_pending = False
+        W = self.W
+        S = spread_waypoints(W, self.g.layout.interpolate, self.dist)
+        if S is not W and self.checker.states(S[1:-1]).all() and self.checker.motions(S[:-1], S[1:]).all():
+            self.W[:] = S
+            self.L[:] = self.dist(S[:-1], S[1:])
 
     def _improve(self, gi: int, c: np.ndarray) -> int:
         """Paper's rule on a valid path: replace W[t] when valid, connected and shorter."""

@@ -129,7 +129,8 @@ class Checker:
         """``si.checkMotion`` of a -> b (n,); a motion that passes is remembered in :attr:`passed`."""
         self.layout.write(self._s1, a)
         self.layout.write(self._s2, b)
-        self.own_checks += max(1, math.ceil(float(self.layout.distance(a, b)) / self._longest))
+        d = math.dist(a, b) if self.layout.is_plain else float(self.layout.distance(a, b))
+        self.own_checks += max(1, math.ceil(d / self._longest))
         ok = bool(self.si.checkMotion(self._s1, self._s2))
         if ok:
             self.passed.add(segment_key(a, b))
