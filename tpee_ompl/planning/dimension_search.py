@@ -1,7 +1,8 @@
 """The dimension-RRT search on a waypoint array, in numpy: what :class:`~tpee_ompl.planning.dimension_rrt.DimensionRRT` runs.
 
 :class:`Search` holds the current path ``W`` (h, n) and does one sample per :meth:`Search.iterate`
-(improvement on a valid path, else the feasibility phase's :class:`LayeredTrees`).  The algorithm is
+(improvement on a valid path, else the feasibility phase: :class:`ConnectTrees` without prescribed
+groups, :class:`LayeredTrees` with them or when a connect path does not fit the h steps).  The algorithm is
 described in :mod:`tpee_ompl.planning.dimension_rrt`; nothing here touches the planner's OMPL problem
 definition, so it can be driven and tested without one; validity comes from
 :class:`~tpee_ompl.planning.search_checker.Checker`.
@@ -97,8 +98,8 @@ class Search:
 
     @property
     def trees(self) -> LayeredTrees | None:
-        """The feasibility phase's layered trees (None before the first sample without a valid path, and
-        once a path exists): for inspection; the search owns them."""
+        """The feasibility phase's layered trees (None before the first sample without a valid path, while
+        the connect trees search, and once a path exists): for inspection; the search owns them."""
         return self._tree
 
     @property
@@ -422,7 +423,7 @@ class Search:
         self._spread_pending = False
         W = self.W
         S = spread_waypoints(W, self.g.layout.interpolate, self.dist)
-        if S is not W and self.checker.states(S[1:-1]).all() and self.checker.motions(S[:-1], S[1:]).all():
+        if S is not W and self.checker.states(S[1:-1]).all() and not self._check_segments(S):  # new segments only
             self.W[:] = S
             self.L[:] = self.dist(S[:-1], S[1:])
 
