@@ -146,3 +146,21 @@ def test_one_run_ladders_give_the_database_of_separate_runs(tmp_path, robot):
     assert all(r[2] == r[0] for r in rows[True])
     first_rrtstar = [[r for r in rows[k] if r[0] == 60 and r[1].endswith("RRTstar")][0] for k in dbs]
     assert first_rrtstar[0][6] == first_rrtstar[1][6]  # the first experiment of both processes: same RNG state
+
+
+def test_checkpoint_columns_write_waypoints_of_a_compound_so2_space():
+    from tpee_ompl.bench.ladder import Ladder
+
+    space = ob.CompoundStateSpace()
+    for _ in range(2):
+        space.addSubspace(ob.SO2StateSpace(), 1.0)
+    si = ob.SpaceInformation(space)
+    si.setStateValidityChecker(lambda s: True)
+    si.setup()
+    pdef = ob.ProblemDefinition(si)
+    snap = {"waypoints": [[3.0, -3.0], [-3.0, 3.0]], "exact": True, "time": 0.1, "valid_fraction": 1.0,
+            "difference": 0.0}
+    row = Ladder._ompl_columns(si, pdef, {}, snap, simplify=False)
+    short_way = 2 * (2 * 3.141592653589793 - 6.0)  # each joint wraps round through pi
+    assert float(row["solution length REAL"]) == pytest.approx(short_way)
+    assert row["correct solution BOOLEAN"] in ("1", "True", "true")

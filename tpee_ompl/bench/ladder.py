@@ -36,6 +36,7 @@ from ompl import base as ob
 from ompl import geometric as og
 from ompl import tools as ot
 
+from ..planning.grouped_space import RealVectorLayout
 from .planners import PlannerContext, RecordingPlanner, planner_factory
 from .results import format_value
 
@@ -309,13 +310,8 @@ class Ladder:
             row["graph motions INTEGER"] = str(snap["graph_motions"])
         if W is None:
             return row
-        path = og.PathGeometric(si)
-        for w in W:
-            s = si.allocState()
-            for i, v in enumerate(w):
-                s[i] = float(v)
-            path.append(s)
         space = si.getStateSpace()
+        path = RealVectorLayout(space).to_path(si, W)  # SO2 compounds too
         factor = space.getValidSegmentCountFactor()
 
         def describe(p, prefix: str) -> dict:
