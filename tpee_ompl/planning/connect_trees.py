@@ -92,7 +92,7 @@ class ConnectTrees:
         D = target - values if not lay.has_circular else lay.delta(values, target)  # node -> target
         d2 = np.einsum("ij,ij->i", D, D)
         i = int(d2.argmin())
-        a = values[i].copy()
+        a = values[i]  # a view: nothing is added to the tree before its last use
         d = math.sqrt(float(d2[i])) if lay.is_plain else float(lay.distance(a, target))
         if d == 0.0:
             return -1 if single else i

@@ -52,10 +52,10 @@ steps: while there are more than ``h``, the interior point whose shortcut saves 
 dropped; the points are held (repeated) to fill the steps, the path is posted, and the next sample
 first spreads the held points over its segments (kept when that path passes the checker).  A path
 that cannot be fitted seeds the layered trees above with its points at ``h`` evenly spaced places.
-Measured on plain-OMPL problems with a Python validity checker (``experiments/foreign_problems.py``):
-the first path on planar arms with 4-8 joints went from 2.5-12.6x RRTConnect's time to 1.1-4x, on a
-3-D narrow passage from 16-56x to 3.6-10x (the rest there is Python per sample against a 1.5 us
-checker), with equal or shorter paths after 1 s.  With a prescribed group (the TPEE case) the
+Measured on plain-OMPL problems with a Python validity checker (``experiments/foreign_problems.py
+--layered``, both in one run): the first path on planar arms with 4-8 joints went from 2.2-8.1x
+RRTConnect's time to 0.8-3.9x, on a 3-D narrow passage from 14-48x to 4.2-5.8x (the rest there is
+Python per sample against a 1.5 us checker), with equal or shorter paths after 1 s.  With a prescribed group (the TPEE case) the
 layered trees stay: a waypoint's prescribed values depend on its step.
 
 Raising h (sec. 4.1.3 names the limit: with ``h`` fixed, a path has at most ``h - 1`` segments, and
