@@ -6,7 +6,7 @@ one from the goal as OMPL's RRTConnect does: per sample, the tree whose turn it 
 it by at most ``range`` (the motion checked in full), then the other tree connects to the new node
 in steps of at most ``range`` until it reaches it or a step is blocked; the trees then swap.  Motions
 are checked in the direction a path runs (goal tree: node towards its parent), as RRTConnect checks
-them.  Seeded with the valid prefix and suffix of the base path.
+them.  Seeded with the valid prefix and suffix of the base path (the search passes a first guess only).
 
 The result is the path's turning points: the steps of one connect lie on one straight line and
 count as one segment (that longer motion is checked again, as one motion, when the path is fitted

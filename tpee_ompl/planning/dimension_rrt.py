@@ -45,8 +45,10 @@ coarse screening makes the first path slower than full checks would (``experimen
 Without prescribed groups (``connect=True``, the default) the first path is searched differently:
 a waypoint's configuration then does not depend on its step, so two trees grow as OMPL's RRTConnect
 grows them (:mod:`tpee_ompl.planning.connect_trees`: uniform samples from the planner's own seeded
-generator, steps of at most 0.2 x the space's maximum extent, every motion checked in full), seeded
-with the valid prefix and suffix of the initial path.  Once they meet, the path's turning points (a
+generator, steps of at most 0.2 x the space's maximum extent, every motion checked in full), from
+the start and the goal alone (with ``initial_waypoints``: from their valid prefix and suffix; the
+straight line's prefix pinned the trees to the obstacle it ends at, a 4-D wall with a hole needed
+77-193 samples instead of 5-38).  Once they meet, the path's turning points (a
 connect's collinear steps are one segment, checked again as one motion) are fitted to the ``h``
 steps: while there are more than ``h``, the interior point whose shortcut saves most and passes is
 dropped; the points are held (repeated) to fill the steps, the path is posted, and the next sample

@@ -77,6 +77,7 @@ class Search:
         self._tree: LayeredTrees | None = None
         self._connect: ConnectTrees | None = None
         self._use_connect = connect
+        self._guess = initial is not None
         self._spread_pending = False
         self._known: dict[bytes, bool] = {W[k : k + 2].tobytes(): bool(self.E[k]) for k in range(len(W) - 1)
                                           if self.V[k] and self.V[k + 1]}
@@ -186,8 +187,13 @@ class Search:
             if self._hold and self._use_connect and len(self._fdims) == self.g.n:
                 self._use_connect = False  # once per search: a path that does not fit hands over to layered trees
                 span = float(self.checker.si.getMaximumExtent())
-                self._connect = ConnectTrees(self.W, self.V, self.E, self.g.layout, RANGE_FRACTION * span,
-                                             self._tree_motions)
+                # from the start and goal alone, as RRTConnect's, unless a first guess was given: the
+                # straight line's valid prefix pinned the trees to the wall it ends at (4-D hole:
+                # median samples to a first path 77-193 -> 5-38)
+                V = self.V.copy()
+                if not self._guess:
+                    V[1:-1] = False
+                self._connect = ConnectTrees(self.W, V, self.E, self.g.layout, RANGE_FRACTION * span, self._tree_motions)
             else:
                 self._tree = self._layered(self.W, self.V, self.E)
         c = self.draw(gi if valid else None)
