@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 from ompl import base as ob
@@ -60,6 +62,19 @@ def test_max_h_raises_h_by_inserting_steps_until_a_path_exists() -> None:
     assert path_passes_motion_checks(ss.getSpaceInformation(), path)
     again, _ = _solve(ss, h=3, max_samples=6000, max_h=17)
     assert again.last_run_stats()["best_cost"] == st["best_cost"]  # deterministic under seed and cap
+
+
+def test_a_connect_path_with_more_turns_than_steps_raises_h_at_once() -> None:
+    ss = _two_walls()
+
+    def samples_to_first_path(**kw) -> int:
+        planner, status = _solve(ss, h=3, max_samples=3000, max_h=17, **kw)
+        assert status == ob.PlannerStatus.EXACT_SOLUTION
+        assert path_passes_motion_checks(ss.getSpaceInformation(), ss.getSolutionPath())
+        return next(n for _, cost, n in planner.last_run_stats()["progress"] if math.isfinite(cost))
+
+    # the layered trees need over 1000 samples here (h raised after 500 without a path each time)
+    assert samples_to_first_path() < 500 < samples_to_first_path(connect=False)
 
 
 def test_refined_space_keeps_prescribed_rows_at_even_steps_on_the_same_polyline() -> None:

@@ -70,3 +70,19 @@ def test_candidate_path_names_the_node_each_segment_leads_into() -> None:
     np.testing.assert_allclose(path[[0, -1]], W[[0, -1]])
     assert owners[0] == ("f", f) and owners[1] == ("c", -1) and owners[2] == ("c", -1)
     assert owners[4] == ("b", b) and 3 not in owners  # steps 3 and 4 both hold b (a zero-length motion)
+
+
+def test_spread_keeps_the_distinct_waypoints_bit_for_bit_and_moves_only_repeated_ones() -> None:
+    from tpee_ompl.planning.layered_trees import spread_waypoints
+
+    rng = np.random.default_rng(4)
+    P = rng.uniform(-2.9, 2.9, (4, 3))
+    W = np.vstack([P[:2], P[1:2], P[2:], P[3:], P[3:]])  # held: row 1 once, the goal twice
+
+    def interpolate(A, B, t):
+        return A + np.asarray(t)[..., None] * (B - A)
+
+    S = spread_waypoints(W, interpolate, lambda A, B: np.linalg.norm(B - A, axis=-1))
+    assert len(S) == len(W) and np.all(np.linalg.norm(np.diff(S, axis=0), axis=1) > 0)
+    for p in P:  # each kept waypoint is in S exactly (not interpolated at 1.0)
+        assert any(np.array_equal(p, s) for s in S)

@@ -90,10 +90,15 @@ class ConnectTrees:
         tree, lay = self.trees[k], self.layout
         values = tree.values[: len(tree)]
         D = target - values if not lay.has_circular else lay.delta(values, target)  # node -> target
-        d2 = np.einsum("ij,ij->i", D, D)
-        i = int(d2.argmin())
+        if lay.is_plain:
+            d2 = np.einsum("ij,ij->i", D, D)
+            i = int(d2.argmin())
+            d = math.sqrt(float(d2[i]))
+        else:  # the space's own metric (weighted subspace distances), as OMPL's nearest neighbours use
+            dist = lay.distance(values, target)
+            i = int(dist.argmin())
+            d = float(dist[i])
         a = values[i]  # a view: nothing is added to the tree before its last use
-        d = math.sqrt(float(d2[i])) if lay.is_plain else float(lay.distance(a, target))
         if d == 0.0:
             return -1 if single else i
         if single:

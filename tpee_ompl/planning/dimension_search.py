@@ -48,6 +48,7 @@ class Search:
         range_: np.ndarray,
         initial: np.ndarray | None = None,
         connect: bool = True,
+        turns: np.ndarray | None = None,
     ) -> None:
         self.g = grouped
         self.checker = checker
@@ -78,6 +79,8 @@ class Search:
         self._connect: ConnectTrees | None = None
         self._use_connect = connect
         self._guess = initial is not None
+        self.unfitted: np.ndarray | None = None
+        """Turning points of a connect-tree path that did not fit the h steps (None: no such path)."""
         self._spread_pending = False
         self._known: dict[bytes, bool] = {W[k : k + 2].tobytes(): bool(self.E[k]) for k in range(len(W) - 1)
                                           if self.V[k] and self.V[k + 1]}
@@ -92,6 +95,9 @@ class Search:
         self._uniform = np.empty((0, 0))
         self._normal = np.empty((0, 0))
         self._ui = 0
+        if turns is not None and not self.valid:  # a connect path found with fewer steps (h raised)
+            self._use_connect = False
+            self._fit(turns)
 
     @property
     def valid(self) -> bool:
@@ -170,8 +176,9 @@ class Search:
         """Draw one sample and try it at every intermediate step (up to ``limit`` samples on a valid path).
 
         On a valid path the sample is the current group's (paper's rule); before, it covers all
-        planned groups at once and grows the layered trees.  Returns the number of waypoints
-        changed (feasibility phase: 1 when the layered trees connected, 0 otherwise).
+        planned groups at once and grows the connect trees (no prescribed group) or the layered
+        trees.  Returns the number of waypoints changed (feasibility phase: 1 when a path was found,
+        0 otherwise).
 
         With ``limit > 1`` on a valid path, the samples that the cost test rejects at every step are
         first passed over in one vectorised step (at most ``limit - 1`` of them): they change nothing
@@ -184,7 +191,9 @@ class Search:
             self._pass_rejected(limit - 1)
         gi = self.current_group()
         if not valid and self._tree is None and self._connect is None:
-            if self._hold and self._use_connect and len(self._fdims) == self.g.n:
+            if self.unfitted is not None:  # a connect path with more turns than steps seeds the layered trees
+                self._tree = self._layered(*self._seed_path(self.unfitted))
+            elif self._hold and self._use_connect:
                 self._use_connect = False  # once per search: a path that does not fit hands over to layered trees
                 span = float(self.checker.si.getMaximumExtent())
                 # from the start and goal alone, as RRTConnect's, unless a first guess was given: the
@@ -258,9 +267,11 @@ class Search:
         if P is None:
             return 0
         self._connect = None
-        if self._fit(P):
-            return 1
-        # more turns than steps: its waypoints at h evenly spaced points seed the layered trees
+        return int(self._fit(P))
+
+    def _seed_path(self, P: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The polyline P (K, n) from start to goal at h evenly spaced points, with the validity of
+        those waypoints and of the motions between them (checked motions remembered)."""
         lay = self.g.layout
         s = np.concatenate(([0.0], np.cumsum(lay.distance(P[:-1], P[1:]))))
         at = np.linspace(0.0, s[-1], self.g.h)
@@ -271,15 +282,18 @@ class Search:
         V[1:-1] = self.checker.states(W[1:-1])
         E = V[:-1] & V[1:]
         E[E] = self.checker.motions(W[:-1][E], W[1:][E])
-        self._tree = self._layered(W, V, E)
-        return 0
+        for k in np.flatnonzero(V[:-1] & V[1:]):
+            self._known[W[k : k + 2].tobytes()] = bool(E[k])
+        return W, V, E
 
     def _fit(self, P: np.ndarray) -> bool:
         """Take the turning points P (K, n) from start to goal as the path when they fit the h steps.
 
         While K > h, the interior point whose shortcut saves most and passes in full is dropped; the
         straight runs are checked as whole motions; the path is adopted with its points held and
-        then spread over its segments (:meth:`_adopt`).  False when it does not fit or a check fails."""
+        then spread over its segments (:meth:`_adopt`).  False when it does not fit (more points
+        than steps after the shortcuts) or a straight run fails as one motion (rare: its steps
+        passed); :attr:`unfitted` then holds the points, for a higher h or the layered trees."""
         h, dist = self.g.h, self.dist
         while len(P) > h:
             gain = dist(P[:-2], P[1:-1]) + dist(P[1:-1], P[2:]) - dist(P[:-2], P[2:])
@@ -288,15 +302,18 @@ class Search:
                     P = np.delete(P, i, axis=0)
                     break
             else:
+                self.unfitted = P
                 return False
         W = np.vstack([P, np.repeat(P[-1:], h - len(P), axis=0)])
         if self._check_segments(W):
+            self.unfitted = P
             return False
         self._adopt(W)
         return True
 
     def _grow(self, c: np.ndarray) -> int:
-        """Feasibility phase: grow the layered trees with the sample c, motions checked lazily.
+        """Feasibility phase: one connect-tree iteration (:meth:`_connect_step`), else grow the layered
+        trees with the sample c, motions checked lazily.
 
         c is checked as a waypoint at every step t that has a forward node before it or a backward
         node after it (once when holding: the configuration is then the same at every step).  Of the

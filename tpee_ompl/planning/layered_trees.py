@@ -198,6 +198,8 @@ def spread_waypoints(W: np.ndarray, interpolate: Callable[[np.ndarray, np.ndarra
     out = [P[:1]]
     for k in range(len(L)):
         frac = np.arange(1, pieces[k] + 1) / pieces[k]
-        out.append(interpolate(np.broadcast_to(P[k], (len(frac), P.shape[1])),
-                               np.broadcast_to(P[k + 1], (len(frac), P.shape[1])), frac))
+        run = interpolate(np.broadcast_to(P[k], (len(frac), P.shape[1])),
+                          np.broadcast_to(P[k + 1], (len(frac), P.shape[1])), frac)
+        run[-1] = P[k + 1]  # the kept waypoint itself, not its value interpolated at 1.0
+        out.append(run)
     return np.vstack(out)
