@@ -55,8 +55,8 @@ dropped; the points are held (repeated) to fill the steps, the path is posted, a
 first spreads the held points over its segments (kept when that path passes the checker).  A path
 that cannot be fitted seeds the layered trees above with its points at ``h`` evenly spaced places.
 Measured on plain-OMPL problems with a Python validity checker (``experiments/foreign_problems.py
---layered``, both in one run): the first path on planar arms with 4-8 joints went from 1.7-8.5x
-RRTConnect's time to 0.8-2.6x, on a 3-D narrow passage from 13-31x to 2.1-3.3x (the rest there is
+--layered``, both in one run): the first path on planar arms with 4-8 joints went from 1.4-7.4x
+RRTConnect's time to 0.7-2.4x, on a 3-D narrow passage from 26-48x to 2.8-4.4x (the rest there is
 Python per sample against a 1.5 us checker), with equal or shorter paths after 1 s.  With a prescribed group (the TPEE case) the
 layered trees stay: a waypoint's prescribed values depend on its step.
 
