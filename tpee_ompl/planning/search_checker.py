@@ -128,15 +128,9 @@ class Checker:
     def check_motion(self, a: np.ndarray, b: np.ndarray) -> bool:
         """``si.checkMotion`` of a -> b (n,); a motion that passes is remembered in :attr:`passed`."""
         lay = self.layout
-        if lay.is_plain:  # lists: one conversion each, then plain float arithmetic
-            la, lb = a.tolist(), b.tolist()
-            self._s1[0 : lay.n] = la
-            self._s2[0 : lay.n] = lb
-            d = math.dist(la, lb)
-        else:
-            lay.write(self._s1, a)
-            lay.write(self._s2, b)
-            d = float(lay.distance(a, b))
+        lay.write(self._s1, a)
+        lay.write(self._s2, b)
+        d = math.dist(a.tolist(), b.tolist()) if lay.is_plain else float(lay.distance(a, b))
         self.own_checks += max(1, math.ceil(d / self._longest))
         ok = bool(self.si.checkMotion(self._s1, self._s2))
         if ok:
