@@ -21,7 +21,7 @@ from collections.abc import Callable
 import numpy as np
 
 from .grouped_space import RealVectorLayout
-from .layered_trees import Tree
+from .layered_trees import Tree, valid_ends
 
 __all__ = ["ConnectTrees", "RANGE_FRACTION"]
 
@@ -45,17 +45,11 @@ class ConnectTrees:
         self.lines: tuple[list[int], list[int]] = ([], [])
         """Per tree and node: the node its straight line into this node starts from (parent for a
         single step, the connect's first node for the steps of one connect; -1 for the root)."""
-        h = len(W)
-        self._add(0, W[0], -1, -1)
-        t = 1
-        while t < h - 1 and V[t] and E[t - 1]:
+        f, b = valid_ends(V, E)
+        for t in range(f + 1):
             self._add(0, W[t], t - 1, t - 1)
-            t += 1
-        self._add(1, W[h - 1], -1, -1)
-        t, i = h - 2, 0
-        while t > 0 and V[t] and E[t]:
-            i = self._add(1, W[t], i, i)
-            t -= 1
+        for i, t in enumerate(range(len(W) - 1, b - 1, -1)):
+            self._add(1, W[t], i - 1, i - 1)
         self._turn = 0
 
     def _add(self, k: int, x: np.ndarray, parent: int, line: int) -> int:

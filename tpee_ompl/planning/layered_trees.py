@@ -21,7 +21,21 @@ from collections.abc import Callable
 
 import numpy as np
 
-__all__ = ["Tree", "LayeredTrees", "spread_waypoints"]
+__all__ = ["Tree", "LayeredTrees", "spread_waypoints", "valid_ends"]
+
+
+def valid_ends(V: np.ndarray, E: np.ndarray) -> tuple[int, int]:
+    """The path's valid prefix and suffix (V: waypoint validity, E: motion validity, h waypoints): the
+    last step f reachable from the start and the first step b that reaches the goal through valid
+    waypoints and motions, among the intermediate steps (f = 0 / b = h - 1 when there are none)."""
+    h = len(V)
+    f = 0
+    while f + 1 < h - 1 and V[f + 1] and E[f]:
+        f += 1
+    b = h - 1
+    while b - 1 > 0 and V[b - 1] and E[b - 1]:
+        b -= 1
+    return f, b
 
 
 class Tree:
@@ -114,16 +128,11 @@ class LayeredTrees:
         self.base = W.copy()
         self.h = h = len(W)
         self.fwd, self.bwd = Tree(len(d)), Tree(len(d))
-        prev = self.fwd.add(W[0, d], 0, -1)
-        t = 1
-        while t < h - 1 and V[t] and E[t - 1]:
-            prev = self.fwd.add(W[t, d], t, prev)
-            t += 1
-        prev = self.bwd.add(W[h - 1, d], h - 1, -1)
-        t = h - 2
-        while t > 0 and V[t] and E[t]:
-            prev = self.bwd.add(W[t, d], t, prev)
-            t -= 1
+        f, b = valid_ends(V, E)
+        for t in range(f + 1):
+            self.fwd.add(W[t, d], t, t - 1)
+        for i, t in enumerate(range(h - 1, b - 1, -1)):
+            self.bwd.add(W[t, d], t, i - 1)
 
     def nearest(self, c: np.ndarray) -> tuple[list[int], list[int]]:
         """For each intermediate step t = 1 .. h-2: the nearest forward node that can precede c at t
