@@ -7,7 +7,8 @@ with plain OMPL + numpy (no project code in their set-up), every listed grouping
 
 Per (problem, grouping): solved (dimension-RRT within --limit s, RRTConnect within 1 s), median time to
 the first exact path (dimension-RRT stopped by ``exactSolnPlannerTerminationCondition``) and its ratio
-to RRTConnect's, and the median path length after --time s for dimension-RRT, RRTConnect alone, and
+to RRTConnect's, dimension-RRT's median samples to it (``n D``) and time per sample (``us/n``, all its
+first-path runs together), and the median path length after --time s for dimension-RRT, RRTConnect alone, and
 RRTConnect whose path is simplified (``og.PathSimplifier.simplify``) for the rest of the same time.
 ``--layered`` adds dimension-RRT with ``connect=False`` (its feasibility phase before the connect trees).
 Validity checkers are plain Python functions (no batched call), motion validation is OMPL's default.
@@ -179,7 +180,7 @@ def main() -> None:
     args = p.parse_args()
     ou.setLogLevel(ou.LOG_NONE)
     print(f"{'problem':12s} {'groups':34s} {'solved D/R':>10s} {'t1 D ms':>8s} {'t1 R ms':>8s} {'ratio':>6s}"
-          f" {'len D':>7s} {'len R':>7s} {'len R+S':>7s}" + ("  layered: ratio, len" if args.layered else ""))
+          f" {'n D':>7s} {'us/n':>6s} {'len D':>7s} {'len R':>7s} {'len R+S':>7s}" + ("  layered: ratio, len" if args.layered else ""))
     for name, build, groupings in problems():
         if args.only and args.only not in name:
             continue
@@ -191,9 +192,11 @@ def main() -> None:
             rc_len.append(_length_at(ss, og.RRTConnect(si), args.time))
             rcs_len.append(_length_at(ss, og.RRTConnect(si), args.time, simplify=True))
         for groups in groupings:
-            d_first, d_len, l_first, l_len = [], [], [], []
+            d_first, d_len, l_first, l_len, d_samples = [], [], [], [], []
             for seed in range(args.seeds):
-                d_first.append(_first_path(ss, DimensionRRT(si, groups=groups, seed=seed), args.limit))
+                planner = DimensionRRT(si, groups=groups, seed=seed)
+                d_first.append(_first_path(ss, planner, args.limit))
+                d_samples.append(planner.last_run_stats()["samples"])
                 d_len.append(_length_at(ss, DimensionRRT(si, groups=groups, seed=seed), args.time))
                 if args.layered:
                     l_first.append(_first_path(ss, DimensionRRT(si, groups=groups, seed=seed, connect=False), args.limit))
@@ -202,8 +205,11 @@ def main() -> None:
             solved_r = sum(x is not None for x in rc_first)
             td, tr = _med(d_first), _med(rc_first)
             extra = f"  {_med(l_first) / tr:6.2f} {_med(l_len):7.3f}" if args.layered else ""
+            us = 1e6 * sum(x for x in d_first if x is not None) / max(1, sum(
+                n for x, n in zip(d_first, d_samples) if x is not None))
             print(f"{name:12s} {str(groups):34s} {solved_d:>4d}/{solved_r:<4d}  {1e3 * td:8.1f} {1e3 * tr:8.1f}"
-                  f" {td / tr:6.2f} {_med(d_len):7.3f} {_med(rc_len):7.3f} {_med(rcs_len):7.3f}{extra}", flush=True)
+                  f" {td / tr:6.2f} {_med(d_samples):7.0f} {us:6.1f} {_med(d_len):7.3f} {_med(rc_len):7.3f}"
+                  f" {_med(rcs_len):7.3f}{extra}", flush=True)
         del ss
         gc.collect()
 

@@ -34,8 +34,9 @@ staying put (a zero-length motion); the sample then joins each tree once, at the
 or highest (backward) step whose motion passes in full (coarse screening alone let the trees grow
 through thin walls there: a 2-D problem with two 0.1-wide walls never connected).  The repeated
 waypoints of the path are spread along its segments before the next sample (kept only if that path
-passes the checker; a run stopped at its first path returns them repeated).  Half of the samples are Gaussian around a random live tree node (sigma log-uniform in
-1-10 % of the bound widths) so the trees grow out of narrow pockets; the other half are uniform.
+passes the checker; a run stopped at its first path returns them repeated).  Half of the samples
+are Gaussian around a random live tree node (sigma log-uniform in 1-10 % of the bound widths) so
+the trees grow out of narrow pockets; the other half are uniform.
 Measured against checking every motion of every sample: on the wearer's 120 planning-necessary
 queries the median collision checks to a first path fell from 3347 to 1026 (RRTConnect: about
 1150) and on planar arms with 4-8 joints about 2-4x; with prescribed groups and thin walls the
@@ -57,8 +58,9 @@ that cannot be fitted seeds the layered trees above with its points at ``h`` eve
 Measured on plain-OMPL problems with a Python validity checker (``experiments/foreign_problems.py
 --layered``, both in one run): the first path on planar arms with 4-8 joints went from 1.4-7.4x
 RRTConnect's time to 0.7-2.4x, on a 3-D narrow passage from 26-48x to 2.8-4.4x (the rest there is
-Python per sample against a 1.5 us checker), with equal or shorter paths after 1 s.  With a prescribed group (the TPEE case) the
-layered trees stay: a waypoint's prescribed values depend on its step.
+Python per sample against a 1.5 us checker), with equal or shorter paths after 1 s.  With a
+prescribed group (the TPEE case) the layered trees stay: a waypoint's prescribed values depend on
+its step.
 
 Raising h (sec. 4.1.3 names the limit: with ``h`` fixed, a path has at most ``h - 1`` segments, and
 an obstacle that needs more turns is never bridged): with ``max_h`` set, after 500 samples without
