@@ -7,11 +7,11 @@ from helpers.planning_spaces import box_problem
 
 from tpee_ompl.planning.connect_trees import ConnectTrees
 from tpee_ompl.planning.grouped_space import GroupedSpace
-from tpee_ompl.planning.paths import path_passes_motion_checks
+from tpee_ompl.planning.paths import path_passes_motion_checks, set_state
 from tpee_ompl.planning.search_checker import Checker
 
 
-def _trees(si, start, goal, calls: list | None = None, range_: float = 0.3) -> ConnectTrees:
+def _trees(si, start, goal, calls: list | None = None, range_: float = 0.3, lean: bool = False) -> ConnectTrees:
     grouped = GroupedSpace(si, [[0, 1]], 5)
     checker = Checker(si, grouped.layout, batch=False)
 
@@ -25,7 +25,8 @@ def _trees(si, start, goal, calls: list | None = None, range_: float = 0.3) -> C
 
     W = np.linspace(start, goal, 5)
     V = np.array([True, False, False, False, True])  # only the ends seed the trees
-    return ConnectTrees(W, V, np.zeros(4, dtype=bool), grouped.layout, range_, check)
+    return ConnectTrees(W, V, np.zeros(4, dtype=bool), grouped.layout, range_, check,
+                        checker.check_step if lean else None)
 
 
 def test_trees_meet_around_a_wall_with_turning_points_that_pass_check_motion() -> None:
@@ -66,3 +67,23 @@ def test_a_blocked_connect_keeps_the_steps_before_the_block() -> None:
     n_goal = len(trees.trees[1])
     assert n_goal > 1  # ...the goal tree advances towards it until the wall
     assert np.all(trees.trees[1].values[:n_goal, 0] > 0.05)
+
+
+def test_lean_per_state_steps_grow_the_same_trees_and_mark_the_checked_edges() -> None:
+    si, _ = box_problem(lo=(-0.1, -1.0), hi=(0.1, 0.5))
+    start, goal = np.array([-0.8, 0.0]), np.array([0.8, 0.0])
+    Q = np.random.default_rng(3).uniform(-1, 1, (2000, 2))
+    stops: list[int] = []
+    arrays, lean = _trees(si, start, goal), _trees(si, start, goal, lean=True)
+    P, used = arrays.run(Q)
+    P2, used2 = lean.run(Q, stop=lambda: stops.append(1) and False)
+    assert P is not None and used == used2 and len(stops) == used - 1
+    np.testing.assert_array_equal(P, P2)
+    for k in (0, 1):
+        n = len(arrays.trees[k])
+        np.testing.assert_array_equal(arrays.trees[k].values[:n], lean.trees[k].values[:n])
+    assert len(lean.verified) == len(P) - 1 and any(lean.verified)
+    a, b = si.allocState(), si.allocState()
+    for k in np.flatnonzero(lean.verified):  # a single tree edge, checked in the path's direction
+        assert si.checkMotion(set_state(a, P[k]), set_state(b, P[k + 1]))
+    assert lean.run(Q[:10], stop=lambda: True) == (None, 1)  # stop is asked after the first sample

@@ -79,14 +79,16 @@ def test_search_finds_a_valid_path_around_the_box_and_only_shortens_it(batch: bo
     np.testing.assert_array_equal(search.W[[0, -1]], [start, goal])
 
 
+@pytest.mark.parametrize("batch", [True, False])
 @pytest.mark.parametrize("limit", [2, 7, 64])
-def test_iterate_passing_over_rejected_samples_matches_one_sample_per_call(limit: int) -> None:
+def test_iterate_in_blocks_matches_one_sample_per_call(limit: int, batch: bool) -> None:
+    """Connect trees, then samples the cost test rejects: blocks give the same path after the same samples."""
     si, _ = box_problem(lo=(-0.2, -1.0), hi=(0.2, 0.6))
     grouped = GroupedSpace(si, [[0], [1]], 7)  # two groups: blocks of 100 samples each, narrowing after 50
     start, goal = np.array([-0.8, 0.0]), np.array([0.8, 0.0])
 
     def search() -> Search:
-        return Search(grouped, Checker(si, grouped.layout, True), np.random.default_rng(5), start, goal,
+        return Search(grouped, Checker(si, grouped.layout, batch), np.random.default_rng(5), start, goal,
                       narrow_after=50, narrowing=0.5, range_={0: np.full(1, 0.02), 1: np.full(1, 0.02)})
 
     one, many = search(), search()
@@ -102,6 +104,23 @@ def test_iterate_passing_over_rejected_samples_matches_one_sample_per_call(limit
     seen = dict(trace_one)
     assert all(seen[n] == w for n, w in trace_many)  # the same path after the same number of samples
     assert many.narrow_start == one.narrow_start and many.group_samples == one.group_samples
+
+
+def test_a_block_of_connect_samples_ends_when_stop_says_so() -> None:
+    si, _ = box_problem(lo=(-0.05, -1.0), hi=(0.05, 1.0))  # a full wall: the trees never meet
+    grouped = GroupedSpace(si, [[0, 1]], 7)
+    search = Search(grouped, Checker(si, grouped.layout, False), np.random.default_rng(0),
+                    np.array([-0.8, 0.0]), np.array([0.8, 0.0]), narrow_after=50, narrowing=0.5,
+                    range_={0: np.full(2, 0.02)})
+    asked: list[int] = []
+
+    def stop() -> bool:
+        asked.append(search.samples)
+        return len(asked) == 5
+
+    assert search.iterate(64, stop) == 0
+    assert search.samples == 5 and not search.valid  # asked before each sample after the first
+    assert search.iterate(64) == 0 and search.samples == 69
 
 
 class _ThinWalls(ob.StateValidityChecker):

@@ -141,7 +141,8 @@ _PROGRESS_PERIOD = 0.01
 
 _PASS_BATCH = 64
 """Most samples per :meth:`Search.iterate` call on a valid path (those the cost test rejects are passed
-over in one vectorised step; the termination condition is asked between calls)."""
+over in one vectorised step; the termination condition is asked between calls) or in the connect
+trees (which ask it before each sample, as RRTConnect does)."""
 
 
 @dataclass(frozen=True)
@@ -456,7 +457,7 @@ class DimensionRRT(PythonPlanner):
                 limit = min(limit, stall - (search.samples - improved_at))
             if stops and drawn < stops[-1]:
                 limit = min(limit, next(s for s in stops if s > drawn) - drawn)
-            accepted = search.iterate(max(1, limit))
+            accepted = search.iterate(max(1, limit), ptc)
             self._samples_drawn = done + search.samples
             now = time.perf_counter()
             if accepted and search.valid and search.cost < poster.found_cost:

@@ -11,6 +11,7 @@ definition, so it can be driven and tested without one; validity comes from
 from __future__ import annotations
 
 import functools
+from collections.abc import Callable
 
 import numpy as np
 
@@ -172,8 +173,9 @@ class Search:
                 C[narrow] = nlo + U[narrow, 3:] * (nhi - nlo)
         return C, n0
 
-    def iterate(self, limit: int = 1) -> int:
-        """Draw one sample and try it at every intermediate step (up to ``limit`` samples on a valid path).
+    def iterate(self, limit: int = 1, stop: Callable[[], bool] | None = None) -> int:
+        """Draw one sample and try it at every intermediate step (up to ``limit`` samples on a valid path
+        or in the connect trees).
 
         On a valid path the sample is the current group's (paper's rule); before, it covers all
         planned groups at once and grows the connect trees (no prescribed group) or the layered
@@ -183,6 +185,9 @@ class Search:
         With ``limit > 1`` on a valid path, the samples that the cost test rejects at every step are
         first passed over in one vectorised step (at most ``limit - 1`` of them): they change nothing
         but the counters, so the result is that of as many single calls, with the same random numbers.
+        In the connect trees, up to ``limit`` samples go through them in one call, until the trees
+        meet or ``stop()`` (a termination condition, asked before each sample after the first) is
+        true: the same samples and result as single calls, without their per-call Python time.
         """
         if self._spread_pending:
             self._spread()
@@ -202,9 +207,12 @@ class Search:
                 V = self.V.copy()
                 if not self._guess:
                     V[1:-1] = False
-                self._connect = ConnectTrees(self.W, V, self.E, self.g.layout, RANGE_FRACTION * span, self._tree_motions)
+                self._connect = ConnectTrees(self.W, V, self.E, self.g.layout, RANGE_FRACTION * span, self.checker.tree_motions,
+                                             None if self.checker.batched else self.checker.check_step)
             else:
                 self._tree = self._layered(self.W, self.V, self.E)
+        if self._connect is not None:
+            return self._connect_samples(max(1, limit), stop)
         c = self.draw(gi if valid else None)
         self.samples += 1
         self.group_samples[gi] += 1
@@ -239,33 +247,29 @@ class Search:
         return LayeredTrees(W, V, E, self._fdims, self._hold,
                             functools.partial(self.delta, dims=self._fdims))  # nodes hold these DOFs
 
-    def _tree_motions(self, A: np.ndarray, B: np.ndarray, starts: bool) -> int:
-        """The connect trees' checks of the motions A[k] -> B[k] (and of A[k] when ``starts``), in full:
-        how many pass before the first that does not (batched: every 8th state of all of them first;
-        else in order, stopping at the first failure, as RRTConnect).  Passes are remembered."""
-        checker = self.checker
-        if checker.batched:
-            ok = checker.states(A) if starts else np.ones(len(A), dtype=bool)
-            go = np.flatnonzero(ok)
-            ok[go] = checker.motions(A[go], B[go])
-            n = len(ok) if ok.all() else int(ok.argmin())
-        else:
-            n = 0
-            while n < len(A) and (not starts or checker.states(A[n : n + 1])[0]) and checker.check_motion(A[n], B[n]):
-                n += 1
-        for k in range(n):
-            self._known[segment_key(A[k], B[k])] = True
-        return n
-
-    def _connect_step(self, c: np.ndarray) -> int:
-        """Feasibility phase without prescribed groups: one RRTConnect iteration; once the trees meet,
+    def _connect_samples(self, limit: int, stop: Callable[[], bool] | None) -> int:
+        """Feasibility phase without prescribed groups: up to ``limit`` RRTConnect iterations (the random
+        rows :meth:`draw` would use, so the samples are those of single calls); once the trees meet,
         the path is fitted to the h steps (:meth:`_fit`), or handed to the layered trees when it
-        cannot be."""
-        x = self.W[0].copy()
-        x[self._fdims] = c
-        P = self._connect.step(x)
+        cannot be.  Returns 1 when the path was fitted, else 0."""
+        k = len(self._fdims)
+        self._refill(k)
+        U = self._uniform[self._ui : self._ui + min(limit, len(self._uniform) - self._ui)]
+        lo, hi = self._fbounds
+        X = np.repeat(self.W[:1], len(U), axis=0)
+        X[:, self._fdims] = lo + U[:, 3:] * (hi - lo)
+        P, used = self._connect.run(X, stop)
+        self._ui += used
+        planned = self.g.planned
+        for s in range(self.samples, self.samples + used):
+            self.group_samples[planned[(s // _GROUP_BLOCK) % len(planned)]] += 1
+        self.samples += used
         if P is None:
             return 0
+        for k in np.flatnonzero(self._connect.verified):  # single tree edges: checked in path direction
+            key = segment_key(P[k], P[k + 1])
+            self._known[key] = True
+            self.checker.passed.add(key)
         self._connect = None
         return int(self._fit(P))
 
@@ -312,8 +316,8 @@ class Search:
         return True
 
     def _grow(self, c: np.ndarray) -> int:
-        """Feasibility phase: one connect-tree iteration (:meth:`_connect_step`), else grow the layered
-        trees with the sample c, motions checked lazily.
+        """Feasibility phase with the layered trees (the connect trees go through
+        :meth:`_connect_samples`): grow them with the sample c, motions checked lazily.
 
         c is checked as a waypoint at every step t that has a forward node before it or a backward
         node after it (once when holding: the configuration is then the same at every step).  Of the
@@ -325,8 +329,6 @@ class Search:
         backward step whose motion passes in full (coarse screening alone let trees grow through
         thin walls there).  Returns 1 when the path is complete, else 0.
         """
-        if self._connect is not None:
-            return self._connect_step(c)
         tree = self._tree
         d = tree.dims
         h = self.g.h
@@ -403,8 +405,10 @@ class Search:
         """Segments of W (K, n) found invalid (lazy checking: called once W is a complete candidate).
 
         The waypoints are known valid; zero-length segments and segments checked before cost
-        nothing; the others go through :meth:`Checker.coarse` together (any failure there ends the
-        check; the segments that passed it are not screened again), then all of them in full.  Every
+        nothing.  Batched, the others go through :meth:`Checker.coarse` together (any failure there
+        ends the check; the segments that passed it are not screened again), then all of them in
+        full.  With a per-state checker they are checked in full in order (``si.checkMotion``'s own
+        bisection finds a failure faster than a Python screen), up to the first failure.  Every
         result is remembered."""
         known, checker = self._known, self.checker
         keys = [W[k : k + 2].tobytes() for k in range(len(W) - 1)]
@@ -412,6 +416,12 @@ class Search:
         todo = [k for k, key in enumerate(keys) if key not in known and np.any(W[k] != W[k + 1])]
         if bad or not todo:
             return bad
+        if not checker.batched:
+            for k in todo:
+                known[keys[k]] = ok = checker.check_motion(W[k], W[k + 1])
+                if not ok:
+                    return [k]
+            return []
         screen = np.array([k for k in todo if keys[k] not in self._coarse_passed], dtype=int)
         if len(screen):
             good = checker.coarse(W[screen], W[screen + 1])  # finds most failing motions at once

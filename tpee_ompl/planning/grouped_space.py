@@ -217,12 +217,12 @@ class RealVectorLayout:
             out[sl] = [leaf.value] if so2 else [leaf[i] for i in range(d)]
         return out
 
-    def write(self, state: ob.State, values: np.ndarray) -> ob.State:
-        """Write a flat array (n,) into the state; return the state."""
-        values = np.asarray(values, dtype=float)
+    def write(self, state: ob.State, values: np.ndarray | list[float]) -> ob.State:
+        """Write a flat array (n,) or list of floats into the state; return the state."""
         if self.is_plain:  # the state is the RealVector state itself: one slice assignment
-            state[0 : self.n] = values.tolist()
+            state[0 : self.n] = values if type(values) is list else np.asarray(values, dtype=float).tolist()
             return state
+        values = np.asarray(values, dtype=float)
         for (path, d, _, so2), sl in zip(self._leaves, self._slices):
             if so2:
                 self._leaf(state, path).value = float(values[sl][0])

@@ -125,6 +125,42 @@ class Checker:
         self.passed.update(segment_key(A[k], B[k]) for k in np.flatnonzero(ok))
         return ok
 
+    def tree_motions(self, A: np.ndarray, B: np.ndarray, starts: bool) -> int:
+        """The connect trees' checks of the motions A[k] -> B[k] (and of A[k] when ``starts``), in full:
+        how many pass before the first that does not (batched: every 8th state of all of them first;
+        else in order, stopping at the first failure, as RRTConnect)."""
+        if self.batched:
+            ok = self.states(A) if starts else np.ones(len(A), dtype=bool)
+            go = np.flatnonzero(ok)
+            ok[go] = self.motions(A[go], B[go])
+            return len(ok) if ok.all() else int(ok.argmin())
+        n = 0
+        while n < len(A) and self.check_step(A[n].tolist(), B[n].tolist(), starts):
+            n += 1
+        return n
+
+    def check_step(self, a: list[float], b: list[float], start: bool) -> bool:
+        """A tree step a -> b given as plain lists (the flat vector): ``si.isValid(a)`` when ``start``,
+        then ``si.checkMotion(a, b)``, as RRTConnect checks a goal-tree step; the lean per-state path
+        of the connect trees (nothing is remembered: the trees know their checked edges)."""
+        lay, s1, s2 = self.layout, self._s1, self._s2
+        plain = lay.is_plain
+        if plain:
+            s1[0 : lay.n] = a
+        else:
+            lay.write(s1, a)
+        if start:
+            self.own_checks += 1
+            if not self.si.isValid(s1):
+                return False
+        if plain:
+            s2[0 : lay.n] = b
+        else:
+            lay.write(s2, b)
+        d = math.dist(a, b) if plain else float(lay.distance(np.array(a), np.array(b)))
+        self.own_checks += max(1, math.ceil(d / self._longest))
+        return bool(self.si.checkMotion(s1, s2))
+
     def check_motion(self, a: np.ndarray, b: np.ndarray) -> bool:
         """``si.checkMotion`` of a -> b (n,); a motion that passes is remembered in :attr:`passed`."""
         lay = self.layout
