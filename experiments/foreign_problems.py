@@ -12,6 +12,8 @@ first-path runs together), and the median path length after --time s for dimensi
 RRTConnect whose path is simplified (``og.PathSimplifier.simplify``) for the rest of the same time.
 ``--layered`` adds dimension-RRT with ``connect=False`` (its feasibility phase before the connect trees).
 Validity checkers are plain Python functions (no batched call), motion validation is OMPL's default.
+OMPL's global seed is set (``--ompl-seed``), so RRTConnect's runs, and a whole run, repeat; its median
+over a few runs still depends on that seed, so ratios are figures of one run.
 """
 
 from __future__ import annotations
@@ -177,8 +179,12 @@ def main() -> None:
     p.add_argument("--limit", type=float, default=10.0, help="dimension-RRT's time limit for a first path")
     p.add_argument("--only", default=None, help="run only problems whose name contains this")
     p.add_argument("--layered", action="store_true", help="also run dimension-RRT with connect=False")
+    p.add_argument("--ompl-seed", type=int, default=1,
+                   help="OMPL's global seed (RRTConnect's samples), so a run repeats; 0 leaves it unseeded")
     args = p.parse_args()
     ou.setLogLevel(ou.LOG_NONE)
+    if args.ompl_seed:
+        ou.RNG.setSeed(args.ompl_seed)
     print(f"{'problem':12s} {'groups':34s} {'solved D/R':>10s} {'t1 D ms':>8s} {'t1 R ms':>8s} {'ratio':>6s}"
           f" {'n D':>7s} {'us/n':>6s} {'len D':>7s} {'len R':>7s} {'len R+S':>7s}" + ("  layered: ratio, len" if args.layered else ""))
     for name, build, groupings in problems():
