@@ -45,3 +45,28 @@ def test_rrtconnect_first_solution_is_the_end_of_its_run():
 def test_a_run_without_an_exact_solution_records_no_first_solution_time():
     rec = _solve(og.RRTstar, 5.0, cap=1)  # one iteration: no path from one sample
     assert not rec["exact"] and rec["first_solution_time"] is None
+
+
+def test_a_runs_checks_are_counted_as_its_solve_returns_not_after_ompls_simplification():
+    from ompl import tools as ot
+
+    si, box = box_problem()
+
+    class Counter:  # the campaign's checkers expose a ``collision_checks`` counter
+        @property
+        def collision_checks(self) -> int:
+            return box.calls
+
+    ss = og.SimpleSetup(si)
+    start, goal = si.allocState(), si.allocState()
+    start[0], start[1], goal[0], goal[1] = -0.9, 0.0, 0.9, 0.0
+    ss.setStartAndGoalStates(start, goal, 1e-9)
+    w = RecordingPlanner(si, og.RRTConnect(si), checker=Counter())
+    bench = ot.Benchmark(ss, "checks")
+    bench.addPlanner(w)
+    before, after = [], []
+    bench.setPreRunEvent(lambda p: before.append(box.calls))
+    bench.setPostRunEvent(lambda p, run: after.append(box.calls))
+    bench.benchmark(ot.Request(maxTime=1.0, maxMem=4096.0, runCount=1, displayProgress=False,
+                               saveConsoleOutput=False, simplify=True))
+    assert before[0] < w.last["checks_end"] < after[0]  # OMPL's simplification checks states after the run

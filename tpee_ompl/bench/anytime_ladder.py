@@ -156,7 +156,7 @@ class AnytimeLadder:
         if mode == "posted" and not hasattr(inner, "set_intermediate_solution_callback"):
             mode = None
         if mode is None:
-            w = RecordingPlanner(si, inner, max_iterations=None, read=read)
+            w = RecordingPlanner(si, inner, max_iterations=None, read=read, checker=checker)
             self.separate.add(w.getName())
         else:
             w = TimeCheckpointPlanner(si, inner, self.checkpoints, (pname, ctx), mode, checker=checker, read=read)

@@ -259,7 +259,7 @@ def _run_experiment(cfg: dict, task: dict, spec: dict, ladder=None, only: list[s
                              problem=problem.name)
         inner = planner_factory(pname)(si, ctx)
         read = None if layout.is_plain else layout.read
-        w = (RecordingPlanner(si, inner, max_iterations=cap, read=read) if ladder is None
+        w = (RecordingPlanner(si, inner, max_iterations=cap, read=read, checker=checker) if ladder is None
              else ladder.wrap(si, inner, cap, pname, ctx, checker=checker, read=read))
         wrappers[w.getName()] = w
         bench.addPlanner(w)
@@ -271,8 +271,10 @@ def _run_experiment(cfg: dict, task: dict, spec: dict, ladder=None, only: list[s
         counter["before"] = checker.collision_checks
 
     def post_run_props(planner) -> dict:
-        checks = checker.collision_checks - counter["before"]
         rec = wrappers[planner.getName()].last
+        # the run's own checks: not those of OMPL's simplification and path checks after it
+        end = rec.get("checks_end")
+        checks = (end if end is not None else checker.collision_checks) - counter["before"]
         props = {
             "collision_checks INTEGER": checks,
             "iterations INTEGER": rec["iterations"],

@@ -166,10 +166,14 @@ class RecordingPlanner(ob.Planner):
     read : callable, optional
         ``state -> array (n,)`` for spaces other than RealVector (e.g. ``RealVectorLayout.read`` of an
         SO2 compound); n is the space's dimension.
+    checker : object with a ``collision_checks`` counter, optional
+        The problem's checker: its counter as ``solve`` returns is recorded (``checks_end``), so a
+        run's checks exclude what OMPL's ``Benchmark`` does after it (simplification, path checks).
 
     After each ``solve``, :attr:`last` holds the run's record: ``waypoints`` (raw path, (K, n), or
     None), ``iterations``, ``samples``, ``best_cost``, ``first_solution_time``, ``progress``
-    (list of (time, best cost, iterations)) and ``error`` (None, or the exception's repr).  A native
+    (list of (time, best cost, iterations)), ``checks_end`` (the checker's counter as ``solve`` returned, or
+None) and ``error`` (None, or the exception's repr).  A native
     planner's ``first_solution_time`` is the first termination check that saw an exact solution (a finite
     ``bestCost()``, or one in the problem definition for planners without it, e.g. AORRTC), else the run's
     end when it returned one (RRTConnect stops at its first path).
@@ -178,8 +182,9 @@ class RecordingPlanner(ob.Planner):
     """
 
     def __init__(self, si, inner, max_iterations: int | None = None, progress_period: float = 0.05,
-                 read: Callable[[ob.State], object] | None = None) -> None:
+                 read: Callable[[ob.State], object] | None = None, checker=None) -> None:
         super().__init__(si, inner.getName())
+        self.checker = checker
         self._dim = int(si.getStateSpace().getDimension())
         self._read = read
         self.inner = inner
@@ -244,12 +249,13 @@ class RecordingPlanner(ob.Planner):
             error = repr(exc)
             status = ob.PlannerStatus(ob.PlannerStatus.CRASH)
         elapsed = time.perf_counter() - t0
+        checks_end = int(self.checker.collision_checks) if self.checker is not None else None
         waypoints = None
         if error is None and pdef.hasSolution():
             waypoints = path_to_array(pdef.getSolutionPath(), self._dim, read=self._read)
         if state["first"] is None and error is None and pdef.hasExactSolution():
             state["first"] = elapsed  # found as the planner returned (RRTConnect stops at its first path)
-        self.last = {"waypoints": waypoints, "error": error,
+        self.last = {"waypoints": waypoints, "error": error, "checks_end": checks_end,
                      **self._run_stats(elapsed, progress, has_cost, state["first"]), **self._graph_size()}
         return status
 
