@@ -365,9 +365,8 @@ def derived_run(si, pdef, w: CheckpointPlanner, i: int, row: dict, rec: dict, sn
     ``snap`` is None (the run ended before the checkpoint), else the snapshot's columns."""
     if snap is None:
         return row, rec["progress"], rec["props"]
-    c0 = w._checks()
     row = Ladder._ompl_columns(si, pdef, row, snap, simplify)
-    checks = snap.get("own_checks", snap["checks"] - w.start_checks[i]) + w._checks() - c0
+    checks = snap.get("own_checks", snap["checks"] - w.start_checks[i])  # the search's, as a full run's
     props = Ladder._our_columns(si, rec["props"], snap, checks, start, goal, path_properties)
     row.update({k: format_value(v) for k, v in props.items()})
     prog = snap.get("progress")
