@@ -56,9 +56,11 @@ dropped; the points are held (repeated) to fill the steps, the path is posted, a
 first spreads the held points over its segments (kept when that path passes the checker).  A path
 that cannot be fitted seeds the layered trees above with its points at ``h`` evenly spaced places.
 Measured on plain-OMPL problems with a Python validity checker (``experiments/foreign_problems.py
---layered``, both in one run): the first path on planar arms with 4-8 joints went from 1.4-7.4x
-RRTConnect's time to 0.7-2.4x, on a 3-D narrow passage from 26-48x to 2.8-4.4x (the rest there is
-Python per sample against a 1.5 us checker), with equal or shorter paths after 1 s.  With a
+--layered``, both in one run): the first path on planar arms with 4-8 joints 1.05-4.1x
+RRTConnect's time with the layered trees, 0.6-1.9x with the connect trees, on a 3-D narrow passage
+9.5-23x and 2.3-2.7x (the rest there is Python per sample against a sub-microsecond checker; with a
+per-state checker a step is one ``si.checkMotion`` on plain lists and the trees take a block of
+samples per call), with equal or shorter paths after 1 s.  With a
 prescribed group (the TPEE case) the layered trees stay: a waypoint's prescribed values depend on
 its step.
 
