@@ -172,9 +172,9 @@ class RecordingPlanner(ob.Planner):
 
     After each ``solve``, :attr:`last` holds the run's record: ``waypoints`` (raw path, (K, n), or
     None), ``iterations``, ``samples``, ``best_cost``, ``first_solution_time``, ``progress``
-    (list of (time, best cost, iterations)), ``checks_end`` (the checker's counter as ``solve`` returned, or
-None) and ``error`` (None, or the exception's repr).  A native
-    planner's ``first_solution_time`` is the first termination check that saw an exact solution (a finite
+    (list of (time, best cost, iterations)), ``checks_end`` (the checker's counter as ``solve``
+    returned, or None) and ``error`` (None, or the exception's repr).  A native planner's
+    ``first_solution_time`` is the first termination check that saw an exact solution (a finite
     ``bestCost()``, or one in the problem definition for planners without it, e.g. AORRTC), else the run's
     end when it returned one (RRTConnect stops at its first path).
     Exceptions never escape to OMPL (they would abort the whole benchmark): a failing ``solve``
