@@ -8,6 +8,7 @@ import pinocchio as pin
 import pytest
 
 from tests.helpers.panda import needs_panda
+from tests.helpers.wearer_configs import valid_and_colliding
 from tpee_ompl.model.obstacles import Obstacle, box
 from tpee_ompl.model.robot_checker import RobotChecker
 from tpee_ompl.model.wearer_arm import WearerArm
@@ -197,3 +198,22 @@ def test_pair_margins_follow_link_margins_for_static_pairs_only(tmp_path):
                for cp, m in zip(gm.collisionPairs, c.pair_margins())}
     assert margins[("b_0", "wall")] == pytest.approx(0.05)
     assert margins[("a_0", "b_0")] == pytest.approx(c.security_margin)
+
+
+def test_first_invalid_stops_at_the_first_invalid_row_and_counts_only_the_rows_checked(robot, rng) -> None:
+    good, bad = valid_and_colliding(robot, rng, 4)
+    Q = np.vstack([good[:2], bad[:1], good[2:], bad[1:]])  # first invalid row: 2
+    c0 = robot.collision_checks
+    assert robot.first_invalid(Q) == 2
+    assert robot.collision_checks - c0 == 3  # rows 0, 1, 2; the rest never checked
+    c0 = robot.collision_checks
+    assert robot.first_invalid(good) == -1 and robot.collision_checks - c0 == len(good)
+    outside = good.copy()
+    outside[1, 0] = robot.upper[0] + 0.1  # out of limits: invalid without a collision check
+    outside[3] = bad[0]
+    c0 = robot.collision_checks
+    assert robot.first_invalid(outside) == 1 and robot.collision_checks - c0 == 1
+    for _ in range(20):  # the verdict of are_valid, row by row
+        M = np.vstack([good, bad])[rng.permutation(2 * len(good))[:5]]
+        ok = robot.are_valid(M)
+        assert robot.first_invalid(M) == (-1 if ok.all() else int(ok.argmin()))

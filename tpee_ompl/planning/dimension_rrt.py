@@ -22,9 +22,11 @@ checked lazily, as in LazyRRT: the sample is checked as a waypoint at every step
 forward node before it or a backward node after it; of the steps with both, the one whose motions
 (from the nearest forward node of step t-1, to the nearest backward node of step t+1; holding:
 of a step before / after) are shortest completes a candidate path, and only then are the path's
-motions not checked before checked (every 8th state of all of them first, ending the check at any
-failure there, then all of them with ``si.checkMotion``'s verdict, in one ``check_motions`` call when
-the validator is the project's).  A failed motion kills the node it leads into with its subtree; the sample joins the
+motions not checked before checked (every 8th state of all of them first, in bisection order --
+each motion's middle state, then the quarter points, ... -- stopping at the first failure when the
+validity checker offers ``first_invalid`` (the project's does: one thread, in order); then all of
+them with ``si.checkMotion``'s verdict, in one ``check_motions`` call when the validator is the
+project's).  A failed motion kills the node it leads into with its subtree; the sample joins the
 trees through its motions of that path that passed in full, and at the other steps on unchecked
 motions (their checks are left to the path that uses them; screening every 8th state of them first
 cost more than it saved: median checks to a first path on the 120 planning-necessary queries 690 ->

@@ -86,8 +86,6 @@ class Search:
         self._known: dict[bytes, bool] = {W[k : k + 2].tobytes(): bool(self.E[k]) for k in range(len(W) - 1)
                                           if self.V[k] and self.V[k + 1]}
         """Segment (two waypoint rows as bytes) -> motion valid, for every motion checked so far."""
-        self._coarse_passed: set[bytes] = set()
-        """Segments whose every 8th state passed, not yet checked in full."""
         # feasibility phase: all planned groups vary jointly (with one planned group: that group)
         self._fdims = np.concatenate([self._dims[gi] for gi in grouped.planned]) if grouped.planned else np.zeros(0, int)
         self._fbounds = (grouped.layout.lower[self._fdims], grouped.layout.upper[self._fdims])
@@ -405,15 +403,16 @@ class Search:
         """Segments of W (K, n) found invalid (lazy checking: called once W is a complete candidate).
 
         The waypoints are known valid; zero-length segments and segments checked before cost
-        nothing.  Batched, the others go through :meth:`Checker.coarse` together (any failure there
-        ends the check; the segments that passed it are not screened again), then all of them in
-        full.  With a per-state checker they are checked in full in order (``si.checkMotion``'s own
+        nothing.  Batched, every 8th state of all of them is screened in bisection order until the
+        first failure (:meth:`Checker.first_failing_motion`: that segment alone is then reported),
+        else all of them are checked in full.  With a per-state checker they are checked in full in order (``si.checkMotion``'s own
         bisection finds a failure faster than a Python screen), up to the first failure.  Every
         result is remembered."""
         known, checker = self._known, self.checker
         keys = [W[k : k + 2].tobytes() for k in range(len(W) - 1)]
         bad = [k for k, key in enumerate(keys) if not known.get(key, True)]
-        todo = [k for k, key in enumerate(keys) if key not in known and np.any(W[k] != W[k + 1])]
+        moving = (W[1:] != W[:-1]).any(axis=1).tolist()
+        todo = [k for k, key in enumerate(keys) if moving[k] and key not in known]
         if bad or not todo:
             return bad
         if not checker.batched:
@@ -422,16 +421,11 @@ class Search:
                 if not ok:
                     return [k]
             return []
-        screen = np.array([k for k in todo if keys[k] not in self._coarse_passed], dtype=int)
-        if len(screen):
-            good = checker.coarse(W[screen], W[screen + 1])  # finds most failing motions at once
-            bad = [int(k) for k, g in zip(screen, good) if not g]
-            for k in bad:
-                known[keys[k]] = False
-            if bad:  # the others passed this test: not screened again in a later candidate
-                self._coarse_passed.update(keys[k] for k, g in zip(screen, good) if g)
-                return bad
         ends = np.array(todo)
+        k = checker.first_failing_motion(W[ends], W[ends + 1], bisect=True)  # finds most failing motions
+        if k >= 0:
+            known[keys[todo[k]]] = False
+            return [todo[k]]
         # all of them: a motion the coarse test missed may not be the only one
         for k, ok in zip(todo, checker.check_motions(W[ends], W[ends + 1])):
             if not ok:

@@ -88,24 +88,6 @@ class Tree:
         return live, start, np.diff(np.append(start, len(st)))
 
 
-def _nearest_per_step(tree: Tree, c: np.ndarray, delta: Callable[[np.ndarray, np.ndarray], np.ndarray],
-                      h: int) -> list[tuple[float, int]]:
-    """For each step s < h: (squared distance, index) of the live node of step s nearest to c (the lowest
-    index among equals), or (inf, -1)."""
-    live = np.flatnonzero(tree.alive[: len(tree)])
-    out = [(math.inf, -1)] * h
-    if not len(live):
-        return out
-    d2 = tree.sq_dist(c, delta)[live]
-    steps = tree.steps[live]
-    order = np.lexsort((live, d2, steps))  # by step, then distance, then index
-    so = steps[order]
-    first = np.flatnonzero(np.concatenate(([True], so[1:] != so[:-1])))
-    for k in order[first].tolist():
-        out[int(steps[k])] = (float(d2[k]), int(live[k]))
-    return out
-
-
 def _running_best(best: list[tuple[float, int]]) -> list[tuple[float, int]]:
     """Prefix minimum of (distance, index) pairs: the nearest over steps 0..s, lowest index among equals."""
     out, cur = [], (math.inf, -1)
@@ -137,24 +119,40 @@ class LayeredTrees:
     def nearest(self, c: np.ndarray) -> tuple[list[int], list[int]]:
         """For each intermediate step t = 1 .. h-2: the nearest forward node that can precede c at t
         (step t-1, or any step <= t-1 when holding) and the nearest backward node that can follow
-        it (step t+1, or >= t+1); -1 where there is none."""
-        h = self.h
-        bf = _nearest_per_step(self.fwd, c, self.delta, h)
-        bb = _nearest_per_step(self.bwd, c, self.delta, h)
+        it (step t+1, or >= t+1); -1 where there is none.  The lowest index wins among equals."""
+        h, fwd, bwd = self.h, self.fwd, self.bwd
+        nf, nb = len(fwd), len(bwd)
+        # both trees in one pass (a handful of numpy calls per sample): backward steps shifted by h
+        D = self.delta(np.concatenate((fwd.values[:nf], bwd.values[:nb])), c)
+        d2 = np.einsum("ij,ij->i", D, D)
+        key = np.concatenate((fwd.steps[:nf], bwd.steps[:nb] + h))
+        live = np.flatnonzero(np.concatenate((fwd.alive[:nf], bwd.alive[:nb])))
+        order = live[np.lexsort((d2[live], key[live]))]  # by step, then distance, then index (stable)
+        ko = key[order]
+        first = order[np.flatnonzero(np.concatenate(([True], ko[1:] != ko[:-1])))].tolist() if len(order) else []
+        best = [(math.inf, -1)] * (2 * h)
+        for i, s, d in zip(first, key[first].tolist(), d2[first].tolist()):
+            best[s] = (d, i if i < nf else i - nf)
+        bf, bb = best[:h], best[h:]
         if self.hold:  # the nearest over all steps before (forward) / after (backward)
             bf, bb = _running_best(bf), _running_best(bb[::-1])[::-1]
         return [bf[t - 1][1] for t in range(1, h - 1)], [bb[t + 1][1] for t in range(1, h - 1)]
 
     def anchor(self, u: float) -> np.ndarray:
-        """Values of a live tree node picked by u in [0, 1): a uniform step of either tree, then a uniform node."""
-        layers = [(tree, *tree.layers()) for tree in (self.fwd, self.bwd)]
-        total = sum(len(count) for _, _, _, count in layers)
-        x = u * total
+        """Values of a live tree node picked by u in [0, 1): a uniform step of either tree, then a uniform node
+        (of that step's live nodes in index order)."""
+        parts = []
+        for tree in (self.fwd, self.bwd):
+            live = np.flatnonzero(tree.alive[: len(tree)])
+            st = tree.steps[live]
+            parts.append((tree, live, st, np.flatnonzero(np.bincount(st, minlength=self.h))))
+        x = u * sum(len(occupied) for *_, occupied in parts)
         k = int(x)
-        for tree, live, start, count in layers:
-            if k < len(count):
-                return tree.values[live[start[k] + int((x - int(x)) * count[k])]]
-            k -= len(count)
+        for tree, live, st, occupied in parts:
+            if k < len(occupied):
+                members = live[st == occupied[k]]
+                return tree.values[members[int((x - int(x)) * len(members))]]
+            k -= len(occupied)
         raise AssertionError("a layered tree without live nodes")
 
     def path(self, t: int, c: np.ndarray, f: int, b: int) -> tuple[np.ndarray, dict[int, tuple[str, int]]]:

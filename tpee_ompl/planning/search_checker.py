@@ -8,6 +8,7 @@ runs the search on top of it).
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -20,6 +21,21 @@ __all__ = ["Checker", "segment_key"]
 
 _COARSE_STRIDE = 8
 """First pass over a motion checks every 8th interior state (collisions span many states)."""
+
+
+@functools.lru_cache(maxsize=256)
+def _bisection_levels(m: int) -> np.ndarray:
+    """Level of each of m evenly spaced points in bisection order: the middle one 0, the middles of
+    the two halves 1, and so on (OMPL's discrete motion validator visits a motion's states this way)."""
+    levels = np.zeros(m, dtype=int)
+    todo = [(0, m - 1, 0)]
+    while todo:
+        lo, hi, level = todo.pop()
+        if lo <= hi:
+            mid = (lo + hi) // 2
+            levels[mid] = level
+            todo += [(lo, mid - 1, level + 1), (mid + 1, hi, level + 1)]
+    return levels
 
 
 def segment_key(a: np.ndarray, b: np.ndarray) -> bytes:
@@ -48,6 +64,8 @@ class Checker:
                 self.euclid = layout.is_plain
         self.batched = self.step is not None
         self._are_valid = are_valid if self.batched else None
+        first_invalid = getattr(svc, "first_invalid", None)
+        self._first_invalid = first_invalid if self.batched and callable(first_invalid) else None
         all_valid = getattr(mv, "all_valid", None)
         # the project's validator screens a motion's evenly spaced states (straight lines only: no SO2 wrap)
         self._all_valid = all_valid if self.batched and callable(all_valid) and layout.is_plain else None
@@ -84,6 +102,40 @@ class Checker:
             self.layout.write(s, q)
             out[k] = self.si.isValid(s)
         return out
+
+    def first_invalid(self, Q: np.ndarray) -> int:
+        """Index of the first invalid configuration of Q (m, n) in row order, or -1.  The validity checker's
+        own ``first_invalid`` (checks in order and stops at the first failure) when it has one, else
+        :meth:`states` of all of them."""
+        if len(Q) == 0:
+            return -1
+        if self._first_invalid is None:
+            ok = self.states(Q)
+            return -1 if ok.all() else int(ok.argmin())
+        self.own_checks += len(Q)  # at most (the robot's own counter, when there is one, is exact)
+        return int(self._first_invalid(Q))
+
+    def first_failing_motion(self, A: np.ndarray, B: np.ndarray, bisect: bool, starts: bool = False) -> int:
+        """The motion k (A[k] -> B[k]) of the first invalid state found among every 8th interior state
+        of each motion (and A[k] itself when ``starts``), or -1 when all of those are valid.
+
+        ``bisect``: every motion's middle state first, then the quarter points, and so on, for a
+        candidate path whose failure can be anywhere and tends to span many states; else motion by
+        motion from A[0], for a chain of steps whose valid prefix is wanted (every motion before the
+        one returned passed).  With a checker that stops at the first failure, the states after it
+        are not checked."""
+        K = len(A)
+        if K == 0:
+            return -1
+        S, idx, j = self.interior(A, B, _COARSE_STRIDE)  # in motion order, then step order
+        if bisect:  # the k-th state of a motion of m ranks at the bisection level of k among m
+            counts = np.bincount(idx, minlength=K).tolist()
+            j = np.concatenate([_bisection_levels(m) for m in counts if m]) if len(idx) else j
+        if starts:  # each motion's start before its interior states
+            S, idx, j = np.concatenate((A, S)), np.concatenate((np.arange(K), idx)), np.concatenate((np.full(K, -1), j))
+        order = np.lexsort((idx, j)) if bisect else np.lexsort((j, idx))
+        i = self.first_invalid(S[order])
+        return -1 if i < 0 else int(idx[order[i]])
 
     def interior(self, A: np.ndarray, B: np.ndarray, stride: int = 1) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Interior states of motions A[k] -> B[k]: (states (M, n), motion index (M,), step index j >= 1;
@@ -130,10 +182,10 @@ class Checker:
         how many pass before the first that does not (batched: every 8th state of all of them first;
         else in order, stopping at the first failure, as RRTConnect)."""
         if self.batched:
-            ok = self.states(A) if starts else np.ones(len(A), dtype=bool)
-            go = np.flatnonzero(ok)
-            ok[go] = self.motions(A[go], B[go])
-            return len(ok) if ok.all() else int(ok.argmin())
+            k = self.first_failing_motion(A, B, bisect=False, starts=starts)
+            m = len(A) if k < 0 else k
+            ok = self.check_motions(A[:m], B[:m])
+            return m if ok.all() else int(ok.argmin())
         n = 0
         while n < len(A) and self.check_step(A[n].tolist(), B[n].tolist(), starts):
             n += 1

@@ -64,6 +64,10 @@ class RobotValidityChecker(ob.StateValidityChecker):
         """Batched validity of configurations Q (N, nq)."""
         return self.robot.are_valid(Q)
 
+    def first_invalid(self, Q: np.ndarray) -> int:
+        """Index of the first invalid configuration of Q (N, nq) in row order, or -1; stops there."""
+        return self.robot.first_invalid(Q)
+
 
 WearerValidityChecker = RobotValidityChecker
 """The name :class:`RobotValidityChecker` had when only the wearer was checked (kept for existing code)."""

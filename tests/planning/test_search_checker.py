@@ -1,0 +1,61 @@
+"""tpee_ompl.planning.search_checker: the search's batched checks that stop at the first failure."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from helpers.wearer_configs import valid_and_colliding
+
+from tpee_ompl.model.wearer_arm import WearerArm
+from tpee_ompl.planning.grouped_space import GroupedSpace
+from tpee_ompl.planning.search_checker import _COARSE_STRIDE, Checker
+from tpee_ompl.planning.setup import make_simple_setup
+
+
+@pytest.fixture(scope="module")
+def checker(robot: WearerArm) -> Checker:
+    si = make_simple_setup(robot).getSpaceInformation()
+    c = Checker(si, GroupedSpace(si, [[0, 1], [2, 3]], 7).layout, batch=True)
+    assert c.batched
+    return c
+
+
+def _screened(checker: Checker, robot: WearerArm, A: np.ndarray, B: np.ndarray, starts: bool) -> np.ndarray:
+    """Per motion: whether its screened states (every 8th interior one, and its start when asked) are valid."""
+    S, idx, _ = checker.interior(A, B, _COARSE_STRIDE)
+    bad = np.bincount(idx[~robot.are_valid(S)], minlength=len(A)) > 0
+    if starts:
+        bad |= ~robot.are_valid(A)
+    return ~bad
+
+
+def test_first_failing_motion_names_a_motion_with_an_invalid_screened_state_in_either_order(checker, robot, rng) -> None:
+    good, _ = valid_and_colliding(robot, rng, 800)
+    A, B = good[:400], good[400:]
+    ok = _screened(checker, robot, A, B, False)
+    assert 5 <= (~ok).sum() and 5 <= ok.sum()  # blocked and free motions to mix
+    blocked, free = np.flatnonzero(~ok), np.flatnonzero(ok)
+    for trial in range(40):
+        pick = rng.permutation(np.concatenate([rng.choice(blocked, trial % 3), rng.choice(free, 4 - trial % 3)]))
+        for starts in (False, True):
+            want = _screened(checker, robot, A[pick], B[pick], starts)
+            in_order = checker.first_failing_motion(A[pick], B[pick], bisect=False, starts=starts)
+            assert in_order == (-1 if want.all() else int(want.argmin()))  # path order: the first failing motion
+            k = checker.first_failing_motion(A[pick], B[pick], bisect=True, starts=starts)
+            assert (k == -1) == want.all() and (k == -1 or not want[k])
+
+
+def test_batched_tree_steps_pass_up_to_the_first_that_check_motion_rejects(checker, robot, rng) -> None:
+    good, bad = valid_and_colliding(robot, rng, 40)
+    pool = np.vstack([good, bad[:5]])
+    for trial in range(25):
+        chain = pool[rng.permutation(len(pool))[:5]]
+        chain[0] = good[trial]  # a tree node: valid
+        A, B = chain[:-1], chain[1:]
+        for starts in (False, True):
+            n = checker.tree_motions(A, B, starts)
+            want = 0
+            while want < len(A) and (not starts or robot.are_valid(A[want : want + 1])[0]) and \
+                    checker.check_motion(A[want], B[want]):
+                want += 1
+            assert n == want
