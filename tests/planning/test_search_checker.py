@@ -59,3 +59,18 @@ def test_batched_tree_steps_pass_up_to_the_first_that_check_motion_rejects(check
                     checker.check_motion(A[want], B[want]):
                 want += 1
             assert n == want
+
+
+def test_candidate_motions_that_pass_are_remembered_as_passing_check_motion(checker, robot, rng) -> None:
+    good, _ = valid_and_colliding(robot, rng, 90)
+    A, C, B = good[:30], good[30:60], good[60:]
+    yes = np.ones(30, dtype=bool)
+    checker.passed.clear()
+    vc, left, right = checker.candidates(C, A, B, yes, yes, np.zeros(30, dtype=bool))
+    remembered = set(checker.passed)
+    assert vc.all() and left.any() and right.any() and not (left & right).all()  # some pass, some fail
+    checker.passed.clear()
+    for k in range(30):
+        for a, b, ok in ((A[k], C[k], left[k]), (C[k], B[k], right[k])):
+            assert ok == checker.check_motion(a, b)  # si.checkMotion's verdict (remembered when it passes)
+    assert remembered == checker.passed  # exactly the passing motions

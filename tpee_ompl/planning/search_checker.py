@@ -252,11 +252,9 @@ class Checker:
             goL &= both | ~strict
             goR &= both | ~strict
             # pass 2: the remaining interior states of motions still in question
-            if self._all_valid is not None:  # screened by the motion validator: the same verdicts
-                bL, bR = np.searchsorted(iL, np.arange(m + 1)), np.searchsorted(iR, np.arange(m + 1))
+            if self._check_motions is not None:  # the motion validator's own verdicts, remembered as such
                 kL, kR = np.flatnonzero(goL), np.flatnonzero(goR)
-                self.own_checks += int((bL[kL + 1] - bL[kL]).sum() + (bR[kR + 1] - bR[kR]).sum())  # at most
-                ok2 = self._all_valid([SL[bL[k] : bL[k + 1]] for k in kL] + [SR[bR[k] : bR[k + 1]] for k in kR])
+                ok2 = self.check_motions(np.concatenate([A[kL], C[kR]]), np.concatenate([C[kL], B[kR]]))
                 left, right = goL.copy(), goR.copy()
                 left[kL], right[kR] = ok2[: len(kL)], ok2[len(kL) :]
                 return vc, left, right
