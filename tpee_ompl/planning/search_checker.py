@@ -1,9 +1,10 @@
 """Validity of states and motions for dimension-RRT's search: :class:`Checker`, batched when the setup allows it.
 
 One ``SpaceInformation``; one batched ``are_valid`` call per pass when its validity checker offers it
-(else ``si.isValid`` / ``si.checkMotion``), and the project's motion validator's screened
-``all_valid`` for whole motions when it is the validator (:mod:`tpee_ompl.planning.dimension_search`
-runs the search on top of it).
+(else ``si.isValid`` / ``si.checkMotion``), its ``first_invalid`` (in order, stopping at the first
+failure) for screens that only need the first failure, and the project's motion validator's own
+``check_motions`` for whole motions when it is the validator
+(:mod:`tpee_ompl.planning.dimension_search` runs the search on top of it).
 """
 
 from __future__ import annotations
@@ -179,7 +180,8 @@ class Checker:
 
     def tree_motions(self, A: np.ndarray, B: np.ndarray, starts: bool) -> int:
         """The connect trees' checks of the motions A[k] -> B[k] (and of A[k] when ``starts``), in full:
-        how many pass before the first that does not (batched: every 8th state of all of them first;
+        how many pass before the first that does not (batched: every 8th state of each in path order,
+        up to the first failure (:meth:`first_failing_motion`), then the motions before it in full;
         else in order, stopping at the first failure, as RRTConnect)."""
         if self.batched:
             k = self.first_failing_motion(A, B, bisect=False, starts=starts)
