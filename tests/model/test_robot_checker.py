@@ -217,3 +217,9 @@ def test_first_invalid_stops_at_the_first_invalid_row_and_counts_only_the_rows_c
         M = np.vstack([good, bad])[rng.permutation(2 * len(good))[:5]]
         ok = robot.are_valid(M)
         assert robot.first_invalid(M) == (-1 if ok.all() else int(ok.argmin()))
+
+
+def test_first_invalid_of_an_empty_batch_finds_none_and_checks_nothing(robot) -> None:
+    c0 = robot.collision_checks
+    assert robot.first_invalid(np.zeros((0, robot.nq))) == -1
+    assert robot.collision_checks == c0

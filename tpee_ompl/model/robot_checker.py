@@ -464,6 +464,8 @@ class RobotChecker:
         states most likely to fail first (a motion's midpoint before its quarter points) finds a
         failure without checking the rest.  Only the rows checked for collision are counted."""
         Q = as_config_batch(Q, self.nq)
+        if len(Q) == 0:
+            return -1
         outside = np.flatnonzero(~np.all((Q >= self.lower) & (Q <= self.upper), axis=1))
         end = int(outside[0]) if len(outside) else len(Q)
         if end == 0:
