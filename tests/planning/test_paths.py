@@ -12,6 +12,7 @@ from tpee_ompl.model.wearer_arm import WearerArm
 from tpee_ompl.planning.grouped_space import RealVectorLayout
 from tpee_ompl.planning.paths import (
     array_to_path,
+    batched_motion_states,
     motion_interior_states,
     motion_is_valid,
     motion_states,
@@ -80,6 +81,22 @@ def test_interior_and_polyline_states_are_motion_states(rng: np.random.Generator
     P = rng.uniform(-1, 1, (6, 3))
     want = np.vstack([P[:1]] + [motion_states(a, b, 0.05) for a, b in zip(P[:-1], P[1:])])
     np.testing.assert_allclose(polyline_motion_states(P, 0.05), want, rtol=0, atol=1e-15)
+
+
+def test_batched_motion_states_are_each_motions_states_bit_for_bit(rng: np.random.Generator) -> None:
+    A, B = rng.uniform(-1, 1, (30, 4)), rng.uniform(-1, 1, (30, 4))
+    B[5] = A[5]  # zero length: one state, the end
+    S, counts = batched_motion_states(A, B, 0.037)
+    want = [motion_states(a, b, 0.037) for a, b in zip(A, B)]
+    assert counts.tolist() == [len(w) for w in want]
+    np.testing.assert_array_equal(S, np.concatenate(want))
+
+
+@pytest.mark.parametrize("A, B, step", [(np.zeros((2, 3)), np.zeros((2, 4)), 0.1), (np.zeros(3), np.ones(3), 0.1),
+                                        (np.full((1, 2), np.nan), np.ones((1, 2)), 0.1), (np.zeros((1, 2)), np.ones((1, 2)), 0.0)])
+def test_batched_motion_states_refuse_bad_ends_or_step(A, B, step) -> None:
+    with pytest.raises(ValueError, match="motion ends|step"):
+        batched_motion_states(A, B, step)
 
 
 @pytest.mark.parametrize("step", [0.0, -1.0, float("nan"), "0.1"])

@@ -164,3 +164,19 @@ def _state(ss, values):
     for i, v in enumerate(values):
         s[i] = float(v)
     return s
+
+
+@pytest.mark.parametrize("screened", [True, False])
+def test_batched_check_motions_gives_each_motion_check_motions_verdict(robot, rng, screened):
+    ss = make_simple_setup(robot)
+    si = ss.getSpaceInformation()
+    mv = BatchedMotionValidator(si, robot, motion_check_step(si), screen_levels=(2.0, 1.0) if screened else ())
+    a, b = si.allocState(), si.allocState()
+    for _ in range(40):
+        K = int(rng.integers(2, 7))
+        A = rng.uniform(robot.lower - 0.05, robot.upper + 0.05, (K, robot.nq))  # some ends outside the limits
+        B = A + rng.normal(scale=0.4, size=A.shape) * (rng.random((K, 1)) < 0.8)  # some zero-length motions
+        got = mv.check_motions(A, B)
+        for k in range(K):
+            set_state(a, A[k]), set_state(b, B[k])
+            assert got[k] == mv.checkMotion(a, b)

@@ -26,7 +26,7 @@ import pinocchio as pin
 if TYPE_CHECKING:
     from .robot_checker import RobotChecker
 
-__all__ = ["BallScreen", "SCREEN_LEVELS", "separated_pairs", "screened_all_valid"]
+__all__ = ["BallScreen", "SCREEN_LEVELS", "separated_pairs", "screened_all_valid", "screened_lines_valid"]
 
 SEPARATION_TOLERANCE = 1e-5
 """Metres taken off every Coal distance (and added to every inflated margin) before it proves anything."""
@@ -117,36 +117,45 @@ class BallScreen:
 def screened_all_valid(robot: RobotChecker, screen: BallScreen, chunks: list[np.ndarray], step: float,
                        levels: tuple[float, ...] = SCREEN_LEVELS) -> np.ndarray:
     """Per chunk (the dense states of one straight motion, evenly spaced along it), True iff every
-    state of it is valid: the same answer as ``robot.are_valid(chunk).all()``, with fewer checks.
-
-    Each chunk starts as one block of states to cover.  At each level h, every block is cut into
-    blocks of at most 2H+1 consecutive states (H: how many states a ball of radius h*``step`` reaches
-    either side); the middle state of each block of 3 or more is checked by :meth:`BallScreen.clear`,
-    and a block whose middle passes is covered.  One batched call per level over all chunks; the states
-    left go to one :meth:`RobotChecker.collision_free` call.  A chunk with a state outside the joint
-    limits is invalid at once (as in ``are_valid``); the others lie inside, so the states a ball covers
-    do too.
-    """
+    state of it is valid: the same answer as ``robot.are_valid(chunk).all()``, with fewer checks
+    (:func:`screened_lines_valid` on the chunks one after the other)."""
     K = len(chunks)
     if K == 0:
         return np.zeros(0, dtype=bool)
     if K == 1:
         return np.array([_one_motion_valid(robot, screen, np.asarray(chunks[0], dtype=float), step, levels)])
     sizes = np.array([len(c) for c in chunks], dtype=np.int64)
-    S = np.concatenate(chunks)
-    offsets = np.cumsum(sizes) - sizes
-    limits_ok = np.all((S >= robot.lower) & (S <= robot.upper), axis=1)
-    inside = np.bincount(np.repeat(np.arange(K), sizes)[~limits_ok], minlength=K) == 0
     spacing = np.array([float(np.linalg.norm(c[1] - c[0])) if len(c) > 1 else 0.0 for c in chunks])
-    live = np.flatnonzero(inside & (sizes > 0))
+    return screened_lines_valid(robot, screen, np.concatenate(chunks), sizes, spacing, step, levels)
+
+
+def screened_lines_valid(robot: RobotChecker, screen: BallScreen, S: np.ndarray, sizes: np.ndarray,
+                         spacing: np.ndarray, step: float, levels: tuple[float, ...] = SCREEN_LEVELS) -> np.ndarray:
+    """:func:`screened_all_valid` for K lines given as one array: S (sum of ``sizes``, nq) holds line k's
+    ``sizes[k]`` states, evenly ``spacing[k]`` apart along a straight segment, after line k - 1's.
+
+    Each line starts as one block of states to cover.  At each level h, every block is cut into
+    blocks of at most 2H+1 consecutive states (H: how many states a ball of radius h*``step`` reaches
+    either side); the middle state of each block of 3 or more is checked by :meth:`BallScreen.clear`,
+    and a block whose middle passes is covered.  One batched call per level over all lines; the states
+    left go to one :meth:`RobotChecker.collision_free` call.  A line with an end outside the joint
+    limits is invalid at once (as in ``are_valid``); the joint box is convex, so the states of the
+    others lie inside it, and so do the states a ball covers.
+    """
+    offsets = np.cumsum(sizes) - sizes
+    live = np.flatnonzero(sizes > 0)
+    E = S[np.concatenate((offsets[live], offsets[live] + sizes[live] - 1))]  # first and last states
+    within = ((E >= robot.lower) & (E <= robot.upper)).all(axis=1)
+    inside = np.ones(len(sizes), dtype=bool)  # an empty line has no invalid state
+    inside[live] = within[: len(live)] & within[len(live) :]
+    live = live[inside[live]]
     starts, lengths, owner = offsets[live], sizes[live], live
     for h in levels:
         if not len(starts):
             break
         radius = h * step
         sp = spacing[owner]
-        H = np.zeros(len(sp), dtype=np.int64)
-        H[sp > 0] = np.floor(radius / sp[sp > 0] * (1 + 1e-12))
+        H = np.floor(radius / np.where(sp > 0, sp, np.inf) * (1 + 1e-12)).astype(np.int64)
         width = np.where(H >= 1, 2 * H + 1, lengths)
         pieces = -(-lengths // width)
         block = np.repeat(np.arange(len(starts)), pieces)
@@ -158,12 +167,12 @@ def screened_all_valid(robot: RobotChecker, screen: BallScreen, chunks: list[np.
         if use.any():
             passed[use] = screen.clear(S[sub_start[use] + (sub_len[use] - 1) // 2], radius)
         starts, lengths, owner = sub_start[~passed], sub_len[~passed], owner[block[~passed]]
-    out = inside.copy()
+    out = inside
     if len(starts):
         idx = np.repeat(starts - (np.cumsum(lengths) - lengths), lengths) + np.arange(int(lengths.sum()))
         bad = ~robot.collision_free(S[idx])
         if bad.any():
-            out[np.unique(np.repeat(owner, lengths)[bad])] = False
+            out[np.repeat(owner, lengths)[bad]] = False
     return out
 
 

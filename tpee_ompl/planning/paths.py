@@ -182,6 +182,30 @@ def unchecked_motion_states(a: np.ndarray, b: np.ndarray, step: float, include_s
     return a + (np.arange(0 if include_start else 1, n + 1) / n)[:, None] * d
 
 
+def batched_motion_states(A: np.ndarray, B: np.ndarray, step: float) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`motion_states` of the motions A[k] -> B[k] (K, n) at once: ``(states, counts)``, motion k's
+    ``counts[k]`` states after motion k - 1's, each the same float as :func:`motion_states` gives.
+
+    Raises
+    ------
+    ValueError
+        If A or B is not finite, their shapes differ or are not (K, n), or step is not a finite number > 0.
+    """
+    A, B = np.asarray(A, dtype=float), np.asarray(B, dtype=float)
+    if A.shape != B.shape or A.ndim != 2:
+        raise ValueError(f"motion ends must be two (K, n) arrays of one shape, got shapes {A.shape} and {B.shape}")
+    if not (np.isfinite(A).all() and np.isfinite(B).all()):
+        raise ValueError("motion ends must be finite")
+    if not (isinstance(step, (int, float, np.integer, np.floating)) and math.isfinite(step) and step > 0):
+        raise ValueError(f"step must be a finite number > 0, got {step!r}")
+    D = B - A
+    # the segment counts as motion_states computes them (one dot product per motion: the same rounding)
+    n = np.array([max(1, math.ceil(math.sqrt(float(d @ d)) / step)) for d in D], dtype=np.int64)
+    idx = np.repeat(np.arange(len(A)), n)
+    j = np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n) + 1
+    return A[idx] + (j / n[idx])[:, None] * D[idx], n
+
+
 def motion_interior_states(
     A: np.ndarray, B: np.ndarray, step: float, lengths: np.ndarray | None = None, stride: int = 1
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -23,10 +23,10 @@ import numpy as np
 from ompl import base as ob
 from ompl import geometric as og
 
-from ..model.clearance_balls import SCREEN_LEVELS, screened_all_valid
+from ..model.clearance_balls import SCREEN_LEVELS, screened_all_valid, screened_lines_valid
 from ..model.robot_checker import RobotChecker
 from ..validation import check_number
-from .paths import MIN_JOINT_STEP, motion_states, set_state, state_to_array, unchecked_motion_states
+from .paths import MIN_JOINT_STEP, batched_motion_states, set_state, state_to_array, unchecked_motion_states
 
 if TYPE_CHECKING:
     from .certified import CertifiedMotionOptions
@@ -112,10 +112,12 @@ class BatchedMotionValidator(ob.MotionValidator):
     def check_motions(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
         """Validity of many motions A[k] -> B[k] (each excluding its start), batched together."""
         A, B = np.atleast_2d(A), np.atleast_2d(B)
-        step = self.effective_step()
-        chunks = [motion_states(a, b, step) for a, b in zip(A, B)]
-        self.motions_checked += len(chunks)
-        return self.all_valid(chunks)
+        S, counts = batched_motion_states(A, B, self.effective_step())
+        self.motions_checked += len(counts)
+        if len(counts) < 2 or not self.screen_levels:
+            return self.all_valid(np.split(S, np.cumsum(counts)[:-1]))
+        spacing = np.sqrt(((B - A) ** 2).sum(-1)) / counts  # the states are evenly spaced along each motion
+        return screened_lines_valid(self.robot, self.robot.ball_screen(), S, counts, spacing, self.step, self.screen_levels)
 
     def all_valid(self, chunks: list[np.ndarray]) -> np.ndarray:
         """Per chunk of evenly spaced states along a line (a motion's dense states), True iff all are valid."""
