@@ -4,6 +4,7 @@
     PYTHONPATH=. .venv/bin/python experiments/first_path.py --queries planning_necessary --max-queries 24
     PYTHONPATH=. .venv/bin/python experiments/first_path.py --skip-overhead --reps 5   # medians over 5 runs per query
     PYTHONPATH=. .venv/bin/python experiments/first_path.py --skip-home           # overhead only
+    PYTHONPATH=. .venv/bin/python experiments/first_path.py --skip-overhead --split   # + time in Pinocchio vs the rest
 
 Home: for every query of each named set (the wearer, ``make_simple_setup`` with its batched motion
 validator), RRTConnect and dimension-RRT (``tpee_dimension_rrt``, seed = query index) run one after the
@@ -46,6 +47,8 @@ def get_argument_parser() -> argparse.ArgumentParser:
                    help="runs per query and planner at home (RRTConnect is unseeded here: its times vary run to run)")
     p.add_argument("--skip-home", action="store_true")
     p.add_argument("--skip-overhead", action="store_true")
+    p.add_argument("--split", action="store_true",
+                   help="time the collision calls (pinocchio.computeCollisions*) apart from the rest of each run")
     return p
 
 
@@ -64,21 +67,48 @@ def _p95(v: list[float]) -> float:
     return float(np.percentile(v, 95)) if v else math.nan
 
 
+class _CollisionTimer:
+    """Wraps Pinocchio's collision calls (the checker calls them through the module) to add up their time."""
+
+    NAMES = ("computeCollisions", "computeCollisionsInParallel")
+
+    def __init__(self) -> None:
+        import pinocchio as pin
+
+        self.spent = 0.0
+        for name in self.NAMES:
+            setattr(pin, name, self._timed(getattr(pin, name)))
+
+    def _timed(self, f):
+        def timed(*a):
+            t = time.perf_counter()
+            try:
+                return f(*a)
+            finally:
+                self.spent += time.perf_counter() - t
+        return timed
+
+
 def home(args: argparse.Namespace) -> None:
+    timer = _CollisionTimer() if args.split else None
     robot = WearerArm()
     for name in args.queries:
         qs = load_queries(name, robot)[: args.max_queries]
         rc, dr, rc_checks, dr_checks = [], [], [], []
+        native: dict[str, list[float]] = {"D": [], "R": []}  # per run: s in collision calls, s outside
+        outside: dict[str, list[float]] = {"D": [], "R": []}
         for k, q in enumerate(qs):
             ss = make_simple_setup(robot, q.start, q.goal)
             si = ss.getSpaceInformation()
             for _ in range(args.reps):  # alternating, so both planners see the same machine state
-                c0 = robot.collision_checks
-                rc.append(_first(ss, og.RRTConnect(si), args.limit))
-                c1 = robot.collision_checks
-                dr.append(_first(ss, tpee_dimension_rrt(si, q.from_sector, q.to_sector, seed=k), args.limit))
-                rc_checks.append(c1 - c0)
-                dr_checks.append(robot.collision_checks - c1)
+                for who, times, checks in (("R", rc, rc_checks), ("D", dr, dr_checks)):
+                    planner = og.RRTConnect(si) if who == "R" else tpee_dimension_rrt(si, q.from_sector, q.to_sector, seed=k)
+                    c0, n0 = robot.collision_checks, timer.spent if timer else 0.0
+                    times.append(_first(ss, planner, args.limit))
+                    checks.append(robot.collision_checks - c0)
+                    if timer and times[-1] is not None:
+                        native[who].append(timer.spent - n0)
+                        outside[who].append(times[-1] - native[who][-1])
         r = [x for x in rc if x is not None]
         d = [x for x in dr if x is not None]
         print(f"home {name:20s} queries {len(qs):4d}  solved D/R {len(d)}/{len(r)}  "
@@ -86,6 +116,11 @@ def home(args: argparse.Namespace) -> None:
               f"ratio {statistics.median(d) / statistics.median(r):5.2f}  p95 D {1e3 * _p95(d):6.1f} ms  "
               f"R {1e3 * _p95(r):6.1f} ms  median checks D {statistics.median(dr_checks):.0f} "
               f"R {statistics.median(rc_checks):.0f}", flush=True)
+        if timer:
+            print(f"     {name:20s} median per run in collision calls D {1e3 * statistics.median(native['D']):5.2f} ms  "
+                  f"R {1e3 * statistics.median(native['R']):5.2f} ms;  outside them D "
+                  f"{1e3 * statistics.median(outside['D']):5.2f} ms  R {1e3 * statistics.median(outside['R']):5.2f} ms",
+                  flush=True)
 
 
 def overhead(args: argparse.Namespace) -> None:
