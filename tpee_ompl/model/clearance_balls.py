@@ -146,40 +146,61 @@ def screened_lines_valid(robot: RobotChecker, screen: BallScreen, S: np.ndarray,
     live = np.flatnonzero(sizes > 0)
     E = S[np.concatenate((offsets[live], offsets[live] + sizes[live] - 1))]  # first and last states
     within = ((E >= robot.lower) & (E <= robot.upper)).all(axis=1)
-    inside = np.ones(len(sizes), dtype=bool)  # an empty line has no invalid state
-    inside[live] = within[: len(live)] & within[len(live) :]
-    live = live[inside[live]]
-    starts, lengths, owner = offsets[live], sizes[live], live
+    out = np.ones(len(sizes), dtype=bool)  # an empty line has no invalid state
+    out[live] = within[: len(live)] & within[len(live) :]
+    live = live[out[live]]
+    ok = _blocks_valid(robot, screen, S, offsets[live].tolist(), sizes[live].tolist(), spacing[live].tolist(), step, levels)
+    out[live] = ok
+    return out
+
+
+def _blocks_valid(robot: RobotChecker, screen: BallScreen, S: np.ndarray, starts: list[int], sizes: list[int],
+                  spacing: list[float], step: float, levels: tuple[float, ...]) -> list[bool]:
+    """The ball screening of :func:`screened_lines_valid` for lines already inside the joint limits, in plain
+    Python over the blocks (a few dozen per call: cheaper than array bookkeeping); one verdict per line."""
+    blocks = [(a, m, k) for k, (a, m) in enumerate(zip(starts, sizes))]  # (start, length, line) still to cover
     for h in levels:
-        if not len(starts):
+        if not blocks:
             break
         radius = h * step
-        sp = spacing[owner]
-        H = np.floor(radius / np.where(sp > 0, sp, np.inf) * (1 + 1e-12)).astype(np.int64)
-        width = np.where(H >= 1, 2 * H + 1, lengths)
-        pieces = -(-lengths // width)
-        block = np.repeat(np.arange(len(starts)), pieces)
-        k = np.arange(len(block)) - np.repeat(np.cumsum(pieces) - pieces, pieces)
-        sub_start = starts[block] + k * width[block]
-        sub_len = np.minimum(width[block], starts[block] + lengths[block] - sub_start)
-        use = (sub_len >= 3) & (H[block] >= 1)
-        passed = np.zeros(len(block), dtype=bool)
-        if use.any():
-            passed[use] = screen.clear(S[sub_start[use] + (sub_len[use] - 1) // 2], radius)
-        starts, lengths, owner = sub_start[~passed], sub_len[~passed], owner[block[~passed]]
-    out = inside
-    if len(starts):
-        idx = np.repeat(starts - (np.cumsum(lengths) - lengths), lengths) + np.arange(int(lengths.sum()))
-        bad = ~robot.collision_free(S[idx])
-        if bad.any():
-            out[np.repeat(owner, lengths)[bad]] = False
-    return out
+        pieces: list[tuple[int, int, int]] = []
+        use: list[int] = []
+        centres: list[int] = []
+        for a, m, k in blocks:
+            sp = spacing[k]
+            H = int(math.floor(radius / sp * (1 + 1e-12))) if sp > 0 else 0
+            if H < 1:
+                pieces.append((a, m, k))
+                continue
+            width = 2 * H + 1
+            for b in range(a, a + m, width):
+                n = min(width, a + m - b)
+                if n >= 3:
+                    use.append(len(pieces))
+                    centres.append(b + (n - 1) // 2)
+                pieces.append((b, n, k))
+        if centres:
+            covered = {i for i, ok in zip(use, screen.clear(S[centres], radius).tolist()) if ok}
+            pieces = [p for i, p in enumerate(pieces) if i not in covered]
+        blocks = pieces
+    ok = [True] * len(starts)
+    if blocks:
+        if len(blocks) == 1:
+            a, m, _ = blocks[0]
+            bad = ~robot.collision_free(S[a : a + m])
+            owner = [blocks[0][2]] * m
+        else:
+            bad = ~robot.collision_free(S[np.concatenate([np.arange(a, a + m) for a, m, _ in blocks])])
+            owner = [k for _, m, k in blocks for _ in range(m)]
+        for i in np.flatnonzero(bad).tolist():
+            ok[owner[i]] = False
+    return ok
 
 
 def _one_motion_valid(robot: RobotChecker, screen: BallScreen, S: np.ndarray, step: float,
                       levels: tuple[float, ...]) -> bool:
-    """:func:`screened_all_valid` for one chunk (``si.checkMotion``'s case): the same blocks, with plain
-    Python over the few failed blocks instead of array bookkeeping (this runs once per motion)."""
+    """:func:`screened_all_valid` for one chunk (``si.checkMotion``'s case, once per motion): the limit test
+    on its two ends without building arrays, then :func:`_blocks_valid`."""
     n = len(S)
     if n == 0:
         return True
@@ -187,28 +208,5 @@ def _one_motion_valid(robot: RobotChecker, screen: BallScreen, S: np.ndarray, st
     lower, upper = robot.lower, robot.upper
     if not ((S[0] >= lower).all() and (S[0] <= upper).all() and (S[-1] >= lower).all() and (S[-1] <= upper).all()):
         return False
-    if n < 3:
-        return bool(robot.collision_free(S).all())
-    d = S[1] - S[0]
-    spacing = math.sqrt(float(d @ d))
-    blocks = [(0, n)]  # (start, length) still to cover
-    for h in levels:
-        if spacing <= 0 or not blocks:
-            break
-        H = int(math.floor(h * step / spacing * (1 + 1e-12)))
-        if H < 1:
-            continue
-        width = 2 * H + 1
-        pieces = [(b, min(width, a + m - b)) for a, m in blocks for b in range(a, a + m, width)]
-        use = [k for k, (_, m) in enumerate(pieces) if m >= 3]
-        if not use:
-            continue
-        passed = screen.clear(S[[pieces[k][0] + (pieces[k][1] - 1) // 2 for k in use]], h * step)
-        covered = {k for k, ok in zip(use, passed.tolist()) if ok}
-        blocks = [p for k, p in enumerate(pieces) if k not in covered]
-    if not blocks:
-        return True
-    if len(blocks) == 1:
-        a, m = blocks[0]
-        return bool(robot.collision_free(S[a : a + m]).all())
-    return bool(robot.collision_free(S[np.concatenate([np.arange(a, a + m) for a, m in blocks])]).all())
+    d = S[1] - S[0] if n > 1 else S[0] * 0.0
+    return _blocks_valid(robot, screen, S, [0], [n], [math.sqrt(float(d @ d))], step, levels)[0]
