@@ -23,7 +23,8 @@ forward node before it or a backward node after it; of the steps with both, the 
 (from the nearest forward node of step t-1, to the nearest backward node of step t+1; holding:
 of a step before / after) are shortest completes a candidate path, and only then are the path's
 motions not checked before checked (every 8th state of all of them first, in bisection order --
-each motion's middle state, then the quarter points, ... -- stopping at the first failure when the
+each motion's middle state, then the quarter points, ..., across motions the state that halves the
+longest unchecked stretch first, so long motions are probed before short ones -- stopping at the first failure when the
 validity checker offers ``first_invalid`` (the project's does: one thread, in order); then all of
 them with ``si.checkMotion``'s verdict, in one ``check_motions`` call when the validator is the
 project's).  A failed motion kills the node it leads into with its subtree; the sample joins the

@@ -403,9 +403,9 @@ class Search:
         """Segments of W (K, n) found invalid (lazy checking: called once W is a complete candidate).
 
         The waypoints are known valid; zero-length segments and segments checked before cost
-        nothing.  Batched, every 8th state of all of them is screened in bisection order until the
-        first failure (:meth:`Checker.first_failing_motion`: that segment alone is then reported),
-        else all of them are checked in full.  With a per-state checker they are checked in full in
+        nothing.  Batched, every 8th state of all of them is screened in bisection order (longest
+        stretch first) until the first failure (:meth:`Checker.first_failing_motion`: that segment
+        alone is then reported), else all of them are checked in full.  With a per-state checker they are checked in full in
         order (``si.checkMotion``'s own bisection finds a failure faster than a Python screen), up to
         the first failure.  Every result is remembered."""
         known, checker = self._known, self.checker
