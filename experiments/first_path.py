@@ -102,7 +102,8 @@ def home(args: argparse.Namespace) -> None:
             si = ss.getSpaceInformation()
             for _ in range(args.reps):  # alternating, so both planners see the same machine state
                 for who, times, checks in (("R", rc, rc_checks), ("D", dr, dr_checks)):
-                    planner = og.RRTConnect(si) if who == "R" else tpee_dimension_rrt(si, q.from_sector, q.to_sector, seed=k)
+                    planner = (og.RRTConnect(si) if who == "R"
+                               else tpee_dimension_rrt(si, q.from_sector, q.to_sector, seed=k))
                     c0, n0 = robot.collision_checks, timer.spent if timer else 0.0
                     times.append(_first(ss, planner, args.limit))
                     checks.append(robot.collision_checks - c0)
@@ -117,7 +118,8 @@ def home(args: argparse.Namespace) -> None:
               f"R {1e3 * _p95(r):6.1f} ms  median checks D {statistics.median(dr_checks):.0f} "
               f"R {statistics.median(rc_checks):.0f}", flush=True)
         if timer:
-            print(f"     {name:20s} median per run in collision calls D {1e3 * statistics.median(native['D']):5.2f} ms  "
+            print(f"     {name:20s} median per run in collision calls "
+                  f"D {1e3 * statistics.median(native['D']):5.2f} ms  "
                   f"R {1e3 * statistics.median(native['R']):5.2f} ms;  outside them D "
                   f"{1e3 * statistics.median(outside['D']):5.2f} ms  R {1e3 * statistics.median(outside['R']):5.2f} ms",
                   flush=True)

@@ -63,8 +63,8 @@ def main(argv: list[str] | None = None) -> None:
         for k, q in enumerate(load_queries(args.queries, robot)):
             ss = make_simple_setup(robot, q.start, q.goal)
             ss.setPlanner(tpee_dimension_rrt(ss.getSpaceInformation(), q.from_sector, q.to_sector, seed=k))
-            ss.solve(ob.plannerOrTerminationCondition(ob.exactSolnPlannerTerminationCondition(ss.getProblemDefinition()),
-                                                      ob.timedPlannerTerminationCondition(args.limit)))
+            first = ob.exactSolnPlannerTerminationCondition(ss.getProblemDefinition())
+            ss.solve(ob.plannerOrTerminationCondition(first, ob.timedPlannerTerminationCondition(args.limit)))
     finally:
         search_checker.Checker.first_failing_motion = original
     counts: dict[str, list[int]] = {"by level": [], "longest stretch first": [], "motion by motion": []}

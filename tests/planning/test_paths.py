@@ -92,8 +92,12 @@ def test_batched_motion_states_are_each_motions_states_bit_for_bit(rng: np.rando
     np.testing.assert_array_equal(S, np.concatenate(want))
 
 
-@pytest.mark.parametrize("A, B, step", [(np.zeros((2, 3)), np.zeros((2, 4)), 0.1), (np.zeros(3), np.ones(3), 0.1),
-                                        (np.full((1, 2), np.nan), np.ones((1, 2)), 0.1), (np.zeros((1, 2)), np.ones((1, 2)), 0.0)])
+@pytest.mark.parametrize("A, B, step", [
+    (np.zeros((2, 3)), np.zeros((2, 4)), 0.1),  # shapes differ
+    (np.zeros(3), np.ones(3), 0.1),  # one motion as vectors, not (K, n)
+    (np.full((1, 2), np.nan), np.ones((1, 2)), 0.1),
+    (np.zeros((1, 2)), np.ones((1, 2)), 0.0),
+])
 def test_batched_motion_states_refuse_bad_ends_or_step(A, B, step) -> None:
     with pytest.raises(ValueError, match="motion ends|step"):
         batched_motion_states(A, B, step)

@@ -149,8 +149,8 @@ def screened_lines_valid(robot: RobotChecker, screen: BallScreen, S: np.ndarray,
     out = np.ones(len(sizes), dtype=bool)  # an empty line has no invalid state
     out[live] = within[: len(live)] & within[len(live) :]
     live = live[out[live]]
-    ok = _blocks_valid(robot, screen, S, offsets[live].tolist(), sizes[live].tolist(), spacing[live].tolist(), step, levels)
-    out[live] = ok
+    out[live] = _blocks_valid(robot, screen, S, offsets[live].tolist(), sizes[live].tolist(), spacing[live].tolist(),
+                              step, levels)
     return out
 
 
@@ -208,5 +208,5 @@ def _one_motion_valid(robot: RobotChecker, screen: BallScreen, S: np.ndarray, st
     lower, upper = robot.lower, robot.upper
     if not ((S[0] >= lower).all() and (S[0] <= upper).all() and (S[-1] >= lower).all() and (S[-1] <= upper).all()):
         return False
-    d = S[1] - S[0] if n > 1 else S[0] * 0.0
-    return _blocks_valid(robot, screen, S, [0], [n], [math.sqrt(float(d @ d))], step, levels)[0]
+    spacing = math.sqrt(float((S[1] - S[0]) @ (S[1] - S[0]))) if n > 1 else 0.0
+    return _blocks_valid(robot, screen, S, [0], [n], [spacing], step, levels)[0]

@@ -24,14 +24,14 @@ forward node before it or a backward node after it; of the steps with both, the 
 of a step before / after) are shortest completes a candidate path, and only then are the path's
 motions not checked before checked (every 8th state of all of them first, in bisection order --
 each motion's middle state, then the quarter points, ..., across motions the state that halves the
-longest unchecked stretch first, so long motions are probed before short ones -- stopping at the first failure when the
-validity checker offers ``first_invalid`` (the project's does: one thread, in order); then all of
-them with ``si.checkMotion``'s verdict, in one ``check_motions`` call when the validator is the
-project's).  A failed motion kills the node it leads into with its subtree; the sample joins the
-trees through its motions of that path that passed in full, and at the other steps on unchecked
-motions (their checks are left to the path that uses them; screening every 8th state of them first
-cost more than it saved: median checks to a first path on the 120 planning-necessary queries 690 ->
-498, Table-4 path lengths unchanged within 1 %).
+longest unchecked stretch first, so long motions are probed before short ones -- stopping at the
+first failure when the validity checker offers ``first_invalid`` (the project's does: one
+thread, in order); then all of them with ``si.checkMotion``'s verdict, in one ``check_motions``
+call when the validator is the project's).  A failed motion kills the node it leads into with its
+subtree; the sample joins the trees through its motions of that path that passed in full, and at
+the other steps on unchecked motions (their checks are left to the path that uses them; screening
+every 8th state of them first cost more than it saved: median checks to a first path on the 120
+planning-necessary queries 690 -> 498, Table-4 path lengths unchanged within 1 %).
 Without prescribed groups a node also serves later (forward) or earlier (backward) steps by
 staying put (a zero-length motion); the sample then joins each tree once, at the lowest (forward)
 or highest (backward) step whose motion passes in full (coarse screening alone let the trees grow

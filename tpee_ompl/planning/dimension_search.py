@@ -405,9 +405,9 @@ class Search:
         The waypoints are known valid; zero-length segments and segments checked before cost
         nothing.  Batched, every 8th state of all of them is screened in bisection order (longest
         stretch first) until the first failure (:meth:`Checker.first_failing_motion`: that segment
-        alone is then reported), else all of them are checked in full.  With a per-state checker they are checked in full in
-        order (``si.checkMotion``'s own bisection finds a failure faster than a Python screen), up to
-        the first failure.  Every result is remembered."""
+        alone is then reported), else all of them are checked in full.  With a per-state checker
+        they are checked in full in order (``si.checkMotion``'s own bisection finds a failure faster
+        than a Python screen), up to the first failure.  Every result is remembered."""
         known, checker = self._known, self.checker
         keys = [W[k : k + 2].tobytes() for k in range(len(W) - 1)]
         bad = [k for k, key in enumerate(keys) if not known.get(key, True)]

@@ -154,6 +154,12 @@ MIN_JOINT_STEP = 1e-4
 """Radians. Smallest accepted motion-check step: finer steps make one motion check take millions of states."""
 
 
+def _check_step(step: float) -> None:
+    """Raise ValueError unless step is a finite number > 0 (a motion check's joint-space step)."""
+    if not (isinstance(step, (int, float, np.integer, np.floating)) and math.isfinite(step) and step > 0):
+        raise ValueError(f"step must be a finite number > 0, got {step!r}")
+
+
 def motion_states(a: np.ndarray, b: np.ndarray, step: float, include_start: bool = False) -> np.ndarray:
     """States checked along the straight motion a -> b, as OMPL's DiscreteMotionValidator picks them.
 
@@ -169,8 +175,7 @@ def motion_states(a: np.ndarray, b: np.ndarray, step: float, include_start: bool
         raise ValueError(f"motion ends must be two vectors of the same length, got shapes {a.shape} and {b.shape}")
     if not (np.all(np.isfinite(a)) and np.all(np.isfinite(b))):
         raise ValueError(f"motion ends must be finite, got {a} -> {b}")
-    if not (isinstance(step, (int, float, np.integer, np.floating)) and math.isfinite(step) and step > 0):
-        raise ValueError(f"step must be a finite number > 0, got {step!r}")
+    _check_step(step)
     return unchecked_motion_states(a, b, step, include_start)
 
 
@@ -196,8 +201,7 @@ def batched_motion_states(A: np.ndarray, B: np.ndarray, step: float) -> tuple[np
         raise ValueError(f"motion ends must be two (K, n) arrays of one shape, got shapes {A.shape} and {B.shape}")
     if not (np.isfinite(A).all() and np.isfinite(B).all()):
         raise ValueError("motion ends must be finite")
-    if not (isinstance(step, (int, float, np.integer, np.floating)) and math.isfinite(step) and step > 0):
-        raise ValueError(f"step must be a finite number > 0, got {step!r}")
+    _check_step(step)
     D = B - A
     # the segment counts as motion_states computes them (one dot product per motion: the same rounding)
     n = np.array([max(1, math.ceil(math.sqrt(float(d @ d)) / step)) for d in D], dtype=np.int64)

@@ -125,10 +125,10 @@ class Checker:
         motions the state that halves the longest unchecked stretch first (a motion of length L at
         bisection level l leaves stretches of L / 2^(l+1)), so long motions are probed more finely
         before short ones (on the wearer's candidate paths: 10.3 states checked to a failure, mean,
-        against 14.7 with every motion's level l before any level l + 1; ``experiments/screen_order.py``).  Else motion by motion
-        from A[0], for a chain of steps whose valid prefix is wanted (every motion before the one
-        returned passed).  With a checker that stops at the first failure, the states after it are
-        not checked."""
+        against 14.7 with every motion's level l before any level l + 1;
+        ``experiments/screen_order.py``).  Else motion by motion from A[0], for a chain of steps whose
+        valid prefix is wanted (every motion before the one returned passed).  With a checker that
+        stops at the first failure, the states after it are not checked."""
         K = len(A)
         if K == 0:
             return -1
@@ -139,7 +139,8 @@ class Checker:
             lengths = self.layout.distance(A, B)
             j = -lengths[idx] / np.exp2(level + 1)  # minus the stretch each state halves
         if starts:  # each motion's start before its interior states
-            S, idx, j = np.concatenate((A, S)), np.concatenate((np.arange(K), idx)), np.concatenate((np.full(K, -np.inf), j))
+            S, idx = np.concatenate((A, S)), np.concatenate((np.arange(K), idx))
+            j = np.concatenate((np.full(K, -np.inf), j))
         order = np.lexsort((idx, j)) if bisect else np.lexsort((j, idx))
         i = self.first_invalid(S[order])
         return -1 if i < 0 else int(idx[order[i]])

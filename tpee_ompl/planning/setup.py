@@ -117,7 +117,8 @@ class BatchedMotionValidator(ob.MotionValidator):
         if len(counts) < 2 or not self.screen_levels:
             return self.all_valid(np.split(S, np.cumsum(counts)[:-1]))
         spacing = np.sqrt(((B - A) ** 2).sum(-1)) / counts  # the states are evenly spaced along each motion
-        return screened_lines_valid(self.robot, self.robot.ball_screen(), S, counts, spacing, self.step, self.screen_levels)
+        return screened_lines_valid(self.robot, self.robot.ball_screen(), S, counts, spacing, self.step,
+                                    self.screen_levels)
 
     def all_valid(self, chunks: list[np.ndarray]) -> np.ndarray:
         """Per chunk of evenly spaced states along a line (a motion's dense states), True iff all are valid."""
