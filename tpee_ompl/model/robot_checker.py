@@ -452,7 +452,7 @@ class RobotChecker:
     def are_valid(self, Q: np.ndarray) -> np.ndarray:
         """Batched :meth:`is_valid` for Q of shape (N, nq): one Pinocchio call; returns bool (N,)."""
         Q = as_config_batch(Q, self.nq)
-        ok = np.all((Q >= self.lower) & (Q <= self.upper), axis=1)
+        ok = ((Q >= self.lower) & (Q <= self.upper)).all(axis=1)
         if ok.any():
             ok[ok] = self.collision_free(Q[ok])
         return ok
@@ -466,7 +466,7 @@ class RobotChecker:
         Q = as_config_batch(Q, self.nq)
         if len(Q) == 0:
             return -1
-        outside = np.flatnonzero(~np.all((Q >= self.lower) & (Q <= self.upper), axis=1))
+        outside = (~((Q >= self.lower) & (Q <= self.upper)).all(axis=1)).nonzero()[0]
         end = int(outside[0]) if len(outside) else len(Q)
         if end == 0:
             return 0

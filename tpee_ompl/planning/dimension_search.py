@@ -341,7 +341,7 @@ class Search:
         vc = np.repeat(self.checker.states(C[:1]), len(ts)) if self._hold else self.checker.states(C)
         fi = np.array([fi_all[t - 1] for t in ts])
         bi = np.array([bi_all[t - 1] for t in ts])
-        both = np.flatnonzero(vc & (fi >= 0) & (bi >= 0))
+        both = (vc & (fi >= 0) & (bi >= 0)).nonzero()[0]
         tried = -1
         joined: set[int] = set()  # holding: the trees c joined already
         if len(both):
@@ -365,7 +365,10 @@ class Search:
                     tree.bwd.kill(node)
             f, b = int(fi[k]), int(bi[k])
             known = self._known  # c joins through a motion checked in full, or of zero length
-            passed = [known.get(W[k : k + 2].tobytes(), not np.any(W[k] != W[k + 1])) for k in (t - 1, t)]
+            passed = []
+            for k in (t - 1, t):
+                ok = known.get(W[k : k + 2].tobytes())
+                passed.append(not (W[k] != W[k + 1]).any() if ok is None else ok)
             if passed[0] and tree.fwd.alive[f]:
                 tree.fwd.add(c, t, f)
                 joined.add(id(tree.fwd))

@@ -80,11 +80,11 @@ class Tree:
 
     def layers(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The live nodes ordered by step, then index, with each step's start in that order and its count."""
-        live = np.flatnonzero(self.alive[: len(self.parents)])
+        live = self.alive[: len(self.parents)].nonzero()[0]
         st = self.steps[live]
         order = np.argsort(st, kind="stable")
         live, st = live[order], st[order]
-        start = np.flatnonzero(np.concatenate(([True], st[1:] != st[:-1]))) if len(st) else np.zeros(0, dtype=int)
+        start = np.concatenate(([True], st[1:] != st[:-1])).nonzero()[0] if len(st) else np.zeros(0, dtype=int)
         return live, start, np.diff(np.append(start, len(st)))
 
 
@@ -126,10 +126,10 @@ class LayeredTrees:
         D = self.delta(np.concatenate((fwd.values[:nf], bwd.values[:nb])), c)
         d2 = np.einsum("ij,ij->i", D, D)
         key = np.concatenate((fwd.steps[:nf], bwd.steps[:nb] + h))
-        live = np.flatnonzero(np.concatenate((fwd.alive[:nf], bwd.alive[:nb])))
+        live = np.concatenate((fwd.alive[:nf], bwd.alive[:nb])).nonzero()[0]
         order = live[np.lexsort((d2[live], key[live]))]  # by step, then distance, then index (stable)
         ko = key[order]
-        first = order[np.flatnonzero(np.concatenate(([True], ko[1:] != ko[:-1])))].tolist() if len(order) else []
+        first = order[np.concatenate(([True], ko[1:] != ko[:-1])).nonzero()[0]].tolist() if len(order) else []
         best = [(math.inf, -1)] * (2 * h)
         for i, s, d in zip(first, key[first].tolist(), d2[first].tolist()):
             best[s] = (d, i if i < nf else i - nf)
@@ -143,9 +143,9 @@ class LayeredTrees:
         (of that step's live nodes in index order)."""
         parts = []
         for tree in (self.fwd, self.bwd):
-            live = np.flatnonzero(tree.alive[: len(tree)])
+            live = tree.alive[: len(tree)].nonzero()[0]
             st = tree.steps[live]
-            parts.append((tree, live, st, np.flatnonzero(np.bincount(st, minlength=self.h))))
+            parts.append((tree, live, st, np.bincount(st, minlength=self.h).nonzero()[0]))
         x = u * sum(len(occupied) for *_, occupied in parts)
         k = int(x)
         for tree, live, st, occupied in parts:
