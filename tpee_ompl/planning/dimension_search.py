@@ -28,10 +28,6 @@ _NARROWING_UNIT = 100
 """The narrowing factor applies per this many samples."""
 _GROUP_BLOCK = 100
 """With several planned groups, each gets this many consecutive samples in turn."""
-_REPAIR_FRACTION = 0.5
-"""Share of repair samples while no valid path exists."""
-_REPAIR_SIGMA = (0.01, 0.1)
-"""Repair samples: Gaussian around a waypoint, sigma log-uniform in this range times the bound widths."""
 
 
 class Search:
@@ -92,7 +88,6 @@ class Search:
         self._hold = not grouped.prescribed
         self.delta = grouped.layout.delta
         self._uniform = np.empty((0, 0))
-        self._normal = np.empty((0, 0))
         self._ui = 0
         if turns is not None and not self.valid:  # a connect path found with fewer steps (h raised)
             self._use_connect = False
@@ -113,18 +108,17 @@ class Search:
         return float(self.L.sum())
 
     def _refill(self, k: int) -> None:
-        """A fresh buffer of randomness (1024 samples of k DOFs) when the current one is used up or of another k."""
-        if self._ui >= len(self._uniform) or self._uniform.shape[1] != k + 3:
-            self._uniform = self.rng.random((1024, k + 3))
-            self._normal = self.rng.standard_normal((1024, k))
+        """A fresh buffer of randomness (1024 samples of k DOFs) when the current one is used up or of another k:
+        per sample, one uniform that picks narrowed or uniform sampling, then k for the values."""
+        if self._ui >= len(self._uniform) or self._uniform.shape[1] != k + 1:
+            self._uniform = self.rng.random((1024, k + 1))
             self._ui = 0
 
-    def _next_random(self, k: int) -> tuple[np.ndarray, np.ndarray]:
-        """Buffered randomness for one sample: 3 + k uniforms and k standard normals."""
+    def _next_random(self, k: int) -> np.ndarray:
+        """Buffered randomness for one sample: 1 + k uniforms (see :meth:`_refill`)."""
         self._refill(k)
-        i = self._ui
         self._ui += 1
-        return self._uniform[i], self._normal[i]
+        return self._uniform[self._ui - 1]
 
     def current_group(self) -> int:
         planned = self.g.planned
@@ -132,29 +126,23 @@ class Search:
 
     def draw(self, gi: int | None) -> np.ndarray:
         """One sample: for group gi (narrowed or uniform), or with gi None for the feasibility phase's
-        joint planned DOFs (repair around a tree node, or uniform); see the module docstring."""
-        d = self._fdims if gi is None else self._dims[gi]
-        lo, hi = self._fbounds if gi is None else self._bounds[gi]
-        u, z = self._next_random(len(d))
-        span = hi - lo
+        joint planned DOFs (uniform over their bounds); see the module docstring."""
         if gi is None:
-            if u[0] < _REPAIR_FRACTION and self._tree is not None:
-                anchor = self._tree.anchor(u[1])
-                sigma = span * _REPAIR_SIGMA[0] * (_REPAIR_SIGMA[1] / _REPAIR_SIGMA[0]) ** u[2]
-                return np.clip(anchor + sigma * z, lo, hi)
-            return lo + u[3:] * span
+            lo, hi = self._fbounds
+            return lo + self._next_random(len(self._fdims))[1:] * (hi - lo)
+        u = self._next_random(len(self._dims[gi]))
         C, n0 = self._group_draws(gi, u[None, :])
         if n0 is not None and self.narrow_start[gi] is None:
             self.narrow_start[gi] = n0
         return C[0]
 
     def _group_draws(self, gi: int, U: np.ndarray) -> tuple[np.ndarray, int | None]:
-        """The next len(U) samples of group gi from the random rows U (m, k + 3), narrowed or uniform as
+        """The next len(U) samples of group gi from the random rows U (m, k + 1), narrowed or uniform as
         :meth:`draw` draws them one by one (the path W unchanged in between), and the group's narrowing
         start they imply (None: not narrowing yet)."""
         lo, hi = self._bounds[gi]
         span = hi - lo
-        C = lo + U[:, 3:] * span
+        C = lo + U[:, 1:] * span
         g0 = self.group_samples[gi]
         n0 = self.narrow_start[gi]
         if n0 is None and g0 + len(U) - 1 >= self.narrow_after:
@@ -168,7 +156,7 @@ class Search:
                 vals = self.W[:, self._dims[gi]]
                 nlo = np.maximum(lo, vals.min(axis=0) - pad)
                 nhi = np.minimum(hi, vals.max(axis=0) + pad)
-                C[narrow] = nlo + U[narrow, 3:] * (nhi - nlo)
+                C[narrow] = nlo + U[narrow, 1:] * (nhi - nlo)
         return C, n0
 
     def iterate(self, limit: int = 1, stop: Callable[[], bool] | None = None) -> int:
@@ -255,7 +243,7 @@ class Search:
         U = self._uniform[self._ui : self._ui + min(limit, len(self._uniform) - self._ui)]
         lo, hi = self._fbounds
         X = np.repeat(self.W[:1], len(U), axis=0)
-        X[:, self._fdims] = lo + U[:, 3:] * (hi - lo)
+        X[:, self._fdims] = lo + U[:, 1:] * (hi - lo)
         P, used = self._connect.run(X, stop)
         self._ui += used
         planned = self.g.planned

@@ -42,7 +42,7 @@ class Tree:
     """Nodes of one layered tree: values (N, k), fake-time step, parent index and liveness of each.
 
     A node is *dead* once the motion into it (or into one of its ancestors) failed a check; dead
-    nodes are never nearest neighbours, anchors or parents again.
+    nodes are never nearest neighbours or parents again.
     """
 
     def __init__(self, k: int) -> None:
@@ -137,23 +137,6 @@ class LayeredTrees:
         if self.hold:  # the nearest over all steps before (forward) / after (backward)
             bf, bb = _running_best(bf), _running_best(bb[::-1])[::-1]
         return [bf[t - 1][1] for t in range(1, h - 1)], [bb[t + 1][1] for t in range(1, h - 1)]
-
-    def anchor(self, u: float) -> np.ndarray:
-        """Values of a live tree node picked by u in [0, 1): a uniform step of either tree, then a uniform node
-        (of that step's live nodes in index order)."""
-        parts = []
-        for tree in (self.fwd, self.bwd):
-            live = tree.alive[: len(tree)].nonzero()[0]
-            st = tree.steps[live]
-            parts.append((tree, live, st, np.bincount(st, minlength=self.h).nonzero()[0]))
-        x = u * sum(len(occupied) for *_, occupied in parts)
-        k = int(x)
-        for tree, live, st, occupied in parts:
-            if k < len(occupied):
-                members = live[st == occupied[k]]
-                return tree.values[members[int((x - int(x)) * len(members))]]
-            k -= len(occupied)
-        raise AssertionError("a layered tree without live nodes")
 
     def path(self, t: int, c: np.ndarray, f: int, b: int) -> tuple[np.ndarray, dict[int, tuple[str, int]]]:
         """The waypoints (h, n) through forward node f, c at step t, backward node b (held nodes repeated).
