@@ -4,7 +4,7 @@
 
 Runs dimension-RRT (``tpee_dimension_rrt``, seed = query index) to its first path on every query of a
 named set, keeps every bisection screen of a candidate path (``Checker.first_failing_motion`` with
-``bisect=True``: every 8th interior state of the path's unchecked motions), checks all of those states,
+``bisect=True``: every 16th interior state of the path's unchecked motions), checks all of those states,
 and counts, per screen, the states an in-order checker (``first_invalid``) would check before the first
 invalid one (all of them when none is), for:
 

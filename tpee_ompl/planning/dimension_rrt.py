@@ -22,7 +22,7 @@ checked lazily, as in LazyRRT: the sample is checked as a waypoint at every step
 forward node before it or a backward node after it; of the steps with both, the one whose motions
 (from the nearest forward node of step t-1, to the nearest backward node of step t+1; holding:
 of a step before / after) are shortest completes a candidate path, and only then are the path's
-motions not checked before checked (every 8th state of all of them first, in bisection order --
+motions not checked before checked (every 16th state of all of them first, in bisection order --
 each motion's middle state, then the quarter points, ..., across motions the state that halves the
 longest unchecked stretch first, so long motions are probed before short ones -- stopping at the
 first failure when the validity checker offers ``first_invalid`` (the project's does: one
@@ -89,7 +89,7 @@ samples pass the cost test and are checked), so the defaults stay at 200 and 0.5
 
 Batching: the candidate waypoints of one sample and their motions go through the validity
 checker's batched ``are_valid(Q)`` when it has one (improvement: two calls per sample at most,
-candidates plus every 8th interior motion state, then the remaining interior states of the
+candidates plus every 16th interior motion state, then the remaining interior states of the
 survivors); otherwise per-state ``si.isValid`` and per-motion ``si.checkMotion``.  Motion states
 are those OMPL's discrete motion validator checks (SO2 entries the short way round).  A motion
 that passed ``si.checkMotion`` in the search is not checked again when its path is posted.  Most

@@ -64,7 +64,7 @@ class Search:
         V[1:-1] = checker.states(W[1:-1])
         self.V = V
         self.E = V[:-1] & V[1:]
-        # in full at once: the initial path is often valid, and then screening every 8th state first only costs
+        # in full at once: the initial path is often valid, and then screening a coarse subset first only costs
         self.E[self.E] = checker.check_motions(W[:-1][self.E], W[1:][self.E])
         self.L = self.dist(W[:-1], W[1:])
         self.samples = 0
@@ -394,7 +394,7 @@ class Search:
         """Segments of W (K, n) found invalid (lazy checking: called once W is a complete candidate).
 
         The waypoints are known valid; zero-length segments and segments checked before cost
-        nothing.  Batched, every 8th state of all of them is screened in bisection order (longest
+        nothing.  Batched, every 16th state of all of them is screened in bisection order (longest
         stretch first) until the first failure (:meth:`Checker.first_failing_motion`: that segment
         alone is then reported), else all of them are checked in full.  With a per-state checker
         they are checked in full in order (``si.checkMotion``'s own bisection finds a failure faster
