@@ -83,7 +83,7 @@ class PythonPlanner(ob.Planner):
         if start is None and pis.getSeenStartStatesCount() > 0:  # solve() again without clear()
             pis.restart()
             start = pis.nextStart()
-        if start is None or not (si.satisfiesBounds(start) and si.isValid(start)):
+        if start is None:  # nextStart() skips start states out of bounds or invalid (OMPL checks them itself)
             return planner_status(ob.PlannerStatus.INVALID_START)
         goal = pdef.getGoal()
         if not isinstance(goal, ob.GoalState):
