@@ -180,3 +180,4 @@ def test_batched_check_motions_gives_each_motion_check_motions_verdict(robot, rn
         for k in range(K):
             set_state(a, A[k]), set_state(b, B[k])
             assert got[k] == mv.checkMotion(a, b)
+    assert mv.check_motions(np.zeros((0, robot.nq)), np.zeros((0, robot.nq))).shape == (0,)  # no motion, no verdict

@@ -115,7 +115,7 @@ class BatchedMotionValidator(ob.MotionValidator):
         S, counts = batched_motion_states(A, B, self.effective_step())
         self.motions_checked += len(counts)
         if len(counts) < 2 or not self.screen_levels:
-            return self.all_valid(np.split(S, np.cumsum(counts)[:-1]))
+            return self.all_valid(np.split(S, np.cumsum(counts)[:-1]) if len(counts) else [])
         spacing = np.sqrt(((B - A) ** 2).sum(-1)) / counts  # the states are evenly spaced along each motion
         return screened_lines_valid(self.robot, self.robot.ball_screen(), S, counts, spacing, self.step,
                                     self.screen_levels)
