@@ -47,6 +47,8 @@ def get_argument_parser() -> argparse.ArgumentParser:
                    help="runs per query and planner at home (RRTConnect is unseeded here: its times vary run to run)")
     p.add_argument("--skip-home", action="store_true")
     p.add_argument("--skip-overhead", action="store_true")
+    p.add_argument("--ompl-seed", type=int, default=0,
+                   help="OMPL's global seed, so RRTConnect's runs repeat (0: unseeded, as by default)")
     p.add_argument("--split", action="store_true",
                    help="time the collision calls (pinocchio.computeCollisions*) apart from the rest of each run")
     return p
@@ -177,6 +179,8 @@ def overhead(args: argparse.Namespace) -> None:
 def main(argv: list[str] | None = None) -> None:
     args = get_argument_parser().parse_args(argv)
     ou.setLogLevel(ou.LOG_NONE)
+    if args.ompl_seed:
+        ou.RNG.setSeed(args.ompl_seed)
     if not args.skip_home:
         home(args)
     if not args.skip_overhead:
