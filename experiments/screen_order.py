@@ -27,7 +27,7 @@ from ompl import util as ou
 from tpee_ompl.model.queries import load_queries
 from tpee_ompl.model.wearer_arm import WearerArm
 from tpee_ompl.planning import search_checker
-from tpee_ompl.planning.search_checker import _COARSE_STRIDE, _bisection_levels
+from tpee_ompl.planning.search_checker import _COARSE_STRIDE, _longest_stretch_key, _screen_levels
 from tpee_ompl.planning.setup import make_simple_setup
 from tpee_ompl.planning.tpee import tpee_dimension_rrt
 
@@ -51,8 +51,7 @@ def main(argv: list[str] | None = None) -> None:
         if bisect:
             S, idx, _ = self.interior(A, B, _COARSE_STRIDE)
             if len(idx):
-                counts = np.bincount(idx, minlength=len(A)).tolist()
-                level = np.concatenate([_bisection_levels(m) for m in counts if m])
+                level = _screen_levels(idx, len(A))
                 screens.append((idx, level, self.layout.distance(A, B)[idx], robot.are_valid(S)))
         return original(self, A, B, bisect, starts)
 
@@ -70,7 +69,8 @@ def main(argv: list[str] | None = None) -> None:
     counts: dict[str, list[int]] = {"by level": [], "longest stretch first": [], "motion by motion": []}
     for idx, level, length, ok in screens:
         counts["by level"].append(_states_to_failure(np.lexsort((idx, level)), ok))
-        counts["longest stretch first"].append(_states_to_failure(np.lexsort((idx, -length / np.exp2(level + 1))), ok))
+        stretch_first = np.lexsort((idx, _longest_stretch_key(level, length)))
+        counts["longest stretch first"].append(_states_to_failure(stretch_first, ok))
         counts["motion by motion"].append(_states_to_failure(np.lexsort((level, idx)), ok))
     failing = sum(int((~ok).any()) for *_, ok in screens)
     print(f"{args.queries}: {len(screens)} screens, {failing} with an invalid state")

@@ -41,6 +41,18 @@ def _bisection_levels(m: int) -> np.ndarray:
     return levels
 
 
+def _screen_levels(idx: np.ndarray, K: int) -> np.ndarray:
+    """Bisection level of each screened state, given its motion idx (in motion order, K motions)."""
+    counts = np.bincount(idx, minlength=K).tolist()
+    return np.concatenate([_bisection_levels(m) for m in counts if m])
+
+
+def _longest_stretch_key(level: np.ndarray, length: np.ndarray) -> np.ndarray:
+    """Sort key of screened states, longest stretch first: minus the stretch each state halves (a motion of
+    that length at that bisection level leaves stretches of length / 2^(level+1))."""
+    return -length / np.exp2(level + 1)
+
+
 def segment_key(a: np.ndarray, b: np.ndarray) -> bytes:
     """Key of the motion a -> b (n,): the bytes of its two float64 ends, as ``W[k : k + 2].tobytes()``."""
     return np.ascontiguousarray(a, dtype=float).tobytes() + np.ascontiguousarray(b, dtype=float).tobytes()
@@ -135,11 +147,8 @@ class Checker:
         if K == 0:
             return -1
         S, idx, j = self.interior(A, B, _COARSE_STRIDE)  # in motion order, then step order
-        if bisect and len(idx):  # the k-th state of a motion of m ranks at the bisection level of k among m
-            counts = np.bincount(idx, minlength=K).tolist()
-            level = np.concatenate([_bisection_levels(m) for m in counts if m])
-            lengths = self.layout.distance(A, B)
-            j = -lengths[idx] / np.exp2(level + 1)  # minus the stretch each state halves
+        if bisect and len(idx):
+            j = _longest_stretch_key(_screen_levels(idx, K), self.layout.distance(A, B)[idx])
         if starts:  # each motion's start before its interior states
             S, idx = np.concatenate((A, S)), np.concatenate((np.arange(K), idx))
             j = np.concatenate((np.full(K, -np.inf), j))
