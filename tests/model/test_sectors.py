@@ -13,6 +13,7 @@ from tpee_ompl.model.sectors import (
     POSTURE_PRESETS,
     SECTORS,
     check_sector,
+    cross_sector_length_bound,
     cross_sector_trajectory,
     in_pointing_sector,
     pointing_sectors,
@@ -138,3 +139,41 @@ def test_bad_targets_raise():
         in_pointing_sector(np.zeros(2), 1)
     with pytest.raises(ValueError, match="itself"):
         cross_sector_trajectory(2, 2)
+
+
+def _length(W: np.ndarray) -> float:
+    return float(np.linalg.norm(np.diff(W, axis=0), axis=1).sum())
+
+
+def _along_row(i: int, j: int, rest: np.ndarray) -> np.ndarray:
+    """Path (7, 2 + k): DOF1/DOF2 on the Table 3 row, the other joints at the given 7 rows."""
+    return np.hstack([cross_sector_trajectory(i, j), rest])
+
+
+@pytest.mark.parametrize("pair", [(1, 2), (3, 4), (1, 4), (2, 4)])
+def test_length_bound_is_attained_by_the_other_joints_moving_with_the_rows_arc_length(pair, rng):
+    i, j = pair
+    row = cross_sector_trajectory(i, j)
+    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(row, axis=0), axis=1))])
+    a, b = rng.uniform(-1.0, 1.0, 2), rng.uniform(-1.0, 1.0, 2)
+    W = _along_row(i, j, a + (s / s[-1])[:, None] * (b - a))
+    assert _length(W) == pytest.approx(cross_sector_length_bound(W[0], W[-1], i, j), rel=1e-12)
+
+
+def test_no_path_along_a_row_is_shorter_than_its_length_bound(rng):
+    for _ in range(500):
+        i, j = (int(k) for k in rng.choice(SECTORS, 2, replace=False))
+        rest = rng.uniform(-2.0, 2.0, (7, 2))
+        W = _along_row(i, j, rest)
+        bound = cross_sector_length_bound(W[0], W[-1], i, j)
+        straight = float(np.linalg.norm(W[-1] - W[0]))
+        assert straight - 1e-12 <= bound <= _length(W) + 1e-12
+
+
+def test_length_bound_refuses_a_start_off_the_row():
+    row = cross_sector_trajectory(1, 2)
+    start, goal = np.r_[row[0] + 0.1, 0.0, 0.0], np.r_[row[-1], 0.0, 0.0]
+    with pytest.raises(ValueError, match="start's DOF1/DOF2"):
+        cross_sector_length_bound(start, goal, 1, 2)
+    with pytest.raises(ValueError, match="same size"):
+        cross_sector_length_bound(goal, goal[:3], 1, 2)

@@ -20,6 +20,7 @@ __all__ = [
     "SECTOR_PAIRS",
     "check_sector",
     "cross_sector_trajectory",
+    "cross_sector_length_bound",
     "in_pointing_sector",
     "pointing_sectors",
     "posture_preset",
@@ -84,6 +85,29 @@ def cross_sector_trajectory(i: int, j: int) -> np.ndarray:
     if i == j:
         raise ValueError(f"no cross-sector trajectory from sector {i} to itself")
     return CROSS_SECTOR_TRAJECTORIES[(i, j)].copy()
+
+
+def cross_sector_length_bound(start: np.ndarray, goal: np.ndarray, i: int, j: int) -> float:
+    """Shortest joint-space length (rad) any path from ``start`` to ``goal`` can have while DOF1/DOF2 follow
+    the Table 3 row from sector i to j: ``hypot(P, S)``, P the row's polyline length, S the straight
+    distance of the other joints.
+
+    Why: it separates what the prescribed row costs from what the search misses.  For segments
+    (a_k, b_k), a_k the DOF1/DOF2 part and b_k the rest, Minkowski's inequality gives
+    sum |(a_k, b_k)| >= hypot(sum |a_k|, sum |b_k|) >= hypot(P, S); a path whose other joints move
+    straight, in proportion to the row's arc length, has exactly this length (obstacles ignored).
+    """
+    row = cross_sector_trajectory(i, j)
+    start, goal = as_float_array(start, "start"), as_float_array(goal, "goal")
+    if start.ndim != 1 or start.shape != goal.shape or start.size < 2:
+        raise ValueError(f"start and goal must be configurations of the same size >= 2, got shapes "
+                         f"{start.shape} and {goal.shape}")
+    for name, q, end in (("start", start, row[0]), ("goal", goal, row[-1])):
+        if not np.allclose(q[:2], end, rtol=0.0, atol=1e-6):
+            raise ValueError(f"{name}'s DOF1/DOF2 {q[:2].tolist()} are not the Table 3 row's end {end.tolist()} "
+                             f"(sectors {i} -> {j})")
+    p = float(np.linalg.norm(np.diff(row, axis=0), axis=1).sum())
+    return float(np.hypot(p, np.linalg.norm(goal[2:] - start[2:])))
 
 
 # ---------------------------------------------------------------------------------------------
