@@ -12,6 +12,7 @@ from tpee_ompl.library.planner import LibraryDimensionRRT, infer_sector
 from tpee_ompl.model.queries import load_queries
 from tpee_ompl.model.sectors import posture_preset
 from tpee_ompl.model.wearer_arm import WearerArm
+from tpee_ompl.planning.dimension_rrt import RELEASE_AFTER, DimensionRRTOptions
 from tpee_ompl.planning.paths import path_passes_motion_checks, path_to_array
 from tpee_ompl.planning.setup import make_simple_setup
 
@@ -153,3 +154,19 @@ def test_a_colliding_direct_motion_changes_nothing(robot, library):
     stats = planner.last_run_stats()
     assert status == ob.PlannerStatus.EXACT_SOLUTION and not stats["direct_motion"]
     assert stats["samples"] > 0
+
+
+def test_the_pipeline_releases_table3_rows_once_its_path_converged(robot, library):
+    q = _stored("planning_necessary", 1, 2)  # its direct motion collides, so the pipeline refines
+    ss, planner, status = _solve(robot, library, q.start, q.goal, max_samples=6000, seed=0)
+    assert planner.options.release_after == RELEASE_AFTER
+    assert planner.settings()["release_after"] == str(RELEASE_AFTER)
+    stats = planner.last_run_stats()
+    assert status == ob.PlannerStatus.EXACT_SOLUTION and stats["released_at"] is not None
+    assert path_passes_motion_checks(ss.getSpaceInformation(), ss.getSolutionPath())
+
+
+def test_options_given_to_the_pipeline_are_kept_as_given(robot, library):
+    ss = make_simple_setup(robot)
+    kept = LibraryDimensionRRT(ss.getSpaceInformation(), library, options=DimensionRRTOptions(seed=1))
+    assert kept.options.release_after is None  # the paper's behaviour, asked for explicitly

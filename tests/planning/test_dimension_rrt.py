@@ -221,7 +221,7 @@ def test_settings_and_stats_shape(robot: WearerArm) -> None:
     assert all(isinstance(v, str) for v in settings.values())
     assert set(planner.last_run_stats()) == {
         "samples", "h", "collision_checks", "first_solution_time", "best_cost", "iterations", "progress",
-        "solutions_posted",
+        "solutions_posted", "released_at",
     }
     assert settings["max_h"] == "None"
 

@@ -24,7 +24,7 @@ from ompl import base as ob
 
 from ..model.queries import straight_motion
 from ..model.sectors import SECTORS, check_sector, posture_preset
-from ..planning.dimension_rrt import DimensionRRT, DimensionRRTOptions
+from ..planning.dimension_rrt import RELEASE_AFTER, DimensionRRT, DimensionRRTOptions
 from ..planning.paths import array_to_path, path_passes_motion_checks, state_to_array
 from ..planning.planner_base import PythonPlanner, planner_status
 from ..planning.tpee import tpee_dimension_rrt
@@ -91,7 +91,7 @@ class LibraryDimensionRRT(PythonPlanner):
         pair = None if from_sector is None else (check_sector(from_sector), check_sector(to_sector))
         if pair is not None and pair[0] == pair[1]:
             raise ValueError(f"({pair[0]}, {pair[1]}) is not a cross-sector motion")
-        opts = options if options is not None else DimensionRRTOptions()
+        opts = options if options is not None else DimensionRRTOptions(release_after=RELEASE_AFTER)
         if not isinstance(opts, DimensionRRTOptions):
             raise ValueError(f"options must be a DimensionRRTOptions, got {type(opts).__name__}")
         opts = dataclasses.replace(opts, name=name, **overrides)
@@ -113,12 +113,14 @@ class LibraryDimensionRRT(PythonPlanner):
             "query_stride": str(lib.query_stride),
             "max_samples": str(self.options.max_samples),
             "seed": str(self.options.seed),
+            "release_after": str(self.options.release_after),
         }
 
     @staticmethod
     def _empty_stats() -> dict[str, Any]:
         return {**PythonPlanner._empty_stats(), "samples": 0, "iterations": 0, "collision_checks": 0,
-                "library_outcome": None, "candidates_tried": 0, "library_seconds": None, "direct_motion": False}
+                "library_outcome": None, "candidates_tried": 0, "library_seconds": None, "direct_motion": False,
+                "released_at": None}
 
     def last_run_stats(self) -> dict[str, Any]:
         """Statistics of the last solve: ``library_outcome`` (how the first path came: "dmp": the closest
@@ -126,7 +128,7 @@ class LibraryDimensionRRT(PythonPlanner):
         "direct": the direct joint-space motion, "planned": dimension-RRT's, "failed"), ``direct_motion``
         (the direct motion was free, so the run ended with it: no path is shorter), ``candidates_tried``,
         ``library_seconds``, and those of :class:`DimensionRRT`
-        (samples, first_solution_time, best_cost, progress [(time_s, best_cost, samples), ...])."""
+        (samples, first_solution_time, best_cost, progress [(time_s, best_cost, samples), ...], released_at)."""
         return super().last_run_stats()
 
     def clear(self) -> None:
@@ -205,7 +207,8 @@ class LibraryDimensionRRT(PythonPlanner):
         t_inner = time.perf_counter() - t0
         status = inner.solve(ptc)
         s = inner.last_run_stats()
-        stats.update(samples=s["samples"], iterations=s["iterations"], collision_checks=s["collision_checks"])
+        stats.update(samples=s["samples"], iterations=s["iterations"], collision_checks=s["collision_checks"],
+                     released_at=s["released_at"])
         posted = s["best_cost"]  # what the inner planner added to the problem definition
         for t, cost, samples in s["progress"]:
             if math.isfinite(cost) and posted <= cost < stats["best_cost"]:

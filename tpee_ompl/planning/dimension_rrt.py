@@ -29,43 +29,27 @@ first failure when the validity checker offers ``first_invalid`` (the project's 
 thread, in order); then all of them with ``si.checkMotion``'s verdict, in one ``check_motions``
 call when the validator is the project's).  A failed motion kills the node it leads into with its
 subtree; the sample joins the trees through its motions of that path that passed in full, and at
-the other steps on unchecked motions (their checks are left to the path that uses them; screening
-every 8th state of them first cost more than it saved: median checks to a first path on the 120
-planning-necessary queries 690 -> 498, Table-4 path lengths unchanged within 1 %).
+the other steps on unchecked motions (their checks are left to the path that uses them).
 Without prescribed groups a node also serves later (forward) or earlier (backward) steps by
 staying put (a zero-length motion); the sample then joins each tree once, at the lowest (forward)
-or highest (backward) step whose motion passes in full (coarse screening alone let the trees grow
-through thin walls there: a 2-D problem with two 0.1-wide walls never connected).  The repeated
+or highest (backward) step whose motion passes in full (coarse screening alone let them through thin walls).  The repeated
 waypoints of the path are spread along its segments before the next sample (kept only if that path
 passes the checker; a run stopped at its first path returns them repeated).  The samples are
-uniform over the planned DOFs' bounds.  (Until 2026-11-25 half of them were Gaussian around a random
-live tree node, meant to grow the trees out of narrow pockets; measured, they cost samples: median
-samples to a first path on the 120 planning-necessary queries 5 -> 4, mean 9.8 -> 7.7, and on the
-plain-OMPL arms and narrow passage with ``connect=False`` 7-54 % less time, 30 seeds each.)
-Measured against checking every motion of every sample: on the wearer's 120 planning-necessary
-queries the median collision checks to a first path fell from 3347 to 1026 (RRTConnect: about
-1150) and on planar arms with 4-8 joints about 2-4x; with prescribed groups and thin walls the
-coarse screening makes the first path slower than full checks would (``experiments/first_path.py``,
-``experiments/foreign_problems.py``).
+uniform over the planned DOFs' bounds.  What each of these choices measured (lazy checks, uniform
+samples, the screen order): ``docs/dimension_rrt.md`` and ``docs/first_path.md``.
 
 Without prescribed groups (``connect=True``, the default) the first path is searched differently:
 a waypoint's configuration then does not depend on its step, so two trees grow as OMPL's RRTConnect
 grows them (:mod:`tpee_ompl.planning.connect_trees`: uniform samples from the planner's own seeded
 generator, steps of at most 0.2 x the space's maximum extent, every motion checked in full), from
 the start and the goal alone (with ``initial_waypoints``: from their valid prefix and suffix; the
-straight line's prefix pinned the trees to the obstacle it ends at, a 4-D wall with a hole needed
-77-193 samples instead of 5-38).  Once they meet, the path's turning points (a
+straight line's prefix would pin the trees to the obstacle it ends at).  Once they meet, the path's turning points (a
 connect's collinear steps are one segment, checked again as one motion) are fitted to the ``h``
 steps: while there are more than ``h``, the interior point whose shortcut saves most and passes is
 dropped; the points are held (repeated) to fill the steps, the path is posted, and the next sample
 first spreads the held points over its segments (kept when that path passes the checker).  A path
-that cannot be fitted seeds the layered trees above with its points at ``h`` evenly spaced places.
-Measured on plain-OMPL problems with a Python validity checker (``experiments/foreign_problems.py
---layered``, both in one run): the first path on planar arms with 4-8 joints 1.05-4.1x
-RRTConnect's time with the layered trees, 0.6-1.9x with the connect trees, on a 3-D narrow passage
-9.5-23x and 2.3-2.7x (the rest there is Python per sample against a sub-microsecond checker; with a
-per-state checker a step is one ``si.checkMotion`` on plain lists and the trees take a block of
-samples per call), with equal or shorter paths after 1 s.  With a
+that cannot be fitted seeds the layered trees above with its points at ``h`` evenly spaced places
+(measured against the layered trees: ``experiments/foreign_problems.py --layered``).  With a
 prescribed group (the TPEE case) the layered trees stay: a waypoint's prescribed values depend on
 its step.
 
@@ -81,11 +65,16 @@ Narrowing: once a valid path exists and the group has drawn ``narrow_after`` sam
 samples come from the bounding box of the current path's group values (all ``h`` steps), padded
 by ``max(range_, span * narrowing ** (m / 100))`` (``span``: the group's bound widths; ``m``:
 samples since narrowing started) and clipped to the bounds; 10 % stay uniform over the bounds.
-The paper narrows once a stable path exists but gives no numbers.  Faster narrowing trades time for
-length at small sample counts (``experiments/narrowing_defaults.py``, 36 held-out queries, not the
-benchmark sets): ``narrow_after=100, narrowing=0.3`` gives a 2.5 % shorter mean path after 500
-samples (3.773 -> 3.679; after 2500: 3.650 -> 3.649) but takes 45 % longer for them (more narrowed
-samples pass the cost test and are checked), so the defaults stay at 200 and 0.5.
+The paper narrows once a stable path exists but gives no numbers; faster narrowing trades time for
+length at a sample cap and buys nothing at equal time (``experiments/narrowing_defaults.py``,
+``docs/dimension_rrt.md``), so the defaults stay at 200 and 0.5.
+
+Releasing the prescribed rows (``release_after``; off by default, as in the paper, which fixes
+DOF1/DOF2 on Table 3's rows "to simplify the calculation"): a converged path along a row can be
+longer than one that leaves it (``experiments/table3_bound.py``).  Once a valid path exists and
+``release_after`` samples in a row brought no shorter one, every group is planned from the current
+path on, by the same rule, without checking that path again (its motions passed ``si.checkMotion``);
+``last_run_stats()["released_at"]`` gives the sample count.  ``LibraryDimensionRRT`` sets it (:data:`RELEASE_AFTER`).
 
 Batching: the candidate waypoints of one sample and their motions go through the validity
 checker's batched ``are_valid(Q)`` when it has one (improvement: two calls per sample at most,
@@ -93,9 +82,8 @@ candidates plus every 16th interior motion state, then the remaining interior st
 survivors); otherwise per-state ``si.isValid`` and per-motion ``si.checkMotion``.  Motion states
 are those OMPL's discrete motion validator checks (SO2 entries the short way round).  A motion
 that passed ``si.checkMotion`` in the search is not checked again when its path is posted.  Most
-samples on a valid path fail the cost test at every step (94 % in 500 samples on the wearer); up to
-64 of them are drawn and passed over in one vectorised step (the same random numbers and the same
-paths as one sample at a time), and the termination condition is asked between such batches and at
+samples on a valid path fail the cost test at every step; up to 64 of them are passed over in one
+vectorised step (the same random numbers and paths as one at a time), and the termination condition is asked between such batches and at
 the sample counts given to :meth:`DimensionRRT.set_sample_checkpoints` (what a benchmark ladder
 reads, with :meth:`DimensionRRT.samples_drawn`).
 
@@ -136,12 +124,15 @@ from .grouped_space import MAX_H, GroupedSpace
 from .planner_base import PythonPlanner, planner_status
 from .solution_posting import SolutionPoster
 
-__all__ = ["DimensionRRT", "DimensionRRTOptions"]
+__all__ = ["RELEASE_AFTER", "DimensionRRT", "DimensionRRTOptions"]
 
 log = logging.getLogger(__name__)
 
 _REFINE_AFTER = 500
 """Samples without a first path after which ``h`` is raised (when ``max_h`` allows; see "Raising h")."""
+
+RELEASE_AFTER = 300
+"""A ``release_after`` that pays (the library pipeline's default; chosen on 36 held-out queries, ``docs/dimension_rrt.md``)."""
 
 _PROGRESS_PERIOD = 0.01
 """Seconds between progress-trace entries (OMPL's benchmark records progress about as often)."""
@@ -185,6 +176,10 @@ class DimensionRRTOptions:
     connect : bool
         Without prescribed groups, look for the first path with RRTConnect's two trees and fit it to
         the ``h`` steps (default True); False: the layered trees.  See "Feasibility phase".
+    release_after : int, optional
+        Once a valid path exists and this many samples in a row brought no shorter one, the prescribed
+        groups are planned too, from the current path (None, the default: prescribed rows are kept
+        to the end, as in the paper).  See "Releasing the prescribed rows".
     """
 
     groups: Sequence[Sequence[int]] | None = None
@@ -199,6 +194,7 @@ class DimensionRRTOptions:
     stall_samples: int | None = None
     max_h: int | None = None
     connect: bool = True
+    release_after: int | None = None
 
     def __post_init__(self) -> None:
         check_name("name", self.name)
@@ -211,6 +207,7 @@ class DimensionRRTOptions:
         set_("connect", check_bool("connect", self.connect))
         set_("stall_samples", check_int("stall_samples", self.stall_samples, minimum=1, optional=True))
         set_("max_h", check_int("max_h", self.max_h, minimum=3, maximum=MAX_H, optional=True))
+        set_("release_after", check_int("release_after", self.release_after, minimum=1, optional=True))
         if self.range_ is not None:
             try:
                 arr = np.asarray(self.range_, dtype=float)
@@ -296,7 +293,7 @@ class DimensionRRT(PythonPlanner):
         self.range_ = rng_full
         self.batch = opts.batch
         self._rng = np.random.default_rng(opts.seed)
-        self._ranges = {gi: rng_full[self.grouped.group_dims(gi)] for gi in self.grouped.planned}
+        self._ranges = {gi: rng_full[self.grouped.group_dims(gi)] for gi in range(len(self.grouped.groups))}
         self._initial = initial
         self._callback: Callable[[ob.Planner, list[ob.State], ob.Cost], object] | None = None
         self._callback_failed = False
@@ -381,6 +378,7 @@ class DimensionRRT(PythonPlanner):
             "batch": str(self.batch),
             "stall_samples": str(self.options.stall_samples),
             "max_h": str(self.options.max_h),
+            "release_after": str(self.options.release_after),
             "connect": str(self.options.connect),
             "initial_waypoints": "none" if self._initial is None else "set",
         }
@@ -396,12 +394,14 @@ class DimensionRRT(PythonPlanner):
             "iterations": 0,
             "progress": [],
             "solutions_posted": 0,
+            "released_at": None,
         }
 
     def last_run_stats(self) -> dict[str, Any]:
         """Statistics of the last solve: samples, h (fake-time steps at the end), collision_checks, first_solution_time (s or None),
         best_cost (inf if none), iterations, progress [(time_s, best_cost, samples), ...],
-        solutions_posted (paths added to the problem definition)."""
+        solutions_posted (paths added to the problem definition), released_at (samples at which the
+        prescribed rows were released, or None)."""
         return super().last_run_stats()
 
     def _start_run(self) -> None:
@@ -441,8 +441,18 @@ class DimensionRRT(PythonPlanner):
             poster.offer(search.W, search.cost, time.perf_counter())
         record(time.perf_counter())
         stall, improved_at = self.options.stall_samples, 0
+        release = self.options.release_after if grouped.prescribed and grouped.planned else None
         stops = self._sample_checkpoints
         while not poster.satisfied and not ptc() and (cap is None or done + search.samples < cap):
+            if release is not None and search.valid and search.samples - improved_at >= release:
+                # converged on the prescribed rows: every group is planned from here, from this path
+                grouped, done, release = grouped.released(), done + search.samples, None
+                search = Search(grouped, checker, self._rng, q0, q1, self.narrow_after, self.narrowing,
+                                self._ranges, search.W, self.options.connect)
+                improved_at = 0
+                stats["released_at"] = done
+                log.info("DimensionRRT: prescribed rows released after %d samples", done)
+                continue
             if stall is not None and math.isfinite(poster.found_cost) and search.samples - improved_at >= stall:
                 break  # converged: nothing shorter in the last ``stall`` samples
             if (not search.valid and 2 * grouped.h - 1 <= max_h

@@ -350,6 +350,11 @@ class GroupedSpace:
         prescribed = {g: W[:, self.group_dims(g)] for g in self.prescribed}
         return GroupedSpace(self.layout.space, self.groups, 2 * self.h - 1, prescribed)
 
+    def released(self) -> GroupedSpace:
+        """The same steps and groups with every group planned (no prescribed rows): what the search
+        continues in once ``release_after`` lets a converged path leave its prescribed rows."""
+        return GroupedSpace(self.layout.space, self.groups, self.h)
+
     def group_point(self, W: np.ndarray, g: int) -> np.ndarray:
         """Path-space point of group g: its values at the h-2 intermediate steps, flat ((h-2) k_g,)."""
         return np.asarray(W)[1:-1][:, self.group_dims(g)].reshape(-1).copy()
