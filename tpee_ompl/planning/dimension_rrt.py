@@ -131,7 +131,7 @@ log = logging.getLogger(__name__)
 _REFINE_AFTER = 500
 """Samples without a first path after which ``h`` is raised (when ``max_h`` allows; see "Raising h")."""
 
-RELEASE_AFTER = 300
+RELEASE_AFTER = 100
 """A ``release_after`` that pays (the library pipeline's default; chosen on 36 held-out queries, ``docs/dimension_rrt.md``)."""
 
 _PROGRESS_PERIOD = 0.01
