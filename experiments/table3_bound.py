@@ -2,10 +2,11 @@
 DOF1/DOF2 row can have, against the best path any planner found.
 
     PYTHONPATH=. .venv/bin/python experiments/table3_bound.py results/<stamp>_pn_anytime/benchmark.db
-    PYTHONPATH=. .venv/bin/python experiments/table3_bound.py DB --planner LibraryDimensionRRT --reference AORRTC
+    PYTHONPATH=. .venv/bin/python experiments/table3_bound.py DB --planner DimensionRRT --reference RRTConnectSimplify
 
-Dimension-RRT's TPEE case keeps DOF1/DOF2 on the paper's Table 3 row; AORRTC, RRTConnect and RRT* move
-them freely.  ``cross_sector_length_bound`` (hypot of the row's length and the other joints' straight
+Dimension-RRT's TPEE case keeps DOF1/DOF2 on the paper's Table 3 row (unless ``release_after`` is set;
+the library pipeline sets it, and its DMP and direct-motion paths leave the row anyway); AORRTC,
+RRTConnect and RRT* move them freely.  ``cross_sector_length_bound`` (hypot of the row's length and the other joints' straight
 distance, obstacles ignored) is a lower bound for every path along the row, so a query whose bound exceeds
 1.05 x the best found cannot be within 5 % for any planner that keeps the row.  Prints, per query, the
 bound / best found and each budget's length / best found of ``--planner`` and ``--reference``; then how many
@@ -29,13 +30,14 @@ from tpee_ompl.model.wearer_arm import WearerArm
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("db", type=Path, help="a campaign's benchmark.db with an anytime comparison")
-    ap.add_argument("--planner", default="DimensionRRT", help="a planner that keeps the Table 3 row")
+    ap.add_argument("--planner", default="DimensionRRT", help="a planner that keeps the Table 3 row (one run per "
+                    "query and budget, as the anytime comparison has)")
     ap.add_argument("--reference", default="AORRTC", help="a planner that moves DOF1/DOF2 freely")
     args = ap.parse_args(argv)
     if not args.db.is_file():
         print(f"table3_bound.py: no such database: {args.db}", file=sys.stderr)
         return 2
-    runs = [r for r in load_runs(args.db) if r["comparison"] == "anytime"]
+    runs = [r for r in load_runs(args.db) if r["comparison"] == "anytime" and r["motion_validator"] in (None, "batched")]
     if not runs:
         print(f"table3_bound.py: {args.db} has no anytime runs", file=sys.stderr)
         return 2
@@ -48,7 +50,12 @@ def main(argv: list[str] | None = None) -> int:
     length: dict[tuple, float] = {}  # (planner, budget, query id) -> raw length of a successful run
     for r in runs:
         if r["success"] and r["planner"] in (args.planner, args.reference):
-            length[(r["planner"], float(r["time_budget"]), r["query_id"])] = float(r["solution_length"])
+            key = (r["planner"], float(r["time_budget"]), r["query_id"])
+            if key in length:
+                print(f"table3_bound.py: {args.db} has several runs of {key[0]} on query {key[2]} at {key[1]:g} s; "
+                      "give a campaign with one run each", file=sys.stderr)
+                return 2
+            length[key] = float(r["solution_length"])
     rows = []
     for qid in sorted(best, key=lambda q: min(r["query_index"] for r in runs if r["query_id"] == q)):
         r0 = next(r for r in runs if r["query_id"] == qid)

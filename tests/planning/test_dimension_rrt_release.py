@@ -44,8 +44,8 @@ def _row_bound() -> float:
 
 def _solve(**kw) -> tuple[og.SimpleSetup, DimensionRRT]:
     ss = _setup()
-    planner = DimensionRRT(ss.getSpaceInformation(), groups=[[0, 1], [2, 3]], prescribed={0: ROW}, seed=0,
-                           max_samples=3000, **kw)
+    kw.setdefault("max_samples", 3000)
+    planner = DimensionRRT(ss.getSpaceInformation(), groups=[[0, 1], [2, 3]], prescribed={0: ROW}, seed=0, **kw)
     ss.setPlanner(planner)
     assert ss.solve(30.0) == ob.PlannerStatus.EXACT_SOLUTION
     return ss, planner
@@ -73,9 +73,24 @@ def test_released_rows_give_a_proven_path_shorter_than_any_path_along_them():
 
 
 def test_release_is_deterministic_under_a_seed_and_a_sample_cap():
-    a, _ = _solve(release_after=100)
-    b, _ = _solve(release_after=100)
+    (a, pa), (b, pb) = _solve(release_after=100), _solve(release_after=100)
+    assert pa.last_run_stats()["released_at"] is not None
+    assert pa.last_run_stats()["released_at"] == pb.last_run_stats()["released_at"]
     np.testing.assert_array_equal(_waypoints(a), _waypoints(b))
+
+
+def test_release_happens_exactly_after_release_after_samples_without_a_shorter_path():
+    _, planner = _solve(release_after=37, max_samples=3000)
+    progress = planner.last_run_stats()["progress"]
+    released = planner.last_run_stats()["released_at"]
+    best = min(cost for _, cost, n in progress if n <= released)
+    last_gain = min(n for _, cost, n in progress if cost == best)  # the trace's entry where that cost came
+    assert released - last_gain == 37
+
+
+def test_stall_counts_on_across_the_release():
+    _, planner = _solve(release_after=50, stall_samples=40)  # stall first: no release
+    assert planner.last_run_stats()["released_at"] is None
 
 
 @pytest.mark.parametrize("bad", [0, -5, 2.5, "300"])

@@ -61,6 +61,8 @@ class LibraryDimensionRRT(PythonPlanner):
         (the Table-1 presets, :func:`infer_sector`).
     options : DimensionRRTOptions, optional
         Settings of the refining dimension-RRT (its ``name`` is ignored; this planner's is ``name``).
+        Left out: the defaults with ``release_after=RELEASE_AFTER`` (Table 3's rows released once the
+        path converged on them); given: used as given (``release_after`` None keeps the rows).
     name : str
         Planner name (``geometric_<name>`` in a Benchmark database).
     **overrides

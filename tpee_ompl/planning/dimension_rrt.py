@@ -48,18 +48,14 @@ connect's collinear steps are one segment, checked again as one motion) are fitt
 steps: while there are more than ``h``, the interior point whose shortcut saves most and passes is
 dropped; the points are held (repeated) to fill the steps, the path is posted, and the next sample
 first spreads the held points over its segments (kept when that path passes the checker).  A path
-that cannot be fitted seeds the layered trees above with its points at ``h`` evenly spaced places
-(measured against the layered trees: ``experiments/foreign_problems.py --layered``).  With a
-prescribed group (the TPEE case) the layered trees stay: a waypoint's prescribed values depend on
-its step.
+that cannot be fitted seeds the layered trees above with its points at ``h`` evenly spaced places.
+With a prescribed group (the TPEE case) the layered trees stay: its values depend on the step.
 
-Raising h (sec. 4.1.3 names the limit: with ``h`` fixed, a path has at most ``h - 1`` segments, and
-an obstacle that needs more turns is never bridged): with ``max_h`` set, after 500 samples without
-a first path, or at once when the connect trees' path has more turns than steps, ``h`` becomes ``2h - 1`` (a step halfway between every two) while that is at most
-``max_h``; the layered trees start again from the refined initial path.  A prescribed group keeps its rows at the even steps and moves linearly between them
-(the same polyline, so the TPEE case's Table 3 motion is unchanged, only sampled at more steps).
-``max_h`` is None by default: ``h`` stays fixed (7 for the TPEE case, as in Table 3) and such a
-problem times out; ``last_run_stats()["h"]`` reports the steps used.
+Raising h (sec. 4.1.3: with ``h`` fixed, an obstacle that needs more than ``h - 1`` segments is never
+bridged): with ``max_h`` set, after 500 samples without a first path, or at once when the connect
+trees' path has more turns than steps, ``h`` becomes ``2h - 1`` while that is at most ``max_h`` and the
+layered trees start again; a prescribed row keeps its polyline, sampled at more steps.  By default
+``h`` stays fixed, as in the paper; ``last_run_stats()["h"]`` reports the steps used.
 
 Narrowing: once a valid path exists and the group has drawn ``narrow_after`` samples, 90 % of the
 samples come from the bounding box of the current path's group values (all ``h`` steps), padded
@@ -73,7 +69,8 @@ Releasing the prescribed rows (``release_after``; off by default, as in the pape
 DOF1/DOF2 on Table 3's rows "to simplify the calculation"): a converged path along a row can be
 longer than one that leaves it (``experiments/table3_bound.py``).  Once a valid path exists and
 ``release_after`` samples in a row brought no shorter one, every group is planned from the current
-path on, by the same rule, without checking that path again (its motions passed ``si.checkMotion``);
+path on, by the same rule (its motions that passed ``si.checkMotion`` are not checked again;
+``stall_samples`` counts on across the release, so a smaller one stops the run first);
 ``last_run_stats()["released_at"]`` gives the sample count.  ``LibraryDimensionRRT`` sets it (:data:`RELEASE_AFTER`).
 
 Batching: the candidate waypoints of one sample and their motions go through the validity
@@ -446,10 +443,11 @@ class DimensionRRT(PythonPlanner):
         while not poster.satisfied and not ptc() and (cap is None or done + search.samples < cap):
             if release is not None and search.valid and search.samples - improved_at >= release:
                 # converged on the prescribed rows: every group is planned from here, from this path
+                # (``improved_at`` shifted so that ``stall`` counts on across the release)
                 grouped, done, release = grouped.released(), done + search.samples, None
+                improved_at -= search.samples
                 search = Search(grouped, checker, self._rng, q0, q1, self.narrow_after, self.narrowing,
                                 self._ranges, search.W, self.options.connect)
-                improved_at = 0
                 stats["released_at"] = done
                 log.info("DimensionRRT: prescribed rows released after %d samples", done)
                 continue
@@ -472,6 +470,8 @@ class DimensionRRT(PythonPlanner):
             limit = _PASS_BATCH if cap is None else min(_PASS_BATCH, cap - drawn)
             if stall is not None:
                 limit = min(limit, stall - (search.samples - improved_at))
+            if release is not None and search.valid:
+                limit = min(limit, release - (search.samples - improved_at))
             if stops and drawn < stops[-1]:
                 limit = min(limit, next(s for s in stops if s > drawn) - drawn)
             accepted = search.iterate(max(1, limit), ptc)
