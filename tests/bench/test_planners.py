@@ -70,3 +70,18 @@ def test_a_runs_checks_are_counted_as_its_solve_returns_not_after_ompls_simplifi
     bench.benchmark(ot.Request(maxTime=1.0, maxMem=4096.0, runCount=1, displayProgress=False,
                                saveConsoleOutput=False, simplify=True))
     assert before[0] < w.last["checks_end"] < after[0]  # OMPL's simplification checks states after the run
+
+
+def test_dimension_rrt_released_is_the_problems_dimension_rrt_with_release_after_under_its_own_name(robot):
+    from tpee_ompl.bench.planners import PlannerContext, planner_factory
+    from tpee_ompl.planning.dimension_rrt import RELEASE_AFTER
+    from tpee_ompl.planning.setup import make_simple_setup
+
+    si = make_simple_setup(robot).getSpaceInformation()
+    ctx = PlannerContext(query={"from_sector": 1, "to_sector": 4}, max_samples=500, seed=3)
+    plain = planner_factory("DimensionRRT")(si, ctx)
+    released = planner_factory("DimensionRRTReleased")(si, ctx)
+    assert released.getName() == "DimensionRRTReleased" and plain.getName() == "DimensionRRT"
+    assert released.options.release_after == RELEASE_AFTER and plain.options.release_after is None
+    assert {k: v for k, v in released.settings().items() if k not in ("release_after", "name")} == \
+        {k: v for k, v in plain.settings().items() if k not in ("release_after", "name")}

@@ -43,8 +43,10 @@ DimensionRRT, LibraryDimensionRRT (the DMP library refined by dimension-RRT) and
 The planners of :data:`ANYTIME_PLANNERS`, in the same order."""
 ANYTIME_PLANNERS: tuple[str, ...] = tuple(CLI_PLANNER_NAMES.values())
 """Planners of the time-matched comparison (every planner the command line knows)."""
-KNOWN_PLANNERS: tuple[str, ...] = (*ANYTIME_PLANNERS, "RRT", "PRMstar")
-"""Every built-in planner name (:data:`tpee_ompl.bench.planners.PLANNER_FACTORIES`); ``module:function`` names a factory elsewhere."""
+KNOWN_PLANNERS: tuple[str, ...] = (*ANYTIME_PLANNERS, "DimensionRRTReleased", "RRT", "PRMstar")
+"""Every built-in planner name (:data:`tpee_ompl.bench.planners.PLANNER_FACTORIES`); ``module:function`` names a factory elsewhere.
+``DimensionRRTReleased`` (named on demand, not in a default comparison) is dimension-RRT with
+``release_after=RELEASE_AFTER``: prescribed rows planned too once the path converged on them."""
 NOT_ITERATION_CAPPED: tuple[str, ...] = ("RRTConnectSimplify",)
 """Planners that cannot be stopped at a sample count, so they never join the iteration-matched comparison."""
 CHECKERS = ("batched", "discrete", "certified", "dense")

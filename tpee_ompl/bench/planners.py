@@ -15,12 +15,14 @@ parser is built without it.
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import importlib
 import logging
 import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 from ompl import base as ob
 from ompl import geometric as og
@@ -53,6 +55,9 @@ class PlannerContext:
     stall_samples: int | None = None
     """Our planners stop after this many samples without a shorter path (None: the paper's behaviour,
     as in every campaign; ``tpee-ompl plan`` sets it so a converged run does not idle to its time limit)."""
+    dimension_rrt_overrides: tuple[tuple[str, Any], ...] = ()
+    """(field, value) pairs of ``DimensionRRTOptions`` a problem's dimension-RRT is built with (a variant's name
+    and settings, e.g. ``DimensionRRTReleased``'s)."""
 
 
 PlannerFactory = Callable[[ob.SpaceInformation, PlannerContext], ob.Planner]
@@ -70,6 +75,13 @@ def _dimension_rrt(si, ctx: PlannerContext):
     from .problems import get_problem
 
     return get_problem(ctx.problem).build_dimension_rrt(si, ctx)
+
+
+def _dimension_rrt_released(si, ctx: PlannerContext):
+    from ..planning.dimension_rrt import RELEASE_AFTER
+
+    overrides = (("release_after", RELEASE_AFTER), ("name", "DimensionRRTReleased"))
+    return _dimension_rrt(si, dataclasses.replace(ctx, dimension_rrt_overrides=overrides))
 
 
 _LIBRARIES: dict[str, object] = {}
@@ -100,6 +112,7 @@ def _rrtconnect_simplify(si, ctx: PlannerContext):
 
 _OURS: dict[str, PlannerFactory] = {
     "DimensionRRT": _dimension_rrt,
+    "DimensionRRTReleased": _dimension_rrt_released,
     "LibraryDimensionRRT": _library_dimension_rrt,
     "RRTConnectSimplify": _rrtconnect_simplify,
 }

@@ -121,7 +121,7 @@ def _wearer_dimension_rrt(si, ctx):
 
     q = ctx.query
     return tpee_dimension_rrt(si, int(q["from_sector"]), int(q["to_sector"]), max_samples=ctx.max_samples,
-                              seed=ctx.seed, stall_samples=ctx.stall_samples)
+                              seed=ctx.seed, stall_samples=ctx.stall_samples, **dict(ctx.dimension_rrt_overrides))
 
 
 def _wearer(name: str, queries: str, what: str) -> Problem:
@@ -147,7 +147,7 @@ def _generic(spec: GenericProblem) -> Problem:
         from ..planning.dimension_rrt import DimensionRRT
 
         return DimensionRRT(si, groups=spec.groups, max_samples=ctx.max_samples, seed=ctx.seed,
-                            stall_samples=ctx.stall_samples)
+                            stall_samples=ctx.stall_samples, **dict(ctx.dimension_rrt_overrides))
 
     extra: dict[str, Any] = {}
     if spec.kind == "arm-so2":
@@ -207,7 +207,7 @@ def _robot_problem(name: str, dimension: int, description: str, robot: str, quer
 
         robots, _ = modules()
         return DimensionRRT(si, groups=getattr(robots, groups_name), max_samples=ctx.max_samples, seed=ctx.seed,
-                            stall_samples=ctx.stall_samples)
+                            stall_samples=ctx.stall_samples, **dict(ctx.dimension_rrt_overrides))
 
     return Problem(name=name, description=description, dimension=dimension, load_queries=load, build=build,
                    build_dimension_rrt=dimension_rrt, groups=((0, 1, 2), (3, 4, 5, 6)),
