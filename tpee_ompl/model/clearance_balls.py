@@ -186,16 +186,14 @@ def _blocks_valid(robot: RobotChecker, screen: BallScreen, S: np.ndarray, starts
             pieces = [p for i, p in enumerate(pieces) if i not in covered]
         blocks = pieces
     ok = [True] * len(starts)
-    if blocks:
-        if len(blocks) == 1:
-            a, m, _ = blocks[0]
-            bad = ~robot.collision_free(S[a : a + m])
-            owner = [blocks[0][2]] * m
-        else:
-            bad = ~robot.collision_free(S[np.concatenate([np.arange(a, a + m) for a, m, _ in blocks])])
-            owner = [k for _, m, k in blocks for _ in range(m)]
-        for i in np.flatnonzero(bad).tolist():
-            ok[owner[i]] = False
+    if len(blocks) == 1:
+        a, m, k = blocks[0]
+        ok[k] = bool(robot.collision_free(S[a : a + m]).all())
+    elif blocks:
+        bad = ~robot.collision_free(S[np.concatenate([np.arange(a, a + m) for a, m, _ in blocks])])
+        owner = np.repeat([k for *_, k in blocks], [m for _, m, _ in blocks])  # the line of each state
+        for k in np.unique(owner[bad]).tolist():
+            ok[k] = False
     return ok
 
 
