@@ -85,3 +85,17 @@ def test_dimension_rrt_released_is_the_problems_dimension_rrt_with_release_after
     assert released.options.release_after == RELEASE_AFTER and plain.options.release_after is None
     assert {k: v for k, v in released.settings().items() if k not in ("release_after", "name")} == \
         {k: v for k, v in plain.settings().items() if k not in ("release_after", "name")}
+
+
+def test_dimension_rrt_no_shortcuts_is_the_problems_dimension_rrt_with_the_papers_rule_alone(robot):
+    from tpee_ompl.bench.planners import PlannerContext, planner_factory
+    from tpee_ompl.planning.setup import make_simple_setup
+
+    si = make_simple_setup(robot).getSpaceInformation()
+    ctx = PlannerContext(query={"from_sector": 2, "to_sector": 3}, max_samples=500, seed=3)
+    plain = planner_factory("DimensionRRT")(si, ctx)
+    paper = planner_factory("DimensionRRTNoShortcuts")(si, ctx)
+    assert paper.getName() == "DimensionRRTNoShortcuts" and plain.getName() == "DimensionRRT"
+    assert paper.shortcuts is False and plain.shortcuts is True  # Table 3 prescribes DOF1/DOF2
+    assert {k: v for k, v in paper.settings().items() if k != "shortcuts"} == \
+        {k: v for k, v in plain.settings().items() if k != "shortcuts"}

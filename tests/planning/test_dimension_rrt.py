@@ -150,6 +150,7 @@ def test_runs_inside_ompl_benchmark(robot: WearerArm, tmp_path) -> None:
         ({"narrowing": 1.5}, "narrowing"),
         ({"narrow_after": -1}, "narrow_after"),
         ({"range_": -0.1}, "range_"),
+        ({"shortcuts": "yes"}, "shortcuts"),
         ({"seed": -3}, "seed"),
         ({"prescribed": {0: np.zeros((5, 2))}}, "shape"),
         ({"prescribed": {4: np.zeros((7, 2))}}, "not a group index"),

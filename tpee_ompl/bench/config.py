@@ -43,10 +43,11 @@ DimensionRRT, LibraryDimensionRRT (the DMP library refined by dimension-RRT) and
 The planners of :data:`ANYTIME_PLANNERS`, in the same order."""
 ANYTIME_PLANNERS: tuple[str, ...] = tuple(CLI_PLANNER_NAMES.values())
 """Planners of the time-matched comparison (every planner the command line knows)."""
-KNOWN_PLANNERS: tuple[str, ...] = (*ANYTIME_PLANNERS, "DimensionRRTReleased", "RRT", "PRMstar")
+KNOWN_PLANNERS: tuple[str, ...] = (*ANYTIME_PLANNERS, "DimensionRRTReleased", "DimensionRRTNoShortcuts", "RRT", "PRMstar")
 """Every built-in planner name (:data:`tpee_ompl.bench.planners.PLANNER_FACTORIES`); ``module:function`` names a factory elsewhere.
 ``DimensionRRTReleased`` (named on demand, not in a default comparison) is dimension-RRT with
-``release_after=RELEASE_AFTER``: prescribed rows planned too once the path converged on them."""
+``release_after=RELEASE_AFTER``: prescribed rows planned too once the path converged on them;
+``DimensionRRTNoShortcuts`` (also on demand) improves by the paper's rule alone (``shortcuts=False``)."""
 NOT_ITERATION_CAPPED: tuple[str, ...] = ("RRTConnectSimplify",)
 """Planners that cannot be stopped at a sample count, so they never join the iteration-matched comparison."""
 CHECKERS = ("batched", "discrete", "certified", "dense")

@@ -84,6 +84,11 @@ def _dimension_rrt_released(si, ctx: PlannerContext):
     return _dimension_rrt(si, dataclasses.replace(ctx, dimension_rrt_overrides=overrides))
 
 
+def _dimension_rrt_no_shortcuts(si, ctx: PlannerContext):
+    overrides = (("shortcuts", False), ("name", "DimensionRRTNoShortcuts"))
+    return _dimension_rrt(si, dataclasses.replace(ctx, dimension_rrt_overrides=overrides))
+
+
 _LIBRARIES: dict[str, object] = {}
 """The default path library, loaded once per process (by model hash) for LibraryDimensionRRT."""
 
@@ -113,6 +118,7 @@ def _rrtconnect_simplify(si, ctx: PlannerContext):
 _OURS: dict[str, PlannerFactory] = {
     "DimensionRRT": _dimension_rrt,
     "DimensionRRTReleased": _dimension_rrt_released,
+    "DimensionRRTNoShortcuts": _dimension_rrt_no_shortcuts,
     "LibraryDimensionRRT": _library_dimension_rrt,
     "RRTConnectSimplify": _rrtconnect_simplify,
 }

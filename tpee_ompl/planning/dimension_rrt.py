@@ -13,30 +13,18 @@ steps are never both replaced by one sample (the motion between them was not che
 
 Feasibility phase (before the first valid path; the paper leaves it open): a forward tree from the
 start and a backward tree from the goal whose depth-t nodes are waypoints of step t.  The trees vary
-ALL planned groups jointly (one sample covers every planned DOF; with a single planned group, as in
-the TPEE case, that is the group) and are built once, so progress in one group is never lost when
-the improvement phase's group turns over (a per-group feasibility phase stalled on a 6-joint arm
-split in three groups).  They are seeded with the valid prefix and suffix of the initial path
-(prescribed groups as given, the others straight).  Every node is a valid waypoint; motions are
-checked lazily, as in LazyRRT: the sample is checked as a waypoint at every step t that has a
-forward node before it or a backward node after it; of the steps with both, the one whose motions
-(from the nearest forward node of step t-1, to the nearest backward node of step t+1; holding:
-of a step before / after) are shortest completes a candidate path, and only then are the path's
-motions not checked before checked (every 16th state of all of them first, in bisection order --
-each motion's middle state, then the quarter points, ..., across motions the state that halves the
-longest unchecked stretch first, so long motions are probed before short ones -- stopping at the
-first failure when the validity checker offers ``first_invalid`` (the project's does: one
-thread, in order); then all of them with ``si.checkMotion``'s verdict, in one ``check_motions``
-call when the validator is the project's).  A failed motion kills the node it leads into with its
-subtree; the sample joins the trees through its motions of that path that passed in full, and at
-the other steps on unchecked motions (their checks are left to the path that uses them).
-Without prescribed groups a node also serves later (forward) or earlier (backward) steps by
-staying put (a zero-length motion); the sample then joins each tree once, at the lowest (forward)
-or highest (backward) step whose motion passes in full (coarse screening alone let them through thin walls).  The repeated
-waypoints of the path are spread along its segments before the next sample (kept only if that path
-passes the checker; a run stopped at its first path returns them repeated).  The samples are
-uniform over the planned DOFs' bounds.  What each of these choices measured (lazy checks, uniform
-samples, the screen order): ``docs/dimension_rrt.md`` and ``docs/first_path.md``.
+ALL planned groups jointly and are built once, so progress in one group is never lost when the
+improvement phase's group turns over (a per-group feasibility phase stalled on a 6-joint arm split
+in three groups).  They are seeded with the valid prefix and suffix of the initial path.  Every node
+is a valid waypoint; motions are checked lazily, as in LazyRRT: the step whose motions from the
+nearest forward node and to the nearest backward node are shortest completes a candidate path, and
+only then are its unchecked motions checked (every 16th state of all of them first, in bisection
+order, longest unchecked stretch first, stopping at the first failure with the checker's
+``first_invalid``; then in full with ``si.checkMotion``'s verdict).  A failed motion kills the node
+it leads into with its subtree.  Without prescribed groups a node also serves later (forward) or
+earlier (backward) steps by staying put; the repeated waypoints of the path are spread along its
+segments before the next sample.  The samples are uniform over the planned DOFs' bounds.  What each
+choice measured: ``docs/dimension_rrt.md`` and ``docs/first_path.md``.
 
 Without prescribed groups (``connect=True``, the default) the first path is searched differently:
 a waypoint's configuration then does not depend on its step, so two trees grow as OMPL's RRTConnect
@@ -58,12 +46,9 @@ layered trees start again; a prescribed row keeps its polyline, sampled at more 
 ``h`` stays fixed, as in the paper; ``last_run_stats()["h"]`` reports the steps used.
 
 Narrowing: once a valid path exists and the group has drawn ``narrow_after`` samples, 90 % of the
-samples come from the bounding box of the current path's group values (all ``h`` steps), padded
-by ``max(range_, span * narrowing ** (m / 100))`` (``span``: the group's bound widths; ``m``:
-samples since narrowing started) and clipped to the bounds; 10 % stay uniform over the bounds.
-The paper narrows once a stable path exists but gives no numbers; faster narrowing trades time for
-length at a sample cap and buys nothing at equal time (``experiments/narrowing_defaults.py``,
-``docs/dimension_rrt.md``), so the defaults stay at 200 and 0.5.
+samples come from the bounding box of the current path's group values, padded by ``max(range_, span
+* narrowing ** (m / 100))`` (``m``: samples since narrowing started), clipped to the bounds; 10 % stay
+uniform.  The paper gives no numbers; the defaults (200, 0.5) are discussed in ``docs/dimension_rrt.md``.
 
 Releasing the prescribed rows (``release_after``; off by default, as in the paper, which fixes
 DOF1/DOF2 on Table 3's rows "to simplify the calculation"): a converged path along a row can be
@@ -72,6 +57,13 @@ longer than one that leaves it (``experiments/table3_bound.py``).  Once a valid 
 path on, by the same rule (its motions that passed ``si.checkMotion`` are not checked again;
 ``stall_samples`` counts on across the release, so a smaller one stops the run first);
 ``last_run_stats()["released_at"]`` gives the sample count.  ``LibraryDimensionRRT`` sets it (:data:`RELEASE_AFTER`).
+
+Shortcuts (``shortcuts``; by default on when a group is prescribed): after each sample that improved
+the path (and on a new path), every intermediate waypoint's values of the sample's group move towards
+the point that is shortest between its neighbours, by the largest of 1, 1/2, 1/4 of the way whose
+waypoint and motions pass (:mod:`tpee_ompl.planning.waypoint_shortcuts`).  Without a prescribed
+group they are off: a waypoint moved onto its neighbours' segment can never move again by the
+paper's rule, and on planar arms the paths ended longer (measured in the docs).
 
 Batching: the candidate waypoints of one sample and their motions go through the validity
 checker's batched ``are_valid(Q)`` when it has one (improvement: two calls per sample at most,
@@ -177,6 +169,10 @@ class DimensionRRTOptions:
         Once a valid path exists and this many samples in a row brought no shorter one, the prescribed
         groups are planned too, from the current path (None, the default: prescribed rows are kept
         to the end, as in the paper).  See "Releasing the prescribed rows".
+    shortcuts : bool, optional
+        After each improvement, move every intermediate waypoint towards the point that is shortest
+        between its neighbours (None, the default: only when a group is prescribed, where it pays;
+        False: the paper's rule alone).  See "Shortcuts".
     """
 
     groups: Sequence[Sequence[int]] | None = None
@@ -192,6 +188,7 @@ class DimensionRRTOptions:
     max_h: int | None = None
     connect: bool = True
     release_after: int | None = None
+    shortcuts: bool | None = None
 
     def __post_init__(self) -> None:
         check_name("name", self.name)
@@ -202,6 +199,8 @@ class DimensionRRTOptions:
         set_("narrowing", check_number("narrowing", self.narrowing, low=0.0, high=1.0, low_open=True))
         set_("batch", check_bool("batch", self.batch))
         set_("connect", check_bool("connect", self.connect))
+        if self.shortcuts is not None:
+            set_("shortcuts", check_bool("shortcuts", self.shortcuts))
         set_("stall_samples", check_int("stall_samples", self.stall_samples, minimum=1, optional=True))
         set_("max_h", check_int("max_h", self.max_h, minimum=3, maximum=MAX_H, optional=True))
         set_("release_after", check_int("release_after", self.release_after, minimum=1, optional=True))
@@ -289,6 +288,7 @@ class DimensionRRT(PythonPlanner):
         self.narrowing = opts.narrowing
         self.range_ = rng_full
         self.batch = opts.batch
+        self.shortcuts = bool(grouped.prescribed) if opts.shortcuts is None else opts.shortcuts
         self._rng = np.random.default_rng(opts.seed)
         self._ranges = {gi: rng_full[self.grouped.group_dims(gi)] for gi in range(len(self.grouped.groups))}
         self._initial = initial
@@ -377,6 +377,7 @@ class DimensionRRT(PythonPlanner):
             "max_h": str(self.options.max_h),
             "release_after": str(self.options.release_after),
             "connect": str(self.options.connect),
+            "shortcuts": str(self.shortcuts),
             "initial_waypoints": "none" if self._initial is None else "set",
         }
 
@@ -422,7 +423,7 @@ class DimensionRRT(PythonPlanner):
         checker = Checker(si, layout, self.batch)
         checks0 = checker.counter()
         search = Search(self.grouped, checker, self._rng, q0, q1, self.narrow_after, self.narrowing, self._ranges,
-                         self._initial, self.options.connect)
+                         self._initial, self.options.connect, shortcuts=self.shortcuts)
         poster = SolutionPoster(self, si, pdef, t0, self.grouped.to_path, self._notify, checker.passed)
         stats = self._stats
         progress = stats["progress"]
@@ -447,7 +448,7 @@ class DimensionRRT(PythonPlanner):
                 grouped, done, release = grouped.released(), done + search.samples, None
                 improved_at -= search.samples
                 search = Search(grouped, checker, self._rng, q0, q1, self.narrow_after, self.narrowing,
-                                self._ranges, search.W, self.options.connect)
+                                self._ranges, search.W, self.options.connect, shortcuts=self.shortcuts)
                 stats["released_at"] = done
                 log.info("DimensionRRT: prescribed rows released after %d samples", done)
                 continue
@@ -460,7 +461,7 @@ class DimensionRRT(PythonPlanner):
                 grouped = grouped.refined(q0, q1)
                 done += search.samples
                 search = Search(grouped, checker, self._rng, q0, q1, self.narrow_after, self.narrowing,
-                                self._ranges, None, self.options.connect, search.unfitted)
+                                self._ranges, None, self.options.connect, search.unfitted, self.shortcuts)
                 if search.valid:
                     poster.offer(search.W, search.cost, time.perf_counter())
                     record(time.perf_counter())

@@ -19,6 +19,7 @@ from .connect_trees import RANGE_FRACTION, ConnectTrees
 from .grouped_space import GroupedSpace
 from .layered_trees import LayeredTrees, spread_waypoints
 from .search_checker import Checker, segment_key
+from .waypoint_shortcuts import shortcut_waypoints
 
 __all__ = ["Search"]
 
@@ -46,6 +47,7 @@ class Search:
         initial: np.ndarray | None = None,
         connect: bool = True,
         turns: np.ndarray | None = None,
+        shortcuts: bool = False,
     ) -> None:
         self.g = grouped
         self.checker = checker
@@ -92,6 +94,9 @@ class Search:
         self.delta = grouped.layout.delta
         self._uniform = np.empty((0, 0))
         self._ui = 0
+        self._shortcuts = shortcuts
+        self._shortcut_due = self.valid
+        """Shortcuts between the waypoints are due: the valid path changed since the last sweep (or is new)."""
         if turns is not None and not self.valid:  # a connect path found with fewer steps (h raised)
             self._use_connect = False
             self._fit(turns)
@@ -205,7 +210,13 @@ class Search:
         c = self.draw(gi if valid else None)
         self.samples += 1
         self.group_samples[gi] += 1
-        return self._improve(gi, c) if valid else self._grow(c)
+        if not valid:
+            return self._grow(c)
+        accepted = self._improve(gi, c)
+        if self._shortcuts and (accepted or self._shortcut_due):
+            self._shortcut_due = False  # one sweep per change of the path: more sweeps cost more than they save
+            accepted += shortcut_waypoints(self.W, self.L, self._dims[gi], self.g.layout, self.checker)
+        return accepted
 
     def _pass_rejected(self, limit: int) -> None:
         """Advance past the next samples (at most ``limit``, within the current group's block and the
@@ -438,6 +449,7 @@ class Search:
         self.E[:] = True
         self.L[:] = self.dist(W[:-1], W[1:])
         self._spread_pending = self._hold
+        self._shortcut_due = True
 
     def _spread(self) -> None:
         """Move held waypoints onto the path's segments, kept only when that path passes the checker."""

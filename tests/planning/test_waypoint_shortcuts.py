@@ -1,0 +1,107 @@
+"""Shortcuts between fake-time waypoints: the target is the shortest point, every move keeps the path valid."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from helpers.planning_spaces import box_problem
+from ompl import base as ob
+from ompl import geometric as og
+
+from tpee_ompl.planning.dimension_rrt import DimensionRRT
+from tpee_ompl.planning.grouped_space import GroupedSpace
+from tpee_ompl.planning.paths import path_passes_motion_checks
+from tpee_ompl.planning.search_checker import Checker
+from tpee_ompl.planning.waypoint_shortcuts import shortcut_targets, shortcut_waypoints
+
+
+def _through(A: np.ndarray, X: np.ndarray, B: np.ndarray) -> np.ndarray:
+    return np.linalg.norm(X - A, axis=-1) + np.linalg.norm(B - X, axis=-1)
+
+
+def test_target_is_the_shortest_point_when_the_other_dofs_stay(rng: np.random.Generator) -> None:
+    si, _ = box_problem(lo=(0.9, 0.9, 0.9, 0.9), hi=(1.0, 1.0, 1.0, 1.0))
+    layout = GroupedSpace(si, [[0, 1], [2, 3]], 5).layout
+    dims = np.array([2, 3])
+    A, X, B = (rng.uniform(-1, 1, (50, 4)) for _ in range(3))
+    T = shortcut_targets(A, X, B, dims, layout)
+    assert np.array_equal(T[:, :2], X[:, :2])  # the fixed DOFs stay
+    for _ in range(20):  # no other value of the moved DOFs is shorter
+        Y = T.copy()
+        Y[:, dims] += rng.normal(0.0, 0.05, (50, 2))
+        assert np.all(_through(A, T, B) <= _through(A, Y, B) + 1e-12)
+
+
+def test_with_every_dof_moved_the_target_is_the_projection_onto_the_neighbours_segment() -> None:
+    si, _ = box_problem()
+    layout = GroupedSpace(si, [[0, 1]], 3).layout
+    A, X, B = np.array([[-0.5, 0.0]]), np.array([[0.1, 0.6]]), np.array([[0.5, 0.0]])
+    assert np.allclose(shortcut_targets(A, X, B, np.array([0, 1]), layout), [[0.1, 0.0]])
+
+
+def test_continuous_joints_are_moved_the_short_way_round() -> None:
+    space = ob.CompoundStateSpace()
+    for _ in range(2):
+        space.addSubspace(ob.SO2StateSpace(), 1.0)
+    si = ob.SpaceInformation(space)
+    si.setStateValidityChecker(lambda s: True)
+    si.setup()
+    layout = GroupedSpace(si, [[0, 1]], 3).layout
+    A, X, B = np.array([[3.0, 0.0]]), np.array([[0.0, 1.0]]), np.array([[-3.0, 0.0]])
+    T = shortcut_targets(A, X, B, np.array([0]), layout)
+    # A and B are 0.28 rad apart through +-pi: the shortest point of joint 0 lies there, not at 0
+    assert abs(abs(T[0, 0]) - np.pi) < 1e-9 and T[0, 1] == 1.0
+    assert -np.pi <= T[0, 0] < np.pi
+
+
+@pytest.mark.parametrize("batch", [True, False])
+def test_a_sweep_only_shortens_the_path_and_keeps_every_motion_valid(batch: bool, rng: np.random.Generator) -> None:
+    si, _ = box_problem(lo=(-0.2, -0.2), hi=(0.2, 0.2))
+    grouped = GroupedSpace(si, [[0, 1]], 7)
+    checker = Checker(si, grouped.layout, batch)
+    start, goal = np.array([-0.9, 0.0]), np.array([0.9, 0.0])
+    # a valid zigzag around the box: above it, with detours up and down
+    W = np.array([start, [-0.6, 0.5], [-0.3, 0.9], [0.0, 0.4], [0.3, 0.9], [0.6, 0.5], goal])
+    assert checker.states(W).all() and checker.check_motions(W[:-1], W[1:]).all()
+    L = grouped.layout.distance(W[:-1], W[1:])
+    lengths = [L.sum()]
+    for _ in range(30):
+        if not shortcut_waypoints(W, L, np.array([0, 1]), grouped.layout, checker):
+            break
+        assert np.allclose(L, grouped.layout.distance(W[:-1], W[1:]))
+        lengths.append(L.sum())
+    assert np.all(np.diff(lengths) < 0) and len(lengths) > 3
+    assert np.array_equal(W[0], start) and np.array_equal(W[-1], goal)
+    assert checker.states(W).all() and checker.check_motions(W[:-1], W[1:]).all()
+    # from 3.3 to within 10 % of the shortest way over the box, 2 |(-0.9, 0) -> (-0.2, 0.2)| + 0.4
+    assert 2 * np.hypot(0.7, 0.2) + 0.4 < lengths[-1] < 1.1 * (2 * np.hypot(0.7, 0.2) + 0.4) < 0.7 * lengths[0]
+
+
+def _solve_3d(shortcuts: bool | None, seed: int, prescribed: bool = True) -> tuple[DimensionRRT, float]:
+    si, _ = box_problem(lo=(-0.3, -0.3, -0.5), hi=(0.3, 0.3, 0.5))
+    ss = og.SimpleSetup(si)
+    start, goal = si.allocState(), si.allocState()
+    for k, (a, b) in enumerate(((-0.9, 0.9), (0.0, 0.1), (0.0, -0.1))):
+        start[k], goal[k] = a, b
+    ss.setStartAndGoalStates(start, goal)
+    ss.setOptimizationObjective(ob.PathLengthOptimizationObjective(si))
+    row = {0: np.linspace(-0.9, 0.9, 7)[:, None]} if prescribed else None
+    planner = DimensionRRT(si, groups=[[0], [1, 2]], h=7, max_samples=300, seed=seed, shortcuts=shortcuts,
+                           prescribed=row)
+    ss.setPlanner(planner)
+    assert ss.solve(10.0) == ob.PlannerStatus.EXACT_SOLUTION
+    path = ss.getSolutionPath()
+    assert path_passes_motion_checks(si, path)
+    return planner, path.length()
+
+
+def test_with_a_prescribed_group_shortcuts_give_shorter_paths_at_a_sample_cap() -> None:
+    off = [_solve_3d(False, seed)[1] for seed in range(5)]
+    on = [_solve_3d(True, seed)[1] for seed in range(5)]
+    assert np.mean(on) < np.mean(off)
+
+
+def test_shortcuts_are_on_by_default_only_with_a_prescribed_group() -> None:
+    assert _solve_3d(None, 0)[0].settings()["shortcuts"] == "True"
+    assert _solve_3d(None, 0, prescribed=False)[0].settings()["shortcuts"] == "False"
+    assert _solve_3d(True, 0, prescribed=False)[0].settings()["shortcuts"] == "True"

@@ -1,0 +1,78 @@
+"""Shortcuts between fake-time waypoints: what dimension-RRT does after each improvement it accepts.
+
+The paper's rule improves a waypoint only when a random sample happens to shorten the path there.
+After such a sample, each intermediate waypoint ``W[t]`` can also move its values of the sample's
+group straight towards the point that makes the path through its neighbours shortest: with the
+waypoint's other DOFs fixed, ``|A - X| + |X - B|`` is least at the point of the segment ``A -> B``
+(the group's DOFs) a fraction ``a / (a + b)`` along it, where ``a`` and ``b`` are the fixed DOFs'
+distances to the neighbours (exact for the Euclidean metric; with no fixed DOF, the projection of
+``W[t]`` onto the segment).  The length through the neighbours is convex along the way there, so each
+fraction of the move shortens the path; the largest of :data:`SHORTCUT_FRACTIONS` whose waypoint and
+both motions pass is taken, by the same checks as a sample's candidate.  A waypoint that lands on its
+neighbours' segment in every DOF can never move again by the paper's rule (nothing is shorter there),
+which is why :class:`~tpee_ompl.planning.dimension_rrt.DimensionRRT` uses them by default only with a
+prescribed group.  Measured in ``docs/dimension_rrt.md`` ("Shortcuts between fake-time waypoints").
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+if TYPE_CHECKING:  # pragma: no cover
+    from .grouped_space import RealVectorLayout
+    from .search_checker import Checker
+
+__all__ = ["SHORTCUT_FRACTIONS", "shortcut_targets", "shortcut_waypoints"]
+
+SHORTCUT_FRACTIONS = (1.0, 0.5, 0.25)
+"""Fractions of the way to the shortest point tried, largest first (the first that passes is kept)."""
+
+
+def shortcut_targets(A: np.ndarray, X: np.ndarray, B: np.ndarray, dims: np.ndarray, layout: RealVectorLayout) -> np.ndarray:
+    """For each row of X (m, n): X with its DOFs ``dims`` moved to where the path A -> X -> B is shortest
+    while X's other DOFs stay (exact for the Euclidean metric; differences the short way round for SO2)."""
+    dAX, dXB, dAB = layout.delta(A, X), layout.delta(X, B), layout.delta(A, B)
+    fixed = np.ones(X.shape[1], dtype=bool)
+    fixed[dims] = False
+    a = np.linalg.norm(dAX[:, fixed], axis=1)
+    b = np.linalg.norm(dXB[:, fixed], axis=1)
+    seg = dAB[:, dims]
+    proj = np.clip((dAX[:, dims] * seg).sum(axis=1) / np.maximum((seg * seg).sum(axis=1), 1e-300), 0.0, 1.0)
+    f = np.where(a + b > 1e-12, a / np.maximum(a + b, 1e-300), proj)
+    T = X.copy()
+    T[:, dims] = A[:, dims] + f[:, None] * seg
+    return layout.wrap(T)
+
+
+def shortcut_waypoints(W: np.ndarray, L: np.ndarray, dims: np.ndarray, layout: RealVectorLayout, checker: Checker) -> int:
+    """Move the intermediate waypoints of the valid path W (h, n) towards their shortest points, in place.
+
+    The odd steps go first, then the even ones, so no two neighbours move at once (the motion between
+    them would be unchecked).  ``L`` (h - 1,) holds the segment lengths and is kept up to date; a
+    waypoint moves only when the path gets shorter and the candidate and both its motions are valid,
+    so W stays a valid path.  Returns the number of waypoints moved."""
+    moved = 0
+    for first in (1, 2):
+        ts = np.arange(first, len(W) - 1, 2)
+        if not len(ts):
+            continue
+        A, X, B = W[ts - 1], W[ts].copy(), W[ts + 1]
+        T = shortcut_targets(A, X, B, dims, layout)
+        todo = np.ones(len(ts), dtype=bool)
+        for fraction in SHORTCUT_FRACTIONS:
+            C = layout.interpolate(X, T, np.full(len(ts), fraction))
+            dl, dr = layout.distance(A, C), layout.distance(C, B)
+            sel = np.flatnonzero(todo & (dl + dr < L[ts - 1] + L[ts] - 1e-12))
+            if not len(sel):
+                break
+            yes = np.ones(len(sel), dtype=bool)
+            vc, left, right = checker.candidates(C[sel], A[sel], B[sel], yes, yes, yes)
+            for k in sel[vc & left & right]:
+                t = ts[k]
+                W[t] = C[k]
+                L[t - 1], L[t] = dl[k], dr[k]
+                todo[k] = False
+                moved += 1
+    return moved
