@@ -11,6 +11,7 @@ from pathlib import Path
 import pytest
 from helpers.bench_databases import assert_same_shape
 from helpers.bench_standins import write_query_file
+from helpers.planning_spaces import free_so2_space
 from ompl import base as ob
 from ompl import geometric as og
 
@@ -151,12 +152,7 @@ def test_one_run_ladders_give_the_database_of_separate_runs(tmp_path, robot):
 def test_checkpoint_columns_write_waypoints_of_a_compound_so2_space():
     from tpee_ompl.bench.ladder import Ladder
 
-    space = ob.CompoundStateSpace()
-    for _ in range(2):
-        space.addSubspace(ob.SO2StateSpace(), 1.0)
-    si = ob.SpaceInformation(space)
-    si.setStateValidityChecker(lambda s: True)
-    si.setup()
+    si = free_so2_space()
     pdef = ob.ProblemDefinition(si)
     snap = {"waypoints": [[3.0, -3.0], [-3.0, 3.0]], "exact": True, "time": 0.1, "valid_fraction": 1.0,
             "difference": 0.0}

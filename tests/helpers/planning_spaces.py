@@ -34,3 +34,14 @@ def box_problem(lo=(0.4, -0.2), hi=(0.6, 0.2), resolution: float = 0.01) -> tupl
     si.setStateValidityCheckingResolution(resolution)
     si.setup()
     return si, checker
+
+
+def free_so2_space(n: int = 2) -> ob.SpaceInformation:
+    """A set-up SpaceInformation over ``n`` continuous joints (a compound of SO2 spaces), every state valid."""
+    space = ob.CompoundStateSpace()
+    for _ in range(n):
+        space.addSubspace(ob.SO2StateSpace(), 1.0)
+    si = ob.SpaceInformation(space)
+    si.setStateValidityChecker(lambda s: True)
+    si.setup()
+    return si

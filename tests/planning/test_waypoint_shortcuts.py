@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from helpers.planning_spaces import box_problem
+from helpers.planning_spaces import box_problem, free_so2_space
 from ompl import base as ob
 from ompl import geometric as og
 
@@ -40,12 +40,7 @@ def test_with_every_dof_moved_the_target_is_the_projection_onto_the_neighbours_s
 
 
 def test_continuous_joints_are_moved_the_short_way_round() -> None:
-    space = ob.CompoundStateSpace()
-    for _ in range(2):
-        space.addSubspace(ob.SO2StateSpace(), 1.0)
-    si = ob.SpaceInformation(space)
-    si.setStateValidityChecker(lambda s: True)
-    si.setup()
+    si = free_so2_space()
     layout = GroupedSpace(si, [[0, 1]], 3).layout
     A, X, B = np.array([[3.0, 0.0]]), np.array([[0.0, 1.0]]), np.array([[-3.0, 0.0]])
     T = shortcut_targets(A, X, B, np.array([0]), layout)

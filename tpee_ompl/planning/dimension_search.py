@@ -171,7 +171,8 @@ class Search:
         """Draw one sample and try it at every intermediate step (up to ``limit`` samples on a valid path
         or in the connect trees).
 
-        On a valid path the sample is the current group's (paper's rule); before, it covers all
+        On a valid path the sample is the current group's (paper's rule), followed with ``shortcuts``
+        by one sweep of :func:`shortcut_waypoints` over that group when the path changed; before, it covers all
         planned groups at once and grows the connect trees (no prescribed group) or the layered
         trees.  Returns the number of waypoints changed (feasibility phase: 1 when a path was found,
         0 otherwise).
