@@ -72,30 +72,21 @@ def test_a_runs_checks_are_counted_as_its_solve_returns_not_after_ompls_simplifi
     assert before[0] < w.last["checks_end"] < after[0]  # OMPL's simplification checks states after the run
 
 
-def test_dimension_rrt_released_is_the_problems_dimension_rrt_with_release_after_under_its_own_name(robot):
+@pytest.mark.parametrize(("variant", "setting", "value", "default"), [
+    ("DimensionRRTReleased", "release_after", "100", "None"),
+    ("DimensionRRTNoShortcuts", "shortcuts", "False", "True"),  # on by default: Table 3 prescribes DOF1/DOF2
+])
+def test_dimension_rrt_variants_are_the_problems_dimension_rrt_with_one_setting_changed_under_their_own_name(
+        robot, variant: str, setting: str, value: str, default: str) -> None:
     from tpee_ompl.bench.planners import PlannerContext, planner_factory
     from tpee_ompl.planning.dimension_rrt import RELEASE_AFTER
     from tpee_ompl.planning.setup import make_simple_setup
 
+    assert RELEASE_AFTER == 100
     si = make_simple_setup(robot).getSpaceInformation()
     ctx = PlannerContext(query={"from_sector": 1, "to_sector": 4}, max_samples=500, seed=3)
-    plain = planner_factory("DimensionRRT")(si, ctx)
-    released = planner_factory("DimensionRRTReleased")(si, ctx)
-    assert released.getName() == "DimensionRRTReleased" and plain.getName() == "DimensionRRT"
-    assert released.options.release_after == RELEASE_AFTER and plain.options.release_after is None
-    assert {k: v for k, v in released.settings().items() if k not in ("release_after", "name")} == \
-        {k: v for k, v in plain.settings().items() if k not in ("release_after", "name")}
-
-
-def test_dimension_rrt_no_shortcuts_is_the_problems_dimension_rrt_with_the_papers_rule_alone(robot):
-    from tpee_ompl.bench.planners import PlannerContext, planner_factory
-    from tpee_ompl.planning.setup import make_simple_setup
-
-    si = make_simple_setup(robot).getSpaceInformation()
-    ctx = PlannerContext(query={"from_sector": 2, "to_sector": 3}, max_samples=500, seed=3)
-    plain = planner_factory("DimensionRRT")(si, ctx)
-    paper = planner_factory("DimensionRRTNoShortcuts")(si, ctx)
-    assert paper.getName() == "DimensionRRTNoShortcuts" and plain.getName() == "DimensionRRT"
-    assert paper.shortcuts is False and plain.shortcuts is True  # Table 3 prescribes DOF1/DOF2
-    assert {k: v for k, v in paper.settings().items() if k != "shortcuts"} == \
-        {k: v for k, v in plain.settings().items() if k != "shortcuts"}
+    plain, other = planner_factory("DimensionRRT")(si, ctx), planner_factory(variant)(si, ctx)
+    assert other.getName() == variant and plain.getName() == "DimensionRRT"
+    assert other.settings()[setting] == value and plain.settings()[setting] == default
+    assert {k: v for k, v in other.settings().items() if k != setting} == \
+        {k: v for k, v in plain.settings().items() if k != setting}
