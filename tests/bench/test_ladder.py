@@ -74,9 +74,12 @@ def test_rrtstar_solution_is_rebuilt_from_its_planner_data(iterations, exact):
 
 
 # --------------------------------------------------------------------------- fresh processes
+_LADDER_PLANNERS = ("DimensionRRT", "RRTstar", "DimensionRRTReleased", "DimensionRRTNoShortcuts")
+
+
 def _task(q: dict, specs: list[dict], ladder: bool, caps: tuple[int, ...]) -> dict:
     cfg = dataclasses.asdict(CampaignConfig(sample_caps=caps, anytime_budgets=(), checkers=("batched",), workers=0,
-                                            one_run_per_ladder=ladder))
+                                            one_run_per_ladder=ladder, iteration_planners=_LADDER_PLANNERS))
     return {"config": cfg, "query": q, "qpos": 0, "query_set": "planning_necessary", "seed": 11, "n_threads": 1,
             "specs": specs}
 
@@ -107,7 +110,8 @@ EXACT_COLUMNS = ("best_cost", "raw_length", "length_dof12", "length_dof34", "sol
 
 @pytest.mark.slow
 def test_checkpoint_rows_equal_separate_capped_runs(tmp_path):
-    """RRT* and dimension-RRT at 500 read from a run capped at 1500 = a run capped at 500 (same seeds)."""
+    """RRT* and dimension-RRT (and its benchmark variants) at 500 read from a run capped at 1500 = a run
+    capped at 500 (same seeds)."""
     _, queries = query_rows("planning_necessary")
     q = stratified_subset(queries, 2)[1]
     caps = (500, 1500)
@@ -116,7 +120,7 @@ def test_checkpoint_rows_equal_separate_capped_runs(tmp_path):
     (tmp_path / "a").mkdir()
     (tmp_path / "b").mkdir()
     a, b = _rows(ladder["logs"], tmp_path / "a"), _rows(separate["logs"], tmp_path / "b")
-    for planner in ("DimensionRRT", "RRTstar"):
+    for planner in _LADDER_PLANNERS:
         ra, rb = a[(500, planner)], b[(500, planner)]
         assert ra["solved"] == 1 and ra["path_valid_dense"] == 1
         assert {c: ra[c] for c in EXACT_COLUMNS} == {c: rb[c] for c in EXACT_COLUMNS}, planner

@@ -44,7 +44,7 @@ __all__ = ["LADDER_PLANNERS", "CheckpointPlanner", "Ladder", "group_ladders"]
 
 log = logging.getLogger(__name__)
 
-LADDER_PLANNERS = ("DimensionRRT", "RRTstar")
+LADDER_PLANNERS = ("DimensionRRT", "DimensionRRTReleased", "DimensionRRTNoShortcuts", "RRTstar")
 """Planners whose checkpoint rows are verified to equal separate capped runs (tests/bench/test_ladder.py)."""
 
 _SOLUTION_KEYS = ("approximate solution", "solution ", "correct solution", "simplif")
