@@ -170,3 +170,10 @@ def test_options_given_to_the_pipeline_are_kept_as_given(robot, library):
     ss = make_simple_setup(robot)
     kept = LibraryDimensionRRT(ss.getSpaceInformation(), library, options=DimensionRRTOptions(seed=1))
     assert kept.options.release_after is None  # the paper's behaviour, asked for explicitly
+
+
+def test_the_pipeline_reports_whether_it_takes_shortcuts_between_waypoints(robot, library):
+    si = make_simple_setup(robot).getSpaceInformation()
+    assert LibraryDimensionRRT(si, library).settings()["shortcuts"] == "True"  # Table 3 prescribes DOF1/DOF2
+    off = LibraryDimensionRRT(si, library, options=DimensionRRTOptions(shortcuts=False))
+    assert off.settings()["shortcuts"] == "False"

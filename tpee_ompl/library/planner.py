@@ -116,6 +116,7 @@ class LibraryDimensionRRT(PythonPlanner):
             "max_samples": str(self.options.max_samples),
             "seed": str(self.options.seed),
             "release_after": str(self.options.release_after),
+            "shortcuts": str(self.options.shortcuts is not False),  # None: on, Table 3 prescribes DOF1/DOF2
         }
 
     @staticmethod
