@@ -79,9 +79,9 @@ def test_search_finds_a_valid_path_around_the_box_and_only_shortens_it(batch: bo
     np.testing.assert_array_equal(search.W[[0, -1]], [start, goal])
 
 
-@pytest.mark.parametrize("batch", [True, False])
+@pytest.mark.parametrize(("batch", "shortcuts"), [(True, False), (False, False), (True, True)])
 @pytest.mark.parametrize("limit", [2, 7, 64])
-def test_iterate_in_blocks_matches_one_sample_per_call(limit: int, batch: bool) -> None:
+def test_iterate_in_blocks_matches_one_sample_per_call(limit: int, batch: bool, shortcuts: bool) -> None:
     """Connect trees, then samples the cost test rejects: blocks give the same path after the same samples."""
     si, _ = box_problem(lo=(-0.2, -1.0), hi=(0.2, 0.6))
     grouped = GroupedSpace(si, [[0], [1]], 7)  # two groups: blocks of 100 samples each, narrowing after 50
@@ -89,7 +89,8 @@ def test_iterate_in_blocks_matches_one_sample_per_call(limit: int, batch: bool) 
 
     def search() -> Search:
         return Search(grouped, Checker(si, grouped.layout, batch), np.random.default_rng(5), start, goal,
-                      narrow_after=50, narrowing=0.5, range_={0: np.full(1, 0.02), 1: np.full(1, 0.02)})
+                      narrow_after=50, narrowing=0.5, range_={0: np.full(1, 0.02), 1: np.full(1, 0.02)},
+                      shortcuts=shortcuts)
 
     one, many = search(), search()
     trace_one, trace_many = [], []

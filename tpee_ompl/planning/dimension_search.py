@@ -94,6 +94,7 @@ class Search:
         self.delta = grouped.layout.delta
         self._uniform = np.empty((0, 0))
         self._ui = 0
+        self._drawn: tuple | None = None
         self._shortcuts = shortcuts
         self._shortcut_due = self.valid
         """Shortcuts between the waypoints are due: the valid path changed since the last sweep (or is new)."""
@@ -138,11 +139,16 @@ class Search:
         if gi is None:
             lo, hi = self._fbounds
             return lo + self._next_random(len(self._fdims))[1:] * (hi - lo)
-        u = self._next_random(len(self._dims[gi]))
-        C, n0 = self._group_draws(gi, u[None, :])
+        drawn, self._drawn = self._drawn, None
+        if drawn is not None and drawn[:2] == (self._ui, gi):  # drawn already by :meth:`_pass_rejected`
+            self._ui += 1
+            c, n0 = drawn[2], drawn[3]
+        else:
+            C, n0 = self._group_draws(gi, self._next_random(len(self._dims[gi]))[None, :])
+            c = C[0]
         if n0 is not None and self.narrow_start[gi] is None:
             self.narrow_start[gi] = n0
-        return C[0]
+        return c
 
     def _group_draws(self, gi: int, U: np.ndarray) -> tuple[np.ndarray, int | None]:
         """The next len(U) samples of group gi from the random rows U (m, k + 1), narrowed or uniform as
@@ -236,6 +242,8 @@ class Search:
         X[:, :, d] = C[:, None, :]
         shorter = (self.dist(W[:-2], X) + self.dist(X, W[2:]) < L[:-1] + L[1:] - 1e-12).any(axis=1)
         j = int(np.argmax(shorter)) if shorter.any() else n
+        # the first sample not rejected, as :meth:`draw` would draw it next (W does not change in between)
+        self._drawn = (self._ui + j, gi, C[j], n0 if n0 is not None and g0 + j >= n0 else None) if j < n else None
         if j == 0:
             return
         self._ui += j
