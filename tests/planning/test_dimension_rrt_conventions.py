@@ -5,6 +5,7 @@ from __future__ import annotations
 import logging
 import math
 
+import numpy as np
 import pytest
 from ompl import base as ob
 
@@ -141,8 +142,6 @@ def test_continuous_joints_plan_across_plus_minus_pi() -> None:
 def test_continuous_joints_with_a_prescribed_row_are_shortcut_the_short_way_round() -> None:
     # joint 0 prescribed across +-pi (2.9 -> -2.9, 0.58 rad the short way), joints 1 and 2 planned from a
     # guess with a detour, free space: the shortcuts take the path close to the shortest along the row
-    import numpy as np
-
     ss = planar_arm_setup(3, start=(2.9, 0.8, -0.5), goal=(-2.9, -0.6, 0.7), obstacles=((5.0, 5.0, 0.1),),
                           continuous=True)
     step = 2 * math.pi - 5.8
