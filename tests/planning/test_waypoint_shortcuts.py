@@ -100,3 +100,12 @@ def test_shortcuts_are_on_by_default_only_with_a_prescribed_group() -> None:
     assert _solve_3d(None, 0)[0].settings()["shortcuts"] == "True"
     assert _solve_3d(None, 0, prescribed=False)[0].settings()["shortcuts"] == "False"
     assert _solve_3d(True, 0, prescribed=False)[0].settings()["shortcuts"] == "True"
+
+
+def test_one_rule_decides_the_shortcuts_default() -> None:
+    from tpee_ompl.planning.dimension_rrt import DimensionRRTOptions, shortcuts_on
+
+    assert shortcuts_on(DimensionRRTOptions(), prescribed=True) is True
+    assert shortcuts_on(DimensionRRTOptions(), prescribed=False) is False
+    assert shortcuts_on(DimensionRRTOptions(shortcuts=False), prescribed=True) is False
+    assert shortcuts_on(DimensionRRTOptions(shortcuts=True), prescribed=False) is True

@@ -24,7 +24,7 @@ from ompl import base as ob
 
 from ..model.queries import straight_motion
 from ..model.sectors import SECTORS, check_sector, posture_preset
-from ..planning.dimension_rrt import RELEASE_AFTER, DimensionRRT, DimensionRRTOptions
+from ..planning.dimension_rrt import RELEASE_AFTER, DimensionRRT, DimensionRRTOptions, shortcuts_on
 from ..planning.paths import array_to_path, path_passes_motion_checks, state_to_array
 from ..planning.planner_base import PythonPlanner, planner_status
 from ..planning.tpee import tpee_dimension_rrt
@@ -116,7 +116,7 @@ class LibraryDimensionRRT(PythonPlanner):
             "max_samples": str(self.options.max_samples),
             "seed": str(self.options.seed),
             "release_after": str(self.options.release_after),
-            "shortcuts": str(self.options.shortcuts is not False),  # None: on, Table 3 prescribes DOF1/DOF2
+            "shortcuts": str(shortcuts_on(self.options, prescribed=True)),  # Table 3 prescribes DOF1/DOF2
         }
 
     @staticmethod

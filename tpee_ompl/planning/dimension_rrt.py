@@ -60,33 +60,27 @@ path on, by the same rule (its motions that passed ``si.checkMotion`` are not ch
 
 Shortcuts (``shortcuts``; by default on when a group is prescribed): after each sample that improved
 the path (and on a new path), every intermediate waypoint's values of the sample's group move towards
-the point that is shortest between its neighbours, by the largest of 1, 1/2, 1/4 of the way whose
-waypoint and motions pass (:mod:`tpee_ompl.planning.waypoint_shortcuts`).  Without a prescribed
-group they are off: a waypoint moved onto its neighbours' segment can never move again by the
-paper's rule, and on planar arms the paths ended longer (measured in the docs).
+the point shortest between its neighbours, as far as its checks allow
+(:mod:`tpee_ompl.planning.waypoint_shortcuts`).  Without a prescribed group they are off: a waypoint
+moved onto its neighbours' segment can never move again by the paper's rule (measured in the docs).
 
-Batching: the candidate waypoints of one sample and their motions go through the validity
-checker's batched ``are_valid(Q)`` when it has one (improvement: two calls per sample at most,
-candidates plus every 16th interior motion state, then the remaining interior states of the
-survivors); otherwise per-state ``si.isValid`` and per-motion ``si.checkMotion``.  Motion states
-are those OMPL's discrete motion validator checks (SO2 entries the short way round).  A motion
-that passed ``si.checkMotion`` in the search is not checked again when its path is posted.  Most
-samples on a valid path fail the cost test at every step; up to 64 of them are passed over in one
-vectorised step (the same random numbers and paths as one at a time), and the termination condition is asked between such batches and at
-the sample counts given to :meth:`DimensionRRT.set_sample_checkpoints` (what a benchmark ladder
-reads, with :meth:`DimensionRRT.samples_drawn`).
+Batching: a sample's candidate waypoints and their motions go through the checker's batched
+``are_valid(Q)`` when it has one (candidates plus every 16th interior motion state, then the rest for
+the survivors), else ``si.isValid`` / ``si.checkMotion``; motion states are those OMPL's discrete
+validator checks, and a motion that passed ``si.checkMotion`` is not checked again when posted.  Up to
+64 samples the cost test rejects are passed over in one vectorised step (the same random numbers and
+paths as one at a time); the termination condition is asked between such batches and at the sample
+counts of :meth:`DimensionRRT.set_sample_checkpoints` (a benchmark ladder's).
 
 Stopping like an OMPL planner: each improved path is added to the problem definition as it is found
 (so ``ob.exactSolnPlannerTerminationCondition(pdef)`` stops at the first), after every segment not
 already checked in an earlier posted path passed ``si.checkMotion``
 (:func:`~tpee_ompl.planning.paths.path_passes_motion_checks`); after the first, improvements are
 posted while posting costs at most 10 % of the run time and the best one always at the end.  The
-planner stops once ``opt.isSatisfied(cost)`` (a cost threshold of ``inf`` = first solution).  An
-optional Python callback (:meth:`DimensionRRT.set_intermediate_solution_callback`) gets the arguments
-of OMPL's intermediate-solution callback for each posted path.
+planner stops once ``opt.isSatisfied(cost)`` (a cost threshold of ``inf`` = first solution);
+:meth:`DimensionRRT.set_intermediate_solution_callback` stands in for OMPL's (refused from Python).
 
-Spaces: RealVector (bounded), SO2 (continuous joints: differences, distance and interpolation the
-short way round, like ``SO2StateSpace``) and compounds of them; anything else is refused by name.
+Spaces: bounded RealVector, SO2 (the short way round, like ``SO2StateSpace``) and compounds of them.
 
 This module holds the settings (:class:`DimensionRRTOptions`) and the OMPL planner; the search
 itself (checker, iteration, layered trees) is :mod:`tpee_ompl.planning.dimension_search`.
@@ -113,7 +107,7 @@ from .grouped_space import MAX_H, GroupedSpace
 from .planner_base import PythonPlanner, planner_status
 from .solution_posting import SolutionPoster
 
-__all__ = ["RELEASE_AFTER", "DimensionRRT", "DimensionRRTOptions"]
+__all__ = ["RELEASE_AFTER", "DimensionRRT", "DimensionRRTOptions", "shortcuts_on"]
 
 log = logging.getLogger(__name__)
 
@@ -213,6 +207,12 @@ class DimensionRRTOptions:
                 raise ValueError(f"range_ must be a positive number or array, got {self.range_!r}")
 
 
+def shortcuts_on(options: DimensionRRTOptions, prescribed: bool) -> bool:
+    """Whether the search takes shortcuts between waypoints: ``options.shortcuts``, or when it is None,
+    whether a group is prescribed (where they pay; see "Shortcuts")."""
+    return prescribed if options.shortcuts is None else options.shortcuts
+
+
 def _resolve_options(options: DimensionRRTOptions | None, overrides: Mapping[str, Any]) -> DimensionRRTOptions:
     """``options`` (default settings if None) with the keyword overrides applied, validated."""
     if options is None:
@@ -288,7 +288,7 @@ class DimensionRRT(PythonPlanner):
         self.narrowing = opts.narrowing
         self.range_ = rng_full
         self.batch = opts.batch
-        self.shortcuts = bool(grouped.prescribed) if opts.shortcuts is None else opts.shortcuts
+        self.shortcuts = shortcuts_on(opts, bool(grouped.prescribed))
         self._rng = np.random.default_rng(opts.seed)
         self._ranges = {gi: rng_full[self.grouped.group_dims(gi)] for gi in range(len(self.grouped.groups))}
         self._initial = initial
