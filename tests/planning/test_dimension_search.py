@@ -107,6 +107,18 @@ def test_iterate_in_blocks_matches_one_sample_per_call(limit: int, batch: bool, 
     assert many.narrow_start == one.narrow_start and many.group_samples == one.group_samples
 
 
+@pytest.mark.parametrize("narrowing", [0.5, 0.3, 0.97])
+def test_narrowing_scales_are_pythons_power_bit_for_bit(narrowing: float) -> None:
+    """The memoised narrowing factor is the float ``narrowing ** (k / 100)`` the per-sample rule computes."""
+    si, _ = box_problem()
+    grouped = GroupedSpace(si, [[0, 1]], 5)
+    search = Search(grouped, Checker(si, grouped.layout, True), np.random.default_rng(0), np.array([-0.8, 0.0]),
+                    np.array([0.8, 0.0]), narrow_after=0, narrowing=narrowing, range_={0: np.full(2, 0.04)})
+    for k in (np.array([3]), np.arange(0, 40), np.array([17, 900, 901]), np.arange(2500, 5000, 7)):
+        got = search._scale(k)
+        assert got.tolist() == [narrowing ** (int(i) / 100) for i in k]
+
+
 def test_a_block_of_connect_samples_ends_when_stop_says_so() -> None:
     si, _ = box_problem(lo=(-0.05, -1.0), hi=(0.05, 1.0))  # a full wall: the trees never meet
     grouped = GroupedSpace(si, [[0, 1]], 7)

@@ -95,6 +95,7 @@ class Search:
         self._uniform = np.empty((0, 0))
         self._ui = 0
         self._drawn: tuple | None = None
+        self._scales = np.zeros(0)
         self._shortcuts = shortcuts
         self._shortcut_due = self.valid
         """Shortcuts between the waypoints are due: the valid path changed since the last sweep (or is new)."""
@@ -108,8 +109,7 @@ class Search:
 
     @property
     def trees(self) -> LayeredTrees | None:
-        """The feasibility phase's layered trees (None before the first sample without a valid path, while
-        the connect trees search, and once a path exists): for inspection; the search owns them."""
+        """The feasibility phase's layered trees while they grow (else None): for inspection only."""
         return self._tree
 
     @property
@@ -165,13 +165,20 @@ class Search:
             g = g0 + np.arange(len(U))
             narrow = np.flatnonzero((g >= n0) & (U[:, 0] >= _UNIFORM_FRACTION))
             if len(narrow):
-                scale = np.array([self.narrowing ** ((int(m) - n0) / _NARROWING_UNIT) for m in g[narrow]])
+                scale = self._scale(g[narrow] - n0)
                 pad = np.maximum(self.range_[gi], span * scale[:, None])
                 vals = self.W[:, self._dims[gi]]
                 nlo = np.maximum(lo, vals.min(axis=0) - pad)
                 nhi = np.minimum(hi, vals.max(axis=0) + pad)
                 C[narrow] = nlo + U[narrow, 1:] * (nhi - nlo)
         return C, n0
+
+    def _scale(self, k: np.ndarray) -> np.ndarray:
+        """``narrowing ** (k / 100)`` for ascending offsets k >= 0, memoised (``np.power`` is not bit-identical)."""
+        if int(k[-1]) >= (have := len(self._scales)):
+            more = range(have, max(int(k[-1]) + 1, 2 * have))
+            self._scales = np.concatenate((self._scales, [self.narrowing ** (i / _NARROWING_UNIT) for i in more]))
+        return self._scales[k]
 
     def iterate(self, limit: int = 1, stop: Callable[[], bool] | None = None) -> int:
         """Draw one sample and try it at every intermediate step (up to ``limit`` samples on a valid path
@@ -183,12 +190,10 @@ class Search:
         trees.  Returns the number of waypoints changed (feasibility phase: 1 when a path was found,
         0 otherwise).
 
-        With ``limit > 1`` on a valid path, the samples that the cost test rejects at every step are
-        first passed over in one vectorised step (at most ``limit - 1`` of them): they change nothing
-        but the counters, so the result is that of as many single calls, with the same random numbers.
-        In the connect trees, up to ``limit`` samples go through them in one call, until the trees
-        meet or ``stop()`` (a termination condition, asked before each sample after the first) is
-        true: the same samples and result as single calls, without their per-call Python time.
+        With ``limit > 1`` on a valid path, up to ``limit - 1`` samples that the cost test rejects at
+        every step are first passed over in one vectorised step; in the connect trees, up to ``limit``
+        samples go through in one call, until the trees meet or ``stop()`` (asked before each sample
+        after the first): either way the same samples and result as single calls.
         """
         if self._spread_pending:
             self._spread()
@@ -416,12 +421,10 @@ class Search:
     def _check_segments(self, W: np.ndarray) -> list[int]:
         """Segments of W (K, n) found invalid (lazy checking: called once W is a complete candidate).
 
-        The waypoints are known valid; zero-length segments and segments checked before cost
-        nothing.  Batched, every 16th state of all of them is screened in bisection order (longest
-        stretch first) until the first failure (:meth:`Checker.first_failing_motion`: that segment
-        alone is then reported), else all of them are checked in full.  With a per-state checker
-        they are checked in full in order (``si.checkMotion``'s own bisection finds a failure faster
-        than a Python screen), up to the first failure.  Every result is remembered."""
+        The waypoints are known valid; zero-length and known segments cost nothing.  Batched, every
+        16th state is screened, longest stretch first (:meth:`Checker.first_failing_motion`: the first
+        failing segment alone is reported), else all are checked in full.  Per-state: in full in order
+        (``si.checkMotion``'s bisection beats a Python screen), up to the first failure.  Results are kept."""
         known, checker = self._known, self.checker
         keys = [W[k : k + 2].tobytes() for k in range(len(W) - 1)]
         bad = [k for k, key in enumerate(keys) if not known.get(key, True)]
@@ -470,10 +473,8 @@ class Search:
             self.L[:] = self.dist(S[:-1], S[1:])
 
     def _improve(self, gi: int, c: np.ndarray) -> int:
-        """Paper's rule on a valid path: replace W[t] when valid, connected and shorter."""
+        """Paper's rule on a valid path: replace W[t] when valid, connected and shorter (V, E stay all true)."""
         d = self._dims[gi]
-        # only called on a valid path (V, E all true); an accepted candidate is valid and both its
-        # motions are, so V and E stay all true and only W and L change
         W, L = self.W, self.L
         C = W[1:-1].copy()
         C[:, d] = c

@@ -258,8 +258,10 @@ class Checker:
         vc = self.states(C) if not self.batched else None
         if self.batched:
             # pass 1: candidate states + every 16th interior state of motions whose other end is valid
-            SL, iL, jL = self.interior(A, C)
-            SR, iR, jR = self.interior(C, B)
+            # (only those built when the validator checks the motions itself in pass 2)
+            stride = 1 if self._check_motions is None else _COARSE_STRIDE
+            SL, iL, jL = self.interior(A, C, stride)
+            SR, iR, jR = self.interior(C, B, stride)
             cL, cR = (jL % _COARSE_STRIDE == 0) & left_known[iL], (jR % _COARSE_STRIDE == 0) & right_known[iR]
             ok = self.states(np.concatenate([C, SL[cL], SR[cR]]))
             vc = ok[:m]
