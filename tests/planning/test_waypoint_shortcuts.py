@@ -12,7 +12,8 @@ from tpee_ompl.planning.dimension_rrt import DimensionRRT
 from tpee_ompl.planning.grouped_space import GroupedSpace
 from tpee_ompl.planning.paths import path_passes_motion_checks
 from tpee_ompl.planning.search_checker import Checker
-from tpee_ompl.planning.waypoint_shortcuts import shortcut_targets, shortcut_waypoints
+from tpee_ompl.planning.dimension_search import Search
+from tpee_ompl.planning.waypoint_shortcuts import respread_candidate, shortcut_targets, shortcut_waypoints
 
 
 def _through(A: np.ndarray, X: np.ndarray, B: np.ndarray) -> np.ndarray:
@@ -70,6 +71,39 @@ def test_a_sweep_only_shortens_the_path_and_keeps_every_motion_valid(batch: bool
     assert checker.states(W).all() and checker.check_motions(W[:-1], W[1:]).all()
     # from 3.3 to within 10 % of the shortest way over the box, 2 |(-0.9, 0) -> (-0.2, 0.2)| + 0.4
     assert 2 * np.hypot(0.7, 0.2) + 0.4 < lengths[-1] < 1.1 * (2 * np.hypot(0.7, 0.2) + 0.4) < 0.7 * lengths[0]
+
+
+def test_a_collapsed_waypoint_gives_its_step_to_the_longest_segment_without_lengthening_the_path() -> None:
+    si, _ = box_problem(lo=(-0.2, -0.2), hi=(0.2, 0.2))
+    layout = GroupedSpace(si, [[0, 1]], 7).layout
+    W = np.array([[-0.9, 0.0], [-0.5, 0.5], [0.0, 0.5], [0.001, 0.5], [0.4, 0.5], [0.6, 0.3], [0.9, 0.0]])
+    L = layout.distance(W[:-1], W[1:])
+    S = respread_candidate(W, L, layout)
+    assert S is not None and S.shape == W.shape and np.array_equal(S[[0, -1]], W[[0, -1]])
+    kept = [w for w in W.tolist() if w != [0.001, 0.5]]  # the inner end of the collapsed segment whose neighbours are closest
+    assert all(w in S.tolist() for w in kept)
+    new = [w for w in S.tolist() if w not in kept]
+    assert len(new) == 1 and np.allclose(new[0], [-0.7, 0.25])  # the middle of the longest segment
+    LS = layout.distance(S[:-1], S[1:])
+    assert LS.sum() <= L.sum() and LS.min() > 0.1 * LS.mean()
+    assert respread_candidate(S, LS, layout) is None  # nothing collapsed any more
+
+
+def test_the_released_search_respreads_collapsed_waypoints_into_a_valid_shorter_path() -> None:
+    si, _ = box_problem(lo=(-0.2, -0.2), hi=(0.2, 0.2))
+    grouped = GroupedSpace(si, [[0], [1]], 7)
+    start, goal = np.array([-0.9, 0.0]), np.array([0.9, 0.0])
+    W = np.array([start, [-0.5, 0.5], [0.0, 0.5], [0.001, 0.5], [0.4, 0.5], [0.6, 0.3], goal])
+    search = Search(grouped, Checker(si, grouped.layout, True), np.random.default_rng(0), start, goal, narrow_after=200,
+                    narrowing=0.5, range_={0: np.full(1, 0.02), 1: np.full(1, 0.02)}, initial=W, shortcuts=True)
+    assert search.valid
+    before = search.cost
+    search._respread()
+    assert search.valid and search.cost <= before and search.L.min() > 0.1 * search.L.mean()
+    assert path_passes_motion_checks(si, search.W)
+    moved = search.W.copy()
+    search._respread()  # nothing collapsed any more: the path stays
+    assert np.array_equal(search.W, moved)
 
 
 def _solve_3d(shortcuts: bool | None, seed: int, prescribed: bool = True) -> tuple[DimensionRRT, float]:

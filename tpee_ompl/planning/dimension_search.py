@@ -19,7 +19,7 @@ from .connect_trees import RANGE_FRACTION, ConnectTrees
 from .grouped_space import GroupedSpace
 from .layered_trees import LayeredTrees, spread_waypoints
 from .search_checker import Checker, segment_key
-from .waypoint_shortcuts import shortcut_waypoints
+from .waypoint_shortcuts import respread_candidate, shortcut_waypoints
 
 __all__ = ["Search"]
 
@@ -97,8 +97,7 @@ class Search:
         self._drawn: tuple | None = None
         self._scales = np.zeros(0)
         self._shortcuts = shortcuts
-        self._shortcut_due = self.valid
-        """Shortcuts between the waypoints are due: the valid path changed since the last sweep (or is new)."""
+        self._shortcut_due = self.valid  # the valid path changed since the last sweep (or is new)
         if turns is not None and not self.valid:  # a connect path found with fewer steps (h raised)
             self._use_connect = False
             self._fit(turns)
@@ -228,7 +227,18 @@ class Search:
         if self._shortcuts and (accepted or self._shortcut_due):
             self._shortcut_due = False  # one sweep per change of the path: more sweeps cost more than they save
             accepted += shortcut_waypoints(self.W, self.L, self._dims[gi], self.g.layout, self.checker)
+            if not self.g.prescribed:
+                self._respread()
         return accepted
+
+    def _respread(self) -> None:
+        """Give a collapsed waypoint's step to the longest segment (:func:`respread_candidate`) when that passes."""
+        W, S = self.W, respread_candidate(self.W, self.L, self.g.layout)
+        if S is not None:
+            self._known.update((W[a : a + 2].tobytes(), True) for a in range(len(W) - 1))  # valid path
+            LS = self.dist(S[:-1], S[1:])
+            if LS.sum() <= self.L.sum() and self.checker.states(S[1:-1]).all() and not self._check_segments(S):
+                self.W[:], self.L[:] = S, LS
 
     def _pass_rejected(self, limit: int) -> None:
         """Advance past the next samples (at most ``limit``, within the current group's block and the
@@ -288,8 +298,7 @@ class Search:
         return int(self._fit(P))
 
     def _seed_path(self, P: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """The polyline P (K, n) from start to goal at h evenly spaced points, with the validity of
-        those waypoints and of the motions between them (checked motions remembered)."""
+        """The polyline P (K, n) at h evenly spaced points, with their validity and their motions'."""
         lay = self.g.layout
         s = np.concatenate(([0.0], np.cumsum(lay.distance(P[:-1], P[1:]))))
         at = np.linspace(0.0, s[-1], self.g.h)
@@ -308,10 +317,9 @@ class Search:
         """Take the turning points P (K, n) from start to goal as the path when they fit the h steps.
 
         While K > h, the interior point whose shortcut saves most and passes in full is dropped; the
-        straight runs are checked as whole motions; the path is adopted with its points held and
-        then spread over its segments (:meth:`_adopt`).  False when it does not fit (more points
-        than steps after the shortcuts) or a straight run fails as one motion (rare: its steps
-        passed); :attr:`unfitted` then holds the points, for a higher h or the layered trees."""
+        runs are checked as whole motions and the path adopted with its points held (:meth:`_adopt`).
+        False when more points than steps remain or a run fails as one motion; :attr:`unfitted` then
+        holds the points, for a higher h or the layered trees."""
         h, dist = self.g.h, self.dist
         while len(P) > h:
             gain = dist(P[:-2], P[1:-1]) + dist(P[1:-1], P[2:]) - dist(P[:-2], P[2:])
@@ -330,19 +338,14 @@ class Search:
         return True
 
     def _grow(self, c: np.ndarray) -> int:
-        """Feasibility phase with the layered trees (the connect trees go through
-        :meth:`_connect_samples`): grow them with the sample c, motions checked lazily.
+        """Layered trees: grow them with the sample c (motions checked lazily); 1 when the path is complete.
 
-        c is checked as a waypoint at every step t that has a forward node before it or a backward
-        node after it (once when holding: the configuration is then the same at every step).  Of the
-        steps with both, the one with the shortest motions completes a candidate path, whose not yet
-        checked motions are checked now: all pass and it is the path; a failed motion kills the node
-        it leads into (and its subtree), and c joins the trees through those of its motions that
-        passed in full.  At the other steps c joins the trees on unchecked motions (checked once a
-        candidate path uses them); when holding, once per tree instead, at the lowest forward / highest
-        backward step whose motion passes in full (coarse screening alone let trees grow through
-        thin walls there).  Returns 1 when the path is complete, else 0.
-        """
+        c is checked at every step t with a forward node before or a backward node after it (once when
+        holding).  Of the steps with both, the one with the shortest motions completes a candidate
+        path, whose unchecked motions are checked now: all pass and it is the path; a failed one kills
+        the node it leads into (and its subtree), and c joins through its motions that passed.  At the
+        other steps c joins on unchecked motions; when holding, once per tree, at the lowest forward /
+        highest backward step whose motion passes in full (screening let trees through thin walls)."""
         tree = self._tree
         d = tree.dims
         h = self.g.h
@@ -451,11 +454,8 @@ class Search:
         return bad
 
     def _adopt(self, W: np.ndarray) -> None:
-        """Take W (h, n), checked by the trees, as the current (valid) path.
-
-        Held (repeated) waypoints are spread along the path's segments at the next :meth:`iterate`
-        (:meth:`_spread`), so the path can be posted first and every fake-time step then takes part
-        in the improvement."""
+        """Take W (h, n), checked by the trees, as the current (valid) path; held (repeated) waypoints are
+        spread along its segments at the next :meth:`iterate` (:meth:`_spread`), after it is posted."""
         self.W[:] = W
         self.V[:] = True
         self.E[:] = True

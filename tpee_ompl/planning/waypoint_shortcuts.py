@@ -12,6 +12,11 @@ both motions pass is taken, by the same checks as a sample's candidate.  A waypo
 neighbours' segment in every DOF can never move again by the paper's rule (nothing is shorter there),
 which is why :class:`~tpee_ompl.planning.dimension_rrt.DimensionRRT` uses them by default only with a
 prescribed group.  Measured in ``docs/dimension_rrt.md`` ("Shortcuts between fake-time waypoints").
+
+Without a prescribed group (the released search) two waypoints can also collapse onto each other, and
+the step between them is then wasted: :func:`respread_candidate` drops the inner one and puts its step
+on the longest segment (:func:`~tpee_ompl.planning.layered_trees.spread_waypoints`), a path no longer
+than before that the search keeps once it passes.
 """
 
 from __future__ import annotations
@@ -20,14 +25,18 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .layered_trees import spread_waypoints
+
 if TYPE_CHECKING:  # pragma: no cover
     from .grouped_space import RealVectorLayout
     from .search_checker import Checker
 
-__all__ = ["SHORTCUT_FRACTIONS", "shortcut_targets", "shortcut_waypoints"]
+__all__ = ["COLLAPSED_FRACTION", "SHORTCUT_FRACTIONS", "respread_candidate", "shortcut_targets", "shortcut_waypoints"]
 
 SHORTCUT_FRACTIONS = (1.0, 0.5, 0.25)
 """Fractions of the way to the shortest point tried, largest first (the first that passes is kept)."""
+COLLAPSED_FRACTION = 0.1
+"""A segment shorter than this fraction of the path's mean segment has collapsed (its step is wasted)."""
 
 
 def shortcut_targets(A: np.ndarray, X: np.ndarray, B: np.ndarray, dims: np.ndarray, layout: RealVectorLayout) -> np.ndarray:
@@ -76,3 +85,20 @@ def shortcut_waypoints(W: np.ndarray, L: np.ndarray, dims: np.ndarray, layout: R
                 todo[k] = False
                 moved += 1
     return moved
+
+
+def respread_candidate(W: np.ndarray, L: np.ndarray, layout: RealVectorLayout) -> np.ndarray | None:
+    """The path W (h, n) (segment lengths L) with a collapsed waypoint's step moved to its longest segment,
+    or None when no segment is shorter than :data:`COLLAPSED_FRACTION` of the mean.
+
+    Of the shortest segment's inner ends, the one whose neighbours are closest is dropped (the path
+    only gets shorter, by the triangle inequality), and the step goes onto the segment whose pieces
+    are longest (the geometry does not change there).  The caller checks the new waypoint and motions."""
+    if len(W) < 3 or not L.min() < COLLAPSED_FRACTION * L.mean():
+        return None
+    k = int(np.argmin(L))
+    i = min((i for i in (k, k + 1) if 0 < i < len(W) - 1), key=lambda i: float(layout.distance(W[i - 1], W[i + 1])))
+    S = W.copy()
+    S[i] = S[i - 1]  # held: spread_waypoints hands the step to the longest segment
+    out = spread_waypoints(S, layout.interpolate, layout.distance)
+    return None if out is S else out
