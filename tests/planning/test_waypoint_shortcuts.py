@@ -9,10 +9,10 @@ from ompl import base as ob
 from ompl import geometric as og
 
 from tpee_ompl.planning.dimension_rrt import DimensionRRT
+from tpee_ompl.planning.dimension_search import Search
 from tpee_ompl.planning.grouped_space import GroupedSpace
 from tpee_ompl.planning.paths import path_passes_motion_checks
 from tpee_ompl.planning.search_checker import Checker
-from tpee_ompl.planning.dimension_search import Search
 from tpee_ompl.planning.waypoint_shortcuts import respread_candidate, shortcut_targets, shortcut_waypoints
 
 
