@@ -98,11 +98,11 @@ def test_the_released_search_respreads_collapsed_waypoints_into_a_valid_shorter_
                     narrowing=0.5, range_={0: np.full(1, 0.02), 1: np.full(1, 0.02)}, initial=W, shortcuts=True)
     assert search.valid
     before = search.cost
-    search._respread()
+    assert search._respread() == 1
     assert search.valid and search.cost <= before and search.L.min() > 0.1 * search.L.mean()
     assert path_passes_motion_checks(si, search.W)
     moved = search.W.copy()
-    search._respread()  # nothing collapsed any more: the path stays
+    assert search._respread() == 0  # nothing collapsed any more: the path stays
     assert np.array_equal(search.W, moved)
 
 

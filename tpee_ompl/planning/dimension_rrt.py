@@ -61,16 +61,16 @@ path on, by the same rule (its motions that passed ``si.checkMotion`` are not ch
 Shortcuts (``shortcuts``; by default on when a group is prescribed): after each sample that improved
 the path (and on a new path), every intermediate waypoint's values of the sample's group move towards
 the point shortest between its neighbours, as far as its checks allow
-(:mod:`tpee_ompl.planning.waypoint_shortcuts`).  Without a prescribed group they are off: a waypoint
-moved onto its neighbours' segment can never move again by the paper's rule (measured in the docs).
+(:mod:`tpee_ompl.planning.waypoint_shortcuts`); without prescribed rows (released), a collapsed waypoint's
+step also goes to the longest segment.  Without a prescribed group they are off: a waypoint moved onto
+its neighbours' segment can never move again by the paper's rule (measured in the docs).
 
 Batching: a sample's candidate waypoints and their motions go through the checker's batched
 ``are_valid(Q)`` when it has one (candidates plus every 16th interior motion state, then the rest for
 the survivors), else ``si.isValid`` / ``si.checkMotion``; motion states are those OMPL's discrete
 validator checks, and a motion that passed ``si.checkMotion`` is not checked again when posted.  Up to
-64 samples the cost test rejects are passed over in one vectorised step (the same random numbers and
-paths as one at a time); the termination condition is asked between such batches and at the sample
-counts of :meth:`DimensionRRT.set_sample_checkpoints` (a benchmark ladder's).
+64 samples the cost test rejects are passed over in one vectorised step (the same paths as one at a
+time); the termination condition is asked between batches and at :meth:`DimensionRRT.set_sample_checkpoints`.
 
 Stopping like an OMPL planner: each improved path is added to the problem definition as it is found
 (so ``ob.exactSolnPlannerTerminationCondition(pdef)`` stops at the first), after every segment not

@@ -180,8 +180,7 @@ class Search:
         return self._scales[k]
 
     def iterate(self, limit: int = 1, stop: Callable[[], bool] | None = None) -> int:
-        """Draw one sample and try it at every intermediate step (up to ``limit`` samples on a valid path
-        or in the connect trees).
+        """Draw one sample and try it at every intermediate step (up to ``limit`` samples; see below).
 
         On a valid path the sample is the current group's (paper's rule), followed with ``shortcuts``
         by one sweep of :func:`shortcut_waypoints` over that group when the path changed; before, it covers all
@@ -227,18 +226,20 @@ class Search:
         if self._shortcuts and (accepted or self._shortcut_due):
             self._shortcut_due = False  # one sweep per change of the path: more sweeps cost more than they save
             accepted += shortcut_waypoints(self.W, self.L, self._dims[gi], self.g.layout, self.checker)
-            if not self.g.prescribed:
-                self._respread()
+            accepted += 0 if self.g.prescribed else self._respread()
         return accepted
 
-    def _respread(self) -> None:
+    def _respread(self) -> int:
         """Give a collapsed waypoint's step to the longest segment (:func:`respread_candidate`) when that passes."""
         W, S = self.W, respread_candidate(self.W, self.L, self.g.layout)
-        if S is not None:
-            self._known.update((W[a : a + 2].tobytes(), True) for a in range(len(W) - 1))  # valid path
-            LS = self.dist(S[:-1], S[1:])
-            if LS.sum() <= self.L.sum() and self.checker.states(S[1:-1]).all() and not self._check_segments(S):
-                self.W[:], self.L[:] = S, LS
+        if S is None:
+            return 0
+        self._known.update((W[a : a + 2].tobytes(), True) for a in range(len(W) - 1))  # valid path
+        LS = self.dist(S[:-1], S[1:])
+        if LS.sum() > self.L.sum() or not self.checker.states(S[1:-1]).all() or self._check_segments(S):
+            return 0
+        self.W[:], self.L[:] = S, LS
+        return 1
 
     def _pass_rejected(self, limit: int) -> None:
         """Advance past the next samples (at most ``limit``, within the current group's block and the
@@ -268,8 +269,7 @@ class Search:
             self.narrow_start[gi] = n0
 
     def _layered(self, W: np.ndarray, V: np.ndarray, E: np.ndarray) -> LayeredTrees:
-        return LayeredTrees(W, V, E, self._fdims, self._hold,
-                            functools.partial(self.delta, dims=self._fdims))  # nodes hold these DOFs
+        return LayeredTrees(W, V, E, self._fdims, self._hold, functools.partial(self.delta, dims=self._fdims))
 
     def _connect_samples(self, limit: int, stop: Callable[[], bool] | None) -> int:
         """Feasibility phase without prescribed groups: up to ``limit`` RRTConnect iterations (the random
