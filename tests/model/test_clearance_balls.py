@@ -133,6 +133,20 @@ def test_a_motion_leaving_the_joint_limits_is_invalid_without_a_check(robot):
     assert robot.collision_checks == c0
 
 
+def test_a_new_motion_validator_builds_its_ball_pools_before_the_first_check():
+    from tpee_ompl.model.wearer_arm import WearerArm
+
+    robot = WearerArm()  # its own screen: no pool built yet
+    ss = make_simple_setup(robot)
+    mv = ss.getSpaceInformation().getMotionValidator()
+    pools = robot.ball_screen()._pools
+    assert sorted(pools) == sorted(h * mv.step for h in mv.screen_levels)
+    before = dict(pools)
+    a = (robot.lower + robot.upper) / 2
+    mv.check_motions(np.stack([a, a]), np.stack([a + 0.05, a - 0.05]))
+    assert pools == before  # the check used them, built nothing
+
+
 class _RecordingValidator(BatchedMotionValidator):
     """The default validator, keeping every motion a planner asked about and its verdict."""
 

@@ -18,6 +18,7 @@ changes, only its cost):
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -107,6 +108,11 @@ class BallScreen:
             self._pools[radius] = pool
         return pool
 
+    def prepare(self, radii: Iterable[float]) -> None:
+        """Build the pools for these radii now (a few ms each), so that the first check does not pay for them."""
+        for radius in radii:
+            self._pool(float(radius))
+
     def clear(self, Q: np.ndarray, radius: float) -> np.ndarray:
         """bool (N,): True where every state within ``radius`` of Q[k] is collision-free with the margins
         (joint limits are the caller's to check)."""
@@ -192,7 +198,7 @@ def _blocks_valid(robot: RobotChecker, screen: BallScreen, S: np.ndarray, starts
     elif blocks:
         bad = ~robot.collision_free(S[np.concatenate([np.arange(a, a + m) for a, m, _ in blocks])])
         owner = np.repeat([k for *_, k in blocks], [m for _, m, _ in blocks])  # the line of each state
-        for k in np.unique(owner[bad]).tolist():
+        for k in set(owner[bad].tolist()):  # not np.unique: its first call imports numpy.ma (~17 ms)
             ok[k] = False
     return ok
 

@@ -98,6 +98,7 @@ class BatchedMotionValidator(ob.MotionValidator):
         self.motions_checked = 0
         self.screen_levels = tuple(check_number("screen_levels (motion-check steps)", h, low=0.5, high=1e3)
                                    for h in screen_levels)
+        robot.ball_screen().prepare(h * self.step for h in self.screen_levels)  # not in the first plan's time
 
     def effective_step(self) -> float:
         """Step (radians) between checked states now: ``step / validSegmentCountFactor``."""
