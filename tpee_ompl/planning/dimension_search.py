@@ -116,14 +116,12 @@ class Search:
         return float(self.L.sum())
 
     def _refill(self, k: int) -> None:
-        """A fresh buffer of randomness (1024 samples of k DOFs) when the current one is used up or of another k:
-        per sample, one uniform that picks narrowed or uniform sampling, then k for the values."""
+        """A fresh buffer of 1024 samples' randomness (one uniform picking narrowed or uniform, then k values)."""
         if self._ui >= len(self._uniform) or self._uniform.shape[1] != k + 1:
             self._uniform = self.rng.random((1024, k + 1))
             self._ui = 0
 
-    def _next_random(self, k: int) -> np.ndarray:
-        """Buffered randomness for one sample: 1 + k uniforms (see :meth:`_refill`)."""
+    def _next_random(self, k: int) -> np.ndarray:  # one sample's 1 + k uniforms (see :meth:`_refill`)
         self._refill(k)
         self._ui += 1
         return self._uniform[self._ui - 1]
@@ -150,9 +148,8 @@ class Search:
         return c
 
     def _group_draws(self, gi: int, U: np.ndarray) -> tuple[np.ndarray, int | None]:
-        """The next len(U) samples of group gi from the random rows U (m, k + 1), narrowed or uniform as
-        :meth:`draw` draws them one by one (the path W unchanged in between), and the group's narrowing
-        start they imply (None: not narrowing yet)."""
+        """The next len(U) samples of group gi from the random rows U (m, k + 1), as :meth:`draw` draws them
+        one by one (W unchanged), and the narrowing start they imply (None: not narrowing yet)."""
         lo, hi = self._bounds[gi]
         span = hi - lo
         C = lo + U[:, 1:] * span
@@ -231,20 +228,25 @@ class Search:
 
     def _respread(self) -> int:
         """Give a collapsed waypoint's step to the longest segment (:func:`respread_candidate`) when that passes."""
-        W, S = self.W, respread_candidate(self.W, self.L, self.g.layout)
+        S = respread_candidate(self.W, self.L, self.g.layout)
         if S is None:
             return 0
-        self._known.update((W[a : a + 2].tobytes(), True) for a in range(len(W) - 1))  # valid path
         LS = self.dist(S[:-1], S[1:])
-        if LS.sum() > self.L.sum() or not self.checker.states(S[1:-1]).all() or self._check_segments(S):
+        if LS.sum() > self.L.sum() or not self._passes(S):
             return 0
         self.W[:], self.L[:] = S, LS
         return 1
 
+    def _passes(self, S: np.ndarray) -> bool:
+        """Whether S (h, n), the valid path W with waypoints moved, passes: its moved waypoints and new motions."""
+        W = self.W
+        self._known.update((W[a : a + 2].tobytes(), True) for a in range(len(W) - 1))  # W's motions are valid
+        moved = (S[1:-1] != W[1:-1]).any(axis=1)
+        return bool(self.checker.states(S[1:-1][moved]).all()) and not self._check_segments(S)
+
     def _pass_rejected(self, limit: int) -> None:
-        """Advance past the next samples (at most ``limit``, within the current group's block and the
-        random buffer) that :meth:`_improve` would reject on cost alone, stopping before the first one it
-        would not: :meth:`draw` and the cost test of :meth:`_improve` for many samples at once."""
+        """Advance past the next samples (at most ``limit``, within the group's block and the random buffer)
+        that :meth:`_improve` would reject on cost alone: :meth:`draw` and its cost test, vectorised."""
         gi = self.current_group()
         d = self._dims[gi]
         self._refill(len(d))
@@ -272,10 +274,9 @@ class Search:
         return LayeredTrees(W, V, E, self._fdims, self._hold, functools.partial(self.delta, dims=self._fdims))
 
     def _connect_samples(self, limit: int, stop: Callable[[], bool] | None) -> int:
-        """Feasibility phase without prescribed groups: up to ``limit`` RRTConnect iterations (the random
-        rows :meth:`draw` would use, so the samples are those of single calls); once the trees meet,
-        the path is fitted to the h steps (:meth:`_fit`), or handed to the layered trees when it
-        cannot be.  Returns 1 when the path was fitted, else 0."""
+        """Feasibility phase without prescribed groups: up to ``limit`` RRTConnect iterations (the random rows
+        :meth:`draw` would use); once the trees meet, the path is fitted to the h steps (:meth:`_fit`) or
+        handed to the layered trees.  Returns 1 when the path was fitted, else 0."""
         k = len(self._fdims)
         self._refill(k)
         U = self._uniform[self._ui : self._ui + min(limit, len(self._uniform) - self._ui)]
@@ -466,9 +467,8 @@ class Search:
     def _spread(self) -> None:
         """Move held waypoints onto the path's segments, kept only when that path passes the checker."""
         self._spread_pending = False
-        W = self.W
-        S = spread_waypoints(W, self.g.layout.interpolate, self.dist)
-        if S is not W and self.checker.states(S[1:-1]).all() and not self._check_segments(S):  # new segments only
+        S = spread_waypoints(self.W, self.g.layout.interpolate, self.dist)
+        if S is not self.W and self._passes(S):
             self.W[:] = S
             self.L[:] = self.dist(S[:-1], S[1:])
 
