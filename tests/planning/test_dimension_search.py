@@ -107,6 +107,27 @@ def test_iterate_in_blocks_matches_one_sample_per_call(limit: int, batch: bool, 
     assert many.narrow_start == one.narrow_start and many.group_samples == one.group_samples
 
 
+@pytest.mark.parametrize("local", [True, False])
+def test_released_search_draws_its_narrowed_samples_around_one_waypoint_at_a_time(local: bool) -> None:
+    """``local`` (the released search): once narrowed, a sample lies within ``range_`` of one intermediate
+    waypoint, each in turn; without it, anywhere in the box around the whole path."""
+    si, _ = box_problem()
+    grouped = GroupedSpace(si, [[0, 1]], 7)
+    search = Search(grouped, Checker(si, grouped.layout, True), np.random.default_rng(0), np.array([-0.8, -0.9]),
+                    np.array([0.8, 0.9]), narrow_after=0, narrowing=1e-3, range_={0: np.full(2, 0.02)}, local=local)
+    U = np.random.default_rng(1).random((3000, 3))
+    C, _ = search._group_draws(0, U)
+    late = np.arange(len(U)) >= 400  # narrowing ** 4: the padding is range_ from here on
+    narrowed = C[late & (U[:, 0] >= 0.1)]
+    gap = np.abs(narrowed[:, None, :] - search.W[None, 1:-1, :]).max(axis=2)  # (samples, waypoints)
+    near = gap.min(axis=1) <= 0.02 + 1e-12
+    if local:
+        assert near.all()
+        assert set(gap.argmin(axis=1).tolist()) == set(range(5))  # every intermediate waypoint gets samples
+    else:
+        assert near.mean() < 0.2
+
+
 @pytest.mark.parametrize("narrowing", [0.5, 0.3, 0.97])
 def test_narrowing_scales_are_pythons_power_bit_for_bit(narrowing: float) -> None:
     """The memoised narrowing factor is the float ``narrowing ** (k / 100)`` the per-sample rule computes."""

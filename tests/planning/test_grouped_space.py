@@ -47,6 +47,13 @@ def test_group_point_round_trip_and_initial_path() -> None:
     assert gs.endpoint_mismatch(np.r_[0.0, 0.0, 0.5, -0.5], goal) == "start"
 
 
+def test_released_space_plans_every_dof_in_one_group_with_nothing_prescribed() -> None:
+    gs = GroupedSpace(_space(), [[0, 1], [2, 3]], 7, {0: cross_sector_trajectory(1, 4)})
+    released = gs.released()
+    assert released.groups == [[0, 1, 2, 3]] and released.planned == [0] and not released.prescribed
+    assert released.h == gs.h
+
+
 def test_path_round_trip_and_metric_match_ompl() -> None:
     space = _space()
     si = ob.SpaceInformation(space)

@@ -53,17 +53,17 @@ uniform.  The paper gives no numbers; the defaults (200, 0.5) are discussed in `
 Releasing the prescribed rows (``release_after``; off by default, as in the paper, which fixes
 DOF1/DOF2 on Table 3's rows "to simplify the calculation"): a converged path along a row can be
 longer than one that leaves it (``experiments/table3_bound.py``).  Once a valid path exists and
-``release_after`` samples in a row brought no shorter one, every group is planned from the current
-path on, by the same rule (its motions that passed ``si.checkMotion`` are not checked again;
-``stall_samples`` counts on across the release, so a smaller one stops the run first);
-``last_run_stats()["released_at"]`` gives the sample count.  ``LibraryDimensionRRT`` sets it (:data:`RELEASE_AFTER`).
+``release_after`` samples in a row brought no shorter one, the search goes on from the current path
+with all DOFs in one planned group, its narrowed samples drawn around one waypoint at a time (a path
+pressed against an obstacle shortens only by moving a waypoint in all DOFs at once; its passed motions
+are not checked again; ``stall_samples`` counts on across the release).  ``last_run_stats()["released_at"]``
+gives the sample count.  ``LibraryDimensionRRT`` sets it (:data:`RELEASE_AFTER`).
 
 Shortcuts (``shortcuts``; by default on when a group is prescribed): after each sample that improved
 the path (and on a new path), every intermediate waypoint's values of the sample's group move towards
-the point shortest between its neighbours, as far as its checks allow
-(:mod:`tpee_ompl.planning.waypoint_shortcuts`); without prescribed rows (released), a collapsed waypoint's
-step also goes to the longest segment.  Without a prescribed group they are off: a waypoint moved onto
-its neighbours' segment can never move again by the paper's rule (measured in the docs).
+the point shortest between its neighbours, as far as its checks allow; once released, a collapsed
+waypoint's step also goes to the longest segment (:mod:`tpee_ompl.planning.waypoint_shortcuts`).  Off
+without a prescribed group: a waypoint on its neighbours' segment never moves again by the paper's rule.
 
 Batching: a sample's candidate waypoints and their motions go through the checker's batched
 ``are_valid(Q)`` when it has one (candidates plus every 16th interior motion state, then the rest for
@@ -151,8 +151,7 @@ class DimensionRRTOptions:
     batch : bool
         Use the checker's batched ``are_valid`` when it has one (default True).
     stall_samples : int, optional
-        Stop once a valid path exists and this many samples in a row brought no shorter one (None,
-        the default: run until the termination condition or ``max_samples``, as the paper does).
+        Stop after this many samples in a row without a shorter valid path (None: as the paper, never).
     max_h : int, optional
         Largest number of fake-time steps the feasibility phase may raise ``h`` to (None, the
         default: ``h`` stays fixed, as in the paper).  See "Raising h" in the module docstring.
@@ -160,13 +159,11 @@ class DimensionRRTOptions:
         Without prescribed groups, look for the first path with RRTConnect's two trees and fit it to
         the ``h`` steps (default True); False: the layered trees.  See "Feasibility phase".
     release_after : int, optional
-        Once a valid path exists and this many samples in a row brought no shorter one, the prescribed
-        groups are planned too, from the current path (None, the default: prescribed rows are kept
-        to the end, as in the paper).  See "Releasing the prescribed rows".
+        After this many samples in a row without a shorter valid path, the prescribed rows are
+        released (None, the default: kept to the end, as in the paper).  See "Releasing the prescribed rows".
     shortcuts : bool, optional
-        After each improvement, move every intermediate waypoint towards the point that is shortest
-        between its neighbours (None, the default: only when a group is prescribed, where it pays;
-        False: the paper's rule alone).  See "Shortcuts".
+        After each improvement, move every intermediate waypoint towards the point shortest between its
+        neighbours (None, the default: only with a prescribed group, where it pays).  See "Shortcuts".
     """
 
     groups: Sequence[Sequence[int]] | None = None
@@ -238,8 +235,7 @@ class DimensionRRT(PythonPlanner):
         planned groups' intermediate waypoints start there instead of on the straight line
         (see :meth:`set_initial_waypoints`).
     **overrides
-        Fields of :class:`DimensionRRTOptions` replacing those of ``options``
-        (``DimensionRRT(si, max_samples=500, seed=1)``); an unknown name raises ``TypeError``.
+        Fields of :class:`DimensionRRTOptions` replacing those of ``options`` (``DimensionRRT(si, seed=1)``).
 
     Raises
     ------
@@ -248,7 +244,7 @@ class DimensionRRT(PythonPlanner):
         ``narrowing``/``narrow_after``/``range_``, a space type other than RealVector/SO2/compound
         (named in the message), or a RealVector space without bounds.
     TypeError
-        An override that is not a field of :class:`DimensionRRTOptions`.
+        An override that is not a field of :class:`DimensionRRTOptions` (named).
     """
 
     def __init__(
@@ -290,12 +286,15 @@ class DimensionRRT(PythonPlanner):
         self.batch = opts.batch
         self.shortcuts = shortcuts_on(opts, bool(grouped.prescribed))
         self._rng = np.random.default_rng(opts.seed)
-        self._ranges = {gi: rng_full[self.grouped.group_dims(gi)] for gi in range(len(self.grouped.groups))}
         self._initial = initial
         self._callback: Callable[[ob.Planner, list[ob.State], ob.Cost], object] | None = None
         self._callback_failed = False
         self._sample_checkpoints: tuple[int, ...] = ()
         self._samples_drawn = 0
+
+    def _ranges(self, grouped: GroupedSpace) -> dict[int, np.ndarray]:
+        """Group index -> the smallest narrowed padding of its DOFs (``range_``), for ``grouped``'s groups."""
+        return {gi: self.range_[grouped.group_dims(gi)] for gi in range(len(grouped.groups))}
 
     @staticmethod
     def _check_initial(grouped: GroupedSpace, W: np.ndarray | None) -> np.ndarray | None:
@@ -422,7 +421,7 @@ class DimensionRRT(PythonPlanner):
             return planner_status(ob.PlannerStatus.INVALID_START if mismatch == "start" else ob.PlannerStatus.INVALID_GOAL)
         checker = Checker(si, layout, self.batch)
         checks0 = checker.counter()
-        search = Search(self.grouped, checker, self._rng, q0, q1, self.narrow_after, self.narrowing, self._ranges,
+        search = Search(self.grouped, checker, self._rng, q0, q1, self.narrow_after, self.narrowing, self._ranges(self.grouped),
                          self._initial, self.options.connect, shortcuts=self.shortcuts)
         poster = SolutionPoster(self, si, pdef, t0, self.grouped.to_path, self._notify, checker.passed)
         stats = self._stats
@@ -448,7 +447,8 @@ class DimensionRRT(PythonPlanner):
                 grouped, done, release = grouped.released(), done + search.samples, None
                 improved_at -= search.samples
                 search = Search(grouped, checker, self._rng, q0, q1, self.narrow_after, self.narrowing,
-                                self._ranges, search.W, self.options.connect, shortcuts=self.shortcuts)
+                                self._ranges(grouped), search.W, self.options.connect, shortcuts=self.shortcuts,
+                                local=True)
                 stats["released_at"] = done
                 log.info("DimensionRRT: prescribed rows released after %d samples", done)
                 continue
@@ -461,7 +461,7 @@ class DimensionRRT(PythonPlanner):
                 grouped = grouped.refined(q0, q1)
                 done += search.samples
                 search = Search(grouped, checker, self._rng, q0, q1, self.narrow_after, self.narrowing,
-                                self._ranges, None, self.options.connect, search.unfitted, self.shortcuts)
+                                self._ranges(grouped), None, self.options.connect, search.unfitted, self.shortcuts)
                 if search.valid:
                     poster.offer(search.W, search.cost, time.perf_counter())
                     record(time.perf_counter())

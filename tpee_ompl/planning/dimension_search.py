@@ -34,21 +34,10 @@ _GROUP_BLOCK = 100
 class Search:
     """The dimension-RRT iteration on a waypoint array; OMPL-free apart from the checker."""
 
-    def __init__(
-        self,
-        grouped: GroupedSpace,
-        checker: Checker,
-        rng: np.random.Generator,
-        start: np.ndarray,
-        goal: np.ndarray,
-        narrow_after: int,
-        narrowing: float,
-        range_: np.ndarray,
-        initial: np.ndarray | None = None,
-        connect: bool = True,
-        turns: np.ndarray | None = None,
-        shortcuts: bool = False,
-    ) -> None:
+    def __init__(self, grouped: GroupedSpace, checker: Checker, rng: np.random.Generator, start: np.ndarray,
+                 goal: np.ndarray, narrow_after: int, narrowing: float, range_: dict[int, np.ndarray],
+                 initial: np.ndarray | None = None, connect: bool = True, turns: np.ndarray | None = None,
+                 shortcuts: bool = False, local: bool = False) -> None:
         self.g = grouped
         self.checker = checker
         self.rng = rng
@@ -97,6 +86,7 @@ class Search:
         self._drawn: tuple | None = None
         self._scales = np.zeros(0)
         self._shortcuts = shortcuts
+        self._local = local
         self._shortcut_due = self.valid  # the valid path changed since the last sweep (or is new)
         if turns is not None and not self.valid:  # a connect path found with fewer steps (h raised)
             self._use_connect = False
@@ -149,7 +139,9 @@ class Search:
 
     def _group_draws(self, gi: int, U: np.ndarray) -> tuple[np.ndarray, int | None]:
         """The next len(U) samples of group gi from the random rows U (m, k + 1), as :meth:`draw` draws them
-        one by one (W unchanged), and the narrowing start they imply (None: not narrowing yet)."""
+        one by one (W unchanged), and the narrowing start they imply (None: not narrowing yet).  With
+        ``local`` a narrowed sample's box is padded around one intermediate waypoint (picked by U[:, 0])
+        instead of around the whole path."""
         lo, hi = self._bounds[gi]
         span = hi - lo
         C = lo + U[:, 1:] * span
@@ -164,8 +156,13 @@ class Search:
                 scale = self._scale(g[narrow] - n0)
                 pad = np.maximum(self.range_[gi], span * scale[:, None])
                 vals = self.W[:, self._dims[gi]]
-                nlo = np.maximum(lo, vals.min(axis=0) - pad)
-                nhi = np.minimum(hi, vals.max(axis=0) + pad)
+                if self._local:
+                    m = len(vals) - 2
+                    t = 1 + np.minimum((U[narrow, 0] - _UNIFORM_FRACTION) / (1 - _UNIFORM_FRACTION) * m, m - 1).astype(int)
+                    vlo = vhi = vals[t]
+                else:
+                    vlo, vhi = vals.min(axis=0), vals.max(axis=0)
+                nlo, nhi = np.maximum(lo, vlo - pad), np.minimum(hi, vhi + pad)
                 C[narrow] = nlo + U[narrow, 1:] * (nhi - nlo)
         return C, n0
 

@@ -351,9 +351,10 @@ class GroupedSpace:
         return GroupedSpace(self.layout.space, self.groups, 2 * self.h - 1, prescribed)
 
     def released(self) -> GroupedSpace:
-        """The same steps and groups with every group planned (no prescribed rows): what the search
-        continues in once ``release_after`` lets a converged path leave its prescribed rows."""
-        return GroupedSpace(self.layout.space, self.groups, self.h)
+        """The same steps with every DOF in one planned group (no prescribed rows): what the search
+        continues in once ``release_after`` lets a converged path leave its prescribed rows (each sample
+        then moves a waypoint in all DOFs at once, as a path pressed against an obstacle needs)."""
+        return GroupedSpace(self.layout.space, [list(range(self.layout.n))], self.h)
 
     def group_point(self, W: np.ndarray, g: int) -> np.ndarray:
         """Path-space point of group g: its values at the h-2 intermediate steps, flat ((h-2) k_g,)."""
