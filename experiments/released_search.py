@@ -24,10 +24,10 @@ import argparse
 import numpy as np
 from ompl import util as ou
 
-from tpee_ompl.planning import dimension_rrt
 from tpee_ompl import PathLibrary, WearerArm, make_simple_setup
 from tpee_ompl.bench.campaign import query_rows, stratified_subset
 from tpee_ompl.library.planner import LibraryDimensionRRT
+from tpee_ompl.planning import dimension_rrt
 from tpee_ompl.planning.dimension_rrt import RELEASE_AFTER
 from tpee_ompl.planning.dimension_search import Search
 from tpee_ompl.planning.grouped_space import GroupedSpace
