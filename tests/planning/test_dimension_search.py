@@ -57,6 +57,30 @@ def test_checker_motions_match_check_motion_and_remember_those_that_passed(robot
     assert checker.passed == {segment_key(p, q) for p, q, w in zip(A, B, want) if w}
 
 
+def test_one_strict_candidate_is_judged_as_a_batch_is_and_stops_at_an_invalid_waypoint(robot, rng: np.random.Generator) -> None:
+    si = make_simple_setup(robot).getSpaceInformation()
+    grouped = GroupedSpace(si, [[0, 1], [2, 3]], 7)
+    checker = Checker(si, grouped.layout, batch=True)
+    Q = robot.lower + rng.random((600, robot.nq)) * (robot.upper - robot.lower)
+    valid = robot.are_valid(Q)
+    A, B = Q[valid][:30], Q[valid][30:60]
+    C = np.concatenate((0.5 * (A[:20] + B[:20]) + 0.02 * rng.standard_normal((20, robot.nq)), Q[~valid][:10]))
+    yes = np.ones(1, dtype=bool)
+    a, b = si.allocState(), si.allocState()
+    for k in range(30):
+        before = checker.counter()
+        vc, left, right = checker.candidates(C[k : k + 1], A[k : k + 1], B[k : k + 1], yes, yes, yes)
+        checks = checker.counter() - before
+        want = bool(si.isValid(set_state(a, C[k])) and si.checkMotion(set_state(a, A[k]), set_state(b, C[k]))
+                    and si.checkMotion(set_state(a, C[k]), set_state(b, B[k])))
+        assert bool(vc[0] and left[0] and right[0]) == want
+        if k >= 20:  # an invalid waypoint: one check, nothing of its motions
+            assert not vc[0] and checks == 1
+    all_at_once = checker.candidates(C, A, B, *(np.ones(30, dtype=bool),) * 3)
+    one_by_one = [checker.candidates(C[k : k + 1], A[k : k + 1], B[k : k + 1], yes, yes, yes) for k in range(30)]
+    np.testing.assert_array_equal(np.logical_and.reduce(all_at_once), [bool(v & l & r) for v, l, r in one_by_one])
+
+
 @pytest.mark.parametrize("connect", [True, False])
 @pytest.mark.parametrize("batch", [True, False])
 def test_search_finds_a_valid_path_around_the_box_and_only_shortens_it(batch: bool, connect: bool) -> None:

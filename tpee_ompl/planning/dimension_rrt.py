@@ -67,8 +67,9 @@ without a prescribed group: a waypoint on its neighbours' segment never moves ag
 
 Batching: a sample's candidate waypoints and their motions go through the checker's batched
 ``are_valid(Q)`` when it has one (candidates plus every 16th interior motion state, then the rest for
-the survivors), else ``si.isValid`` / ``si.checkMotion``; motion states are those OMPL's discrete
-validator checks, and a motion that passed ``si.checkMotion`` is not checked again when posted.  Up to
+the survivors; a lone candidate first, then that screen in bisection order up to the first failure),
+else ``si.isValid`` / ``si.checkMotion``; motion states are those OMPL's discrete validator checks,
+and a motion that passed ``si.checkMotion`` is not checked again when posted.  Up to
 64 samples the cost test rejects are passed over in one vectorised step (the same paths as one at a
 time); the termination condition is asked between batches and at :meth:`DimensionRRT.set_sample_checkpoints`.
 
@@ -81,9 +82,7 @@ planner stops once ``opt.isSatisfied(cost)`` (a cost threshold of ``inf`` = firs
 :meth:`DimensionRRT.set_intermediate_solution_callback` stands in for OMPL's (refused from Python).
 
 Spaces: bounded RealVector, SO2 (the short way round, like ``SO2StateSpace``) and compounds of them.
-
-This module holds the settings (:class:`DimensionRRTOptions`) and the OMPL planner; the search
-itself (checker, iteration, layered trees) is :mod:`tpee_ompl.planning.dimension_search`.
+Here: the settings (:class:`DimensionRRTOptions`) and the planner; the search is :mod:`tpee_ompl.planning.dimension_search`.
 """
 
 from __future__ import annotations

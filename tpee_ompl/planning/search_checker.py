@@ -143,9 +143,15 @@ class Checker:
         ``experiments/screen_order.py``).  Else motion by motion from A[0], for a chain of steps whose
         valid prefix is wanted (every motion before the one returned passed).  With a checker that
         stops at the first failure, the states after it are not checked."""
-        K = len(A)
-        if K == 0:
+        if len(A) == 0:
             return -1
+        S, idx = self._screen(A, B, bisect, starts)
+        i = self.first_invalid(S)
+        return -1 if i < 0 else int(idx[i])
+
+    def _screen(self, A: np.ndarray, B: np.ndarray, bisect: bool, starts: bool = False) -> tuple[np.ndarray, np.ndarray]:
+        """The states :meth:`first_failing_motion` checks, in its order, and the motion of each."""
+        K = len(A)
         S, idx, j = self.interior(A, B, _COARSE_STRIDE)  # in motion order, then step order
         if bisect and len(idx):
             j = _longest_stretch_key(_screen_levels(idx, K), self.layout.distance(A, B)[idx])
@@ -153,8 +159,7 @@ class Checker:
             S, idx = np.concatenate((A, S)), np.concatenate((np.arange(K), idx))
             j = np.concatenate((np.full(K, -np.inf), j))
         order = np.lexsort((idx, j)) if bisect else np.lexsort((j, idx))
-        i = self.first_invalid(S[order])
-        return -1 if i < 0 else int(idx[order[i]])
+        return S[order], idx[order]
 
     def interior(self, A: np.ndarray, B: np.ndarray, stride: int = 1) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Interior states of motions A[k] -> B[k]: (states (M, n), motion index (M,), step index j >= 1;
@@ -251,10 +256,20 @@ class Checker:
         """Evaluate candidate waypoints C (m, n) between neighbours A and B (m, n).
 
         ``left_known[k]`` / ``right_known[k]`` false means that neighbour is invalid, so that motion is
-        invalid without a check.  For ``strict[k]`` candidates only all-valid matters, so the second
-        motion is not finished once one fails.  Returns validity of C, of A->C and of C->B (ends incl.).
+        invalid without a check.  For ``strict[k]`` candidates only all-valid matters, so the motions are
+        not finished once one fails.  Returns validity of C, of A->C and of C->B (ends incl.).
         """
         m = len(C)
+        if m == 1 and self._first_invalid is not None and self._check_motions is not None \
+                and bool(strict[0] and left_known[0] and right_known[0]):
+            # one strict candidate (the improvement phase's usual case): the candidate, then its motions'
+            # screen in bisection order, stopping at the first failure; the motions in full if none
+            A2, B2 = np.concatenate((A, C)), np.concatenate((C, B))
+            i = self.first_invalid(np.concatenate((C, self._screen(A2, B2, bisect=True)[0])))
+            if i >= 0:
+                return np.array([i > 0]), np.zeros(1, dtype=bool), np.zeros(1, dtype=bool)
+            ok = self.check_motions(A2, B2)
+            return np.ones(1, dtype=bool), ok[:1], ok[1:]
         vc = self.states(C) if not self.batched else None
         if self.batched:
             # pass 1: candidate states + every 16th interior state of motions whose other end is valid
