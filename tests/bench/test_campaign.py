@@ -93,6 +93,18 @@ def test_smoke_campaign_fills_the_database(query_file, tmp_path):
     assert meta["seed"] == 3 and "ompl" in meta["versions"]
 
 
+def test_aorrtc_runs_again_in_one_experiment_with_a_fresh_planner_per_run(query_file, tmp_path):
+    """ompl 2.0.1's AORRTC segfaults when solved again after ``clear()`` (``--runs 2``): each run after the
+    first gets a fresh one (``SINGLE_USE_PLANNERS``).  A worker process, so a crash is a lost query, not pytest's."""
+    cfg = tiny_config(query_file, tmp_path, sample_caps=(), anytime_planners=("AORRTC",), runs=3, workers=1)
+    res = run_campaign(cfg, progress_bar=False)
+    assert not res.failed_tasks and res.database is not None
+    con = sqlite3.connect(res.database)
+    statuses = [r[0] for r in con.execute("SELECT status FROM runs")]
+    crash = con.execute("SELECT value FROM enums WHERE name = 'status' AND description = 'Crash'").fetchone()[0]
+    assert len(statuses) == 2 * 3 and crash not in statuses
+
+
 def test_interrupted_campaign_keeps_finished_logs_and_builds_the_db(query_file, tmp_path):
     def stop_after_first(logs):
         raise KeyboardInterrupt

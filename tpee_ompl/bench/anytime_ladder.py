@@ -149,17 +149,20 @@ class AnytimeLadder:
         """The spec of the run itself (the longest budget)."""
         return self.specs[-1]
 
-    def wrap(self, si, inner, cap, pname: str, ctx: PlannerContext, checker=None, read=None) -> RecordingPlanner:
+    def wrap(self, si, inner, cap, pname: str, ctx: PlannerContext, checker=None, read=None,
+             renew=None) -> RecordingPlanner:
         """The recording wrapper of one planner: a :class:`TimeCheckpointPlanner` when its answer at a
-        time can be read (:data:`ANYTIME_READ`), else a plain :class:`RecordingPlanner` run separately."""
+        time can be read (:data:`ANYTIME_READ`), else a plain :class:`RecordingPlanner` run separately
+        (``renew``: :class:`RecordingPlanner`'s)."""
         mode = ANYTIME_READ.get(pname)
         if mode == "posted" and not hasattr(inner, "set_intermediate_solution_callback"):
             mode = None
         if mode is None:
-            w = RecordingPlanner(si, inner, max_iterations=None, read=read, checker=checker)
+            w = RecordingPlanner(si, inner, max_iterations=None, read=read, checker=checker, renew=renew)
             self.separate.add(w.getName())
         else:
             w = TimeCheckpointPlanner(si, inner, self.checkpoints, (pname, ctx), mode, checker=checker, read=read)
+            w.renew = renew
         self.wrappers[w.getName()] = w
         self.names[w.getName()] = pname
         return w

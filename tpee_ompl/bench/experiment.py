@@ -16,6 +16,7 @@ the raw planner output: lengths (:func:`group_lengths`), dense validity, iterati
 
 from __future__ import annotations
 
+import functools
 import logging
 import math
 import os
@@ -32,7 +33,7 @@ from ompl import util as ou
 from ..planning.grouped_space import RealVectorLayout
 from ..planning.paths import path_length, path_passes_motion_checks
 from .database import failed_run_properties, pad_aborted_runs, patch_recorded_data
-from .planners import PlannerContext, RecordingPlanner, planner_factory
+from .planners import SINGLE_USE_PLANNERS, PlannerContext, RecordingPlanner, planner_factory
 from .problems import get_problem
 from ..files import write_new_file
 from .results import format_value
@@ -257,10 +258,12 @@ def _run_experiment(cfg: dict, task: dict, spec: dict, ladder=None, only: list[s
             continue
         ctx = PlannerContext(query=query, max_samples=cap, seed=_sub_seed(cfg["seed"], qpos, k, tag),
                              problem=problem.name)
-        inner = planner_factory(pname)(si, ctx)
+        factory = planner_factory(pname)
+        inner = factory(si, ctx)
         read = None if layout.is_plain else layout.read
-        w = (RecordingPlanner(si, inner, max_iterations=cap, read=read, checker=checker) if ladder is None
-             else ladder.wrap(si, inner, cap, pname, ctx, checker=checker, read=read))
+        renew = functools.partial(factory, si, ctx) if pname in SINGLE_USE_PLANNERS else None
+        w = (RecordingPlanner(si, inner, max_iterations=cap, read=read, checker=checker, renew=renew) if ladder is None
+             else ladder.wrap(si, inner, cap, pname, ctx, checker=checker, read=read, renew=renew))
         wrappers[w.getName()] = w
         bench.addPlanner(w)
 

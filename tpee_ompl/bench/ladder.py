@@ -234,10 +234,12 @@ class Ladder:
         """The spec of the run itself (the largest cap)."""
         return self.specs[-1]
 
-    def wrap(self, si, inner, cap: int, pname: str, ctx: PlannerContext, checker=None, read=None) -> CheckpointPlanner:
+    def wrap(self, si, inner, cap: int, pname: str, ctx: PlannerContext, checker=None, read=None,
+             renew=None) -> CheckpointPlanner:
         """The recording wrapper of one planner of the run (``checker``: the problem's, whose checks are
-        counted; ``read``: the state reader of a non-RealVector space)."""
+        counted; ``read``: the state reader of a non-RealVector space; ``renew``: :class:`RecordingPlanner`'s)."""
         w = CheckpointPlanner(si, inner, cap, self.checkpoints, (pname, ctx), checker=checker, read=read)
+        w.renew = renew
         self.wrappers[w.getName()] = w
         return w
 

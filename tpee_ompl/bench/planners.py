@@ -130,6 +130,12 @@ PLANNER_FACTORIES: dict[str, PlannerFactory] = {
 imported instead (so worker processes can build planners defined elsewhere, e.g. test stand-ins)."""
 
 
+SINGLE_USE_PLANNERS: tuple[str, ...] = ("AORRTC",)
+"""Native planners that crash when solved again after ``clear()``: ompl 2.0.1's AORRTC segfaults in the second
+run of a benchmark experiment (``--runs 2``; setup, solve, clear, solve).  :class:`RecordingPlanner` is given
+a fresh one for each run after the first (``renew``)."""
+
+
 def planner_factory(name: str) -> PlannerFactory:
     """The factory of a planner name of :data:`PLANNER_FACTORIES`, or of a ``module:function`` name."""
     if name in PLANNER_FACTORIES:
@@ -188,6 +194,9 @@ class RecordingPlanner(ob.Planner):
     checker : object with a ``collision_checks`` counter, optional
         The problem's checker: its counter as ``solve`` returns is recorded (``checks_end``), so a
         run's checks exclude what OMPL's ``Benchmark`` does after it (simplification, path checks).
+    renew : callable, optional
+        ``() -> ob.Planner``: a fresh inner planner, built and set up at ``clear()`` after a run instead of
+        clearing the one that ran (:data:`SINGLE_USE_PLANNERS`).
 
     After each ``solve``, :attr:`last` holds the run's record: ``waypoints`` (raw path, (K, n), or
     None), ``iterations``, ``samples``, ``best_cost``, ``first_solution_time``, ``progress``
@@ -201,9 +210,12 @@ class RecordingPlanner(ob.Planner):
     """
 
     def __init__(self, si, inner, max_iterations: int | None = None, progress_period: float = 0.05,
-                 read: Callable[[ob.State], object] | None = None, checker=None) -> None:
+                 read: Callable[[ob.State], object] | None = None, checker=None,
+                 renew: Callable[[], ob.Planner] | None = None) -> None:
         super().__init__(si, inner.getName())
         self.checker = checker
+        self.renew = renew
+        self._ran = False
         self._dim = int(si.getStateSpace().getDimension())
         self._read = read
         self.inner = inner
@@ -218,6 +230,9 @@ class RecordingPlanner(ob.Planner):
 
     def setup(self) -> None:  # noqa: D102 (OMPL override)
         super().setup()
+        self._setup_inner()
+
+    def _setup_inner(self) -> None:
         self._setup_error = None
         try:  # an exception escaping to C++ would abort the whole benchmark
             self.inner.setProblemDefinition(self.getProblemDefinition())
@@ -229,7 +244,12 @@ class RecordingPlanner(ob.Planner):
     def clear(self) -> None:  # noqa: D102 (OMPL override)
         super().clear()
         try:
-            self.inner.clear()
+            if self.renew is not None and self._ran:
+                self.inner = self.renew()
+                self._ran = False
+                self._setup_inner()  # Benchmark sets the wrapper up once, before the first run
+            else:
+                self.inner.clear()
         except Exception:  # noqa: BLE001
             log.exception("planner %s: clear failed", self.inner.getName())
 
@@ -255,6 +275,7 @@ class RecordingPlanner(ob.Planner):
             return cap is not None and it is not None and it >= cap
 
         error = self._setup_error
+        self._ran = True
         try:
             if error is not None:
                 raise RuntimeError(f"setup failed: {error}")
