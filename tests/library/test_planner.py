@@ -177,3 +177,25 @@ def test_the_pipeline_reports_whether_it_takes_shortcuts_between_waypoints(robot
     assert LibraryDimensionRRT(si, library).settings()["shortcuts"] == "True"  # Table 3 prescribes DOF1/DOF2
     off = LibraryDimensionRRT(si, library, options=DimensionRRTOptions(shortcuts=False))
     assert off.settings()["shortcuts"] == "False"
+
+
+def test_a_second_run_of_one_pipeline_draws_other_samples_and_a_new_planner_repeats_the_first(robot, library):
+    """A benchmark's runs of one planner (``--runs``) are different runs, as OMPL's are; a seed still fixes the first."""
+    q = _stored("planning_necessary", 1, 2)  # its direct motion collides, so the pipeline refines
+
+    def runs(planner, ss, n):
+        out = []
+        for _ in range(n):
+            ss.clear()
+            assert ss.solve(30.0) == ob.PlannerStatus.EXACT_SOLUTION
+            out.append(path_to_array(ss.getSolutionPath(), 4))
+        return out
+
+    ss = make_simple_setup(robot, q.start, q.goal)
+    planner = LibraryDimensionRRT(ss.getSpaceInformation(), library, max_samples=400, seed=3)
+    ss.setPlanner(planner)
+    first, second = runs(planner, ss, 2)
+    assert not np.array_equal(first, second)
+    ss2 = make_simple_setup(robot, q.start, q.goal)
+    ss2.setPlanner(LibraryDimensionRRT(ss2.getSpaceInformation(), library, max_samples=400, seed=3))
+    np.testing.assert_array_equal(runs(None, ss2, 1)[0], first)

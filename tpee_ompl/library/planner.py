@@ -102,6 +102,7 @@ class LibraryDimensionRRT(PythonPlanner):
         self.pair = pair
         self.options = opts
         self._inner: DimensionRRT | None = None
+        self._refinements = 0
 
     # ------------------------------------------------------------------ reporting
     def settings(self) -> dict[str, str]:
@@ -135,9 +136,17 @@ class LibraryDimensionRRT(PythonPlanner):
         return super().last_run_stats()
 
     def clear(self) -> None:
-        """Forget the last run."""
+        """Forget the last run (not the seed's stream: the next run draws other samples, as OMPL's planners do)."""
         super().clear()
         self._inner = None
+
+    def _run_seed(self) -> int | None:
+        """The refining dimension-RRT's seed for this run: ``options.seed`` in the first, then one derived from
+        it and the run's number (a benchmark's runs of one planner are different runs, as OMPL's are)."""
+        k, self._refinements = self._refinements, self._refinements + 1
+        if self.options.seed is None or k == 0:
+            return self.options.seed
+        return int(np.random.SeedSequence([self.options.seed, k]).generate_state(1)[0])
 
     def _solve(self, ptc: ob.PlannerTerminationCondition) -> ob.PlannerStatus:
         t0 = time.perf_counter()
@@ -202,7 +211,7 @@ class LibraryDimensionRRT(PythonPlanner):
             return planner_status(ob.PlannerStatus.EXACT_SOLUTION)
         if stats["library_outcome"] is None:
             stats["library_outcome"] = "planned"
-        inner = tpee_dimension_rrt(si, i, j, self.options,
+        inner = tpee_dimension_rrt(si, i, j, dataclasses.replace(self.options, seed=self._run_seed()),
                                    initial_waypoints=seed if seed is not None and seed.shape[0] == self.options.h
                                    else None)
         inner.setProblemDefinition(pdef)
