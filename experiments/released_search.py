@@ -1,7 +1,7 @@
 """The released search, joint or per group: what planning every DOF as one group, sampled around one waypoint, buys.
 
     .venv/bin/python experiments/make_queries.py --seed 777 --n-per-pair 3 --out /tmp/heldout   # once
-    PYTHONPATH=. .venv/bin/python experiments/released_search.py                                 # ~3 min
+    PYTHONPATH=. .venv/bin/python experiments/released_search.py                                 # ~70 s
     PYTHONPATH=. .venv/bin/python experiments/released_search.py --budgets 0.01 0.1 1 --seeds 1
 
 Once ``release_after`` samples brought no shorter path along the prescribed rows, the search goes on

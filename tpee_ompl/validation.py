@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["MAX_SEED", "as_float_array", "check_bool", "check_int", "check_name", "check_number", "check_seed"]
+__all__ = ["MAX_SEED", "as_float_array", "check_bool", "check_int", "check_name", "check_number", "check_seed", "sub_seed"]
 
 
 def check_int(name: str, value: Any, *, minimum: int | None = None, maximum: int | None = None,
@@ -76,6 +76,12 @@ def as_float_array(x: object, what: str) -> np.ndarray:
 
 MAX_SEED = 2**32 - 1
 """Largest accepted seed (OMPL's ``RNG.setSeed`` takes an unsigned integer; numpy's generators accept it too)."""
+
+
+def sub_seed(*parts: int) -> int:
+    """A seed in [0, 2**32) derived from integer ``parts`` (``np.random.SeedSequence``): independent
+    streams for each (campaign seed, query, planner, budget) or (planner seed, run) from one seed."""
+    return int(np.random.SeedSequence([int(p) for p in parts]).generate_state(1)[0])
 
 
 def check_seed(name: str, value: Any) -> int:

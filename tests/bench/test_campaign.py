@@ -93,6 +93,7 @@ def test_smoke_campaign_fills_the_database(query_file, tmp_path):
     assert meta["seed"] == 3 and "ompl" in meta["versions"]
 
 
+@pytest.mark.slow
 def test_aorrtc_runs_again_in_one_experiment_with_a_fresh_planner_per_run(query_file, tmp_path):
     """ompl 2.0.1's AORRTC segfaults when solved again after ``clear()`` (``--runs 2``): each run after the
     first gets a fresh one (``SINGLE_USE_PLANNERS``).  A worker process, so a crash is a lost query, not pytest's."""

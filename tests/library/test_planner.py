@@ -183,7 +183,7 @@ def test_a_second_run_of_one_pipeline_draws_other_samples_and_a_new_planner_repe
     """A benchmark's runs of one planner (``--runs``) are different runs, as OMPL's are; a seed still fixes the first."""
     q = _stored("planning_necessary", 1, 2)  # its direct motion collides, so the pipeline refines
 
-    def runs(planner, ss, n):
+    def runs(ss, n):
         out = []
         for _ in range(n):
             ss.clear()
@@ -194,8 +194,8 @@ def test_a_second_run_of_one_pipeline_draws_other_samples_and_a_new_planner_repe
     ss = make_simple_setup(robot, q.start, q.goal)
     planner = LibraryDimensionRRT(ss.getSpaceInformation(), library, max_samples=400, seed=3)
     ss.setPlanner(planner)
-    first, second = runs(planner, ss, 2)
+    first, second = runs(ss, 2)
     assert not np.array_equal(first, second)
     ss2 = make_simple_setup(robot, q.start, q.goal)
     ss2.setPlanner(LibraryDimensionRRT(ss2.getSpaceInformation(), library, max_samples=400, seed=3))
-    np.testing.assert_array_equal(runs(None, ss2, 1)[0], first)
+    np.testing.assert_array_equal(runs(ss2, 1)[0], first)

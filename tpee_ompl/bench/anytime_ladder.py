@@ -93,8 +93,8 @@ class TimeCheckpointPlanner(CheckpointPlanner):
     """
 
     def __init__(self, si, inner, checkpoints: list[float], context: tuple[str, PlannerContext], mode: str,
-                 checker=None, read=None):
-        RecordingPlanner.__init__(self, si, inner, max_iterations=None, read=read)
+                 checker=None, read=None, renew=None):
+        RecordingPlanner.__init__(self, si, inner, max_iterations=None, read=read, renew=renew)
         self.checkpoints = sorted({float(c) for c in checkpoints})
         self.context = context
         self.mode = mode
@@ -161,8 +161,8 @@ class AnytimeLadder:
             w = RecordingPlanner(si, inner, max_iterations=None, read=read, checker=checker, renew=renew)
             self.separate.add(w.getName())
         else:
-            w = TimeCheckpointPlanner(si, inner, self.checkpoints, (pname, ctx), mode, checker=checker, read=read)
-            w.renew = renew
+            w = TimeCheckpointPlanner(si, inner, self.checkpoints, (pname, ctx), mode, checker=checker, read=read,
+                                      renew=renew)
         self.wrappers[w.getName()] = w
         self.names[w.getName()] = pname
         return w

@@ -37,6 +37,7 @@ from .planners import SINGLE_USE_PLANNERS, PlannerContext, RecordingPlanner, pla
 from .problems import get_problem
 from ..files import write_new_file
 from .results import format_value
+from ..validation import sub_seed
 
 __all__ = ["experiment_specs", "group_lengths", "log_name", "run_query_task"]
 
@@ -74,10 +75,6 @@ def _seed_process(seed: int) -> None:
         _SEEDED.append(int(seed))
     elif _SEEDED[0] != int(seed):
         log.warning("OMPL was seeded with %d in this process, not %d: runs are not reproducible", _SEEDED[0], seed)
-
-
-def _sub_seed(*parts: int) -> int:
-    return int(np.random.SeedSequence([int(p) for p in parts]).generate_state(1)[0])
 
 
 def experiment_specs(cfg: dict, qpos: int) -> list[dict]:
@@ -256,7 +253,7 @@ def _run_experiment(cfg: dict, task: dict, spec: dict, ladder=None, only: list[s
     for k, pname in enumerate(planners):
         if only is not None and pname not in only:
             continue
-        ctx = PlannerContext(query=query, max_samples=cap, seed=_sub_seed(cfg["seed"], qpos, k, tag),
+        ctx = PlannerContext(query=query, max_samples=cap, seed=sub_seed(cfg["seed"], qpos, k, tag),
                              problem=problem.name)
         factory = planner_factory(pname)
         inner = factory(si, ctx)

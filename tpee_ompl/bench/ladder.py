@@ -123,9 +123,9 @@ class CheckpointPlanner(RecordingPlanner):
     """
 
     def __init__(self, si, inner, max_iterations: int, checkpoints: list[int], context: tuple[str, PlannerContext],
-                 checker=None, read=None):
+                 checker=None, read=None, renew=None):
         super().__init__(si, inner, max_iterations=None if hasattr(inner, "last_run_stats") else max_iterations,
-                         read=read)
+                         read=read, renew=renew)
         self.checkpoints = sorted({int(c) for c in checkpoints if int(c) < max_iterations})
         self.context = context
         self.python = hasattr(inner, "last_run_stats")
@@ -238,8 +238,7 @@ class Ladder:
              renew=None) -> CheckpointPlanner:
         """The recording wrapper of one planner of the run (``checker``: the problem's, whose checks are
         counted; ``read``: the state reader of a non-RealVector space; ``renew``: :class:`RecordingPlanner`'s)."""
-        w = CheckpointPlanner(si, inner, cap, self.checkpoints, (pname, ctx), checker=checker, read=read)
-        w.renew = renew
+        w = CheckpointPlanner(si, inner, cap, self.checkpoints, (pname, ctx), checker=checker, read=read, renew=renew)
         self.wrappers[w.getName()] = w
         return w
 

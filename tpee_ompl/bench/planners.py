@@ -250,8 +250,10 @@ class RecordingPlanner(ob.Planner):
                 self._setup_inner()  # Benchmark sets the wrapper up once, before the first run
             else:
                 self.inner.clear()
-        except Exception:  # noqa: BLE001
+        except Exception as exc:  # noqa: BLE001
             log.exception("planner %s: clear failed", self.inner.getName())
+            if self._ran:  # never solve a used single-use planner again: the run is recorded as a crash
+                self._setup_error = repr(exc)
 
     def solve(self, ptc):  # noqa: D102 (OMPL override)
         inner, cap = self.inner, self.max_iterations

@@ -28,6 +28,7 @@ from ..planning.dimension_rrt import RELEASE_AFTER, DimensionRRT, DimensionRRTOp
 from ..planning.paths import array_to_path, path_passes_motion_checks, state_to_array
 from ..planning.planner_base import PythonPlanner, planner_status
 from ..planning.tpee import tpee_dimension_rrt
+from ..validation import sub_seed
 from .path_library import PathLibrary
 
 __all__ = ["LibraryDimensionRRT", "infer_sector"]
@@ -141,12 +142,10 @@ class LibraryDimensionRRT(PythonPlanner):
         self._inner = None
 
     def _run_seed(self) -> int | None:
-        """The refining dimension-RRT's seed for this run: ``options.seed`` in the first, then one derived from
-        it and the run's number (a benchmark's runs of one planner are different runs, as OMPL's are)."""
+        """The refining dimension-RRT's seed: ``options.seed`` in the first refinement, then one derived from it
+        and the refinement's number (a benchmark's runs of one planner are different runs, as OMPL's are)."""
         k, self._refinements = self._refinements, self._refinements + 1
-        if self.options.seed is None or k == 0:
-            return self.options.seed
-        return int(np.random.SeedSequence([self.options.seed, k]).generate_state(1)[0])
+        return self.options.seed if self.options.seed is None or k == 0 else sub_seed(self.options.seed, k)
 
     def _solve(self, ptc: ob.PlannerTerminationCondition) -> ob.PlannerStatus:
         t0 = time.perf_counter()

@@ -46,9 +46,9 @@ layered trees start again; a prescribed row keeps its polyline, sampled at more 
 ``h`` stays fixed, as in the paper; ``last_run_stats()["h"]`` reports the steps used.
 
 Narrowing: once a valid path exists and the group has drawn ``narrow_after`` samples, 90 % of the
-samples come from the bounding box of the current path's group values, padded by ``max(range_, span
-* narrowing ** (m / 100))`` (``m``: samples since narrowing started), clipped to the bounds; 10 % stay
-uniform.  The paper gives no numbers; the defaults (200, 0.5) are discussed in ``docs/dimension_rrt.md``.
+samples come from the bounding box of the current path's group values (released: of one waypoint's),
+padded by ``max(range_, span * narrowing ** (m / 100))`` (``m``: samples since narrowing started), clipped
+to the bounds; 10 % stay uniform.  The paper gives no numbers; the defaults (200, 0.5): ``docs/dimension_rrt.md``.
 
 Releasing the prescribed rows (``release_after``; off by default, as in the paper, which fixes
 DOF1/DOF2 on Table 3's rows "to simplify the calculation"): a converged path along a row can be
@@ -441,7 +441,7 @@ class DimensionRRT(PythonPlanner):
         stops = self._sample_checkpoints
         while not poster.satisfied and not ptc() and (cap is None or done + search.samples < cap):
             if release is not None and search.valid and search.samples - improved_at >= release:
-                # converged on the prescribed rows: every group is planned from here, from this path
+                # converged on the prescribed rows: from this path on, every DOF in one group, around one waypoint
                 # (``improved_at`` shifted so that ``stall`` counts on across the release)
                 grouped, done, release = grouped.released(), done + search.samples, None
                 improved_at -= search.samples

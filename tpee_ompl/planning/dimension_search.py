@@ -32,7 +32,8 @@ _GROUP_BLOCK = 100
 
 
 class Search:
-    """The dimension-RRT iteration on a waypoint array; OMPL-free apart from the checker."""
+    """The dimension-RRT iteration on a waypoint array; OMPL-free apart from the checker.  ``local``: narrowed
+    samples around one waypoint at a time (the released search; :meth:`_group_draws`)."""
 
     def __init__(self, grouped: GroupedSpace, checker: Checker, rng: np.random.Generator, start: np.ndarray,
                  goal: np.ndarray, narrow_after: int, narrowing: float, range_: dict[int, np.ndarray],
