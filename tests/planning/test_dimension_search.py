@@ -152,16 +152,22 @@ def test_released_search_draws_its_narrowed_samples_around_one_waypoint_at_a_tim
         assert near.mean() < 0.2
 
 
-@pytest.mark.parametrize("narrowing", [0.5, 0.3, 0.97])
-def test_narrowing_scales_are_pythons_power_bit_for_bit(narrowing: float) -> None:
-    """The memoised narrowing factor is the float ``narrowing ** (k / 100)`` the per-sample rule computes."""
+@pytest.mark.parametrize("narrowing", [0.5, 0.3, 0.97, 1.0])
+def test_narrowing_paddings_are_those_of_pythons_power_bit_for_bit(narrowing: float) -> None:
+    """The memoised narrowing factor gives the paddings ``max(range_, span * narrowing ** (k / 100))`` the
+    per-sample rule computes, past the offset where they all reached ``range_`` too."""
     si, _ = box_problem()
     grouped = GroupedSpace(si, [[0, 1]], 5)
+    range_ = np.array([0.04, 0.01])
     search = Search(grouped, Checker(si, grouped.layout, True), np.random.default_rng(0), np.array([-0.8, 0.0]),
-                    np.array([0.8, 0.0]), narrow_after=0, narrowing=narrowing, range_={0: np.full(2, 0.04)})
-    for k in (np.array([3]), np.arange(0, 40), np.array([17, 900, 901]), np.arange(2500, 5000, 7)):
-        got = search._scale(k)
-        assert got.tolist() == [narrowing ** (int(i) / 100) for i in k]
+                    np.array([0.8, 0.0]), narrow_after=0, narrowing=narrowing, range_={0: range_})
+    lo, hi = grouped.group_bounds(0)
+    for k in (np.array([3]), np.arange(0, 40), np.array([17, 900, 901]), np.arange(2500, 5000, 7), np.array([200_000])):
+        got = np.maximum(range_, (hi - lo) * search._scale(k)[:, None])
+        want = np.maximum(range_, (hi - lo) * np.array([narrowing ** (int(i) / 100) for i in k])[:, None])
+        assert got.tolist() == want.tolist()
+    assert (search._cut is None) == (narrowing == 1.0)
+    assert narrowing == 1.0 or len(search._scales) < 50_000  # the memo stops growing where the paddings stop
 
 
 def test_a_block_of_connect_samples_ends_when_stop_says_so() -> None:

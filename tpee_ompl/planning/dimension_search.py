@@ -2,10 +2,8 @@
 
 :class:`Search` holds the current path ``W`` (h, n) and does one sample per :meth:`Search.iterate`
 (improvement on a valid path, else the feasibility phase: :class:`ConnectTrees` without prescribed
-groups, :class:`LayeredTrees` with them or when a connect path does not fit the h steps).  The algorithm is
-described in :mod:`tpee_ompl.planning.dimension_rrt`; nothing here touches the planner's OMPL problem
-definition, so it can be driven and tested without one; validity comes from
-:class:`~tpee_ompl.planning.search_checker.Checker`.
+groups, :class:`LayeredTrees` with them or when a connect path does not fit the h steps); the algorithm:
+:mod:`tpee_ompl.planning.dimension_rrt`.  No OMPL problem definition here (validity: :class:`Checker`).
 """
 
 from __future__ import annotations
@@ -23,12 +21,9 @@ from .waypoint_shortcuts import respread_candidate, shortcut_waypoints
 
 __all__ = ["Search"]
 
-_UNIFORM_FRACTION = 0.1
-"""Share of samples drawn uniformly over the bounds once the sampling region has narrowed."""
-_NARROWING_UNIT = 100
-"""The narrowing factor applies per this many samples."""
-_GROUP_BLOCK = 100
-"""With several planned groups, each gets this many consecutive samples in turn."""
+_UNIFORM_FRACTION = 0.1  # share of samples drawn uniformly over the bounds once the region has narrowed
+_NARROWING_UNIT = 100  # the narrowing factor applies per this many samples
+_GROUP_BLOCK = 100  # with several planned groups, each gets this many consecutive samples in turn
 
 
 class Search:
@@ -86,6 +81,9 @@ class Search:
         self._ui = 0
         self._drawn: tuple | None = None
         self._scales = np.zeros(0)
+        self._cut: int | None = None  # the offset from which every group's padding is its range_
+        self._floor = min((float(np.min(range_[gi] / (hi - lo))) for gi, (lo, hi) in self._bounds.items()),
+                          default=0.0) * (1 - 1e-12)
         self._shortcuts = shortcuts
         self._local = local
         self._shortcut_due = self.valid  # the valid path changed since the last sweep (or is new)
@@ -168,11 +166,15 @@ class Search:
         return C, n0
 
     def _scale(self, k: np.ndarray) -> np.ndarray:
-        """``narrowing ** (k / 100)`` for ascending offsets k >= 0, memoised (``np.power`` is not bit-identical)."""
-        if int(k[-1]) >= (have := len(self._scales)):
-            more = range(have, max(int(k[-1]) + 1, 2 * have))
+        """``narrowing ** (k / 100)`` for ascending offsets k >= 0, memoised (``np.power`` is not bit-identical),
+        up to the offset where every padding has reached its ``range_``: later offsets get that one's (the same
+        paddings; the memo stops growing there)."""
+        while self._cut is None and int(k[-1]) >= (have := len(self._scales)):
+            more = range(have, max(2 * have, 128))
             self._scales = np.concatenate((self._scales, [self.narrowing ** (i / _NARROWING_UNIT) for i in more]))
-        return self._scales[k]
+            below = np.flatnonzero(self._scales <= self._floor)
+            self._cut = int(below[0]) if len(below) else None
+        return self._scales[k if self._cut is None else np.minimum(k, self._cut)]
 
     def iterate(self, limit: int = 1, stop: Callable[[], bool] | None = None) -> int:
         """Draw one sample and try it at every intermediate step (up to ``limit`` samples; see below).

@@ -262,12 +262,15 @@ class Checker:
         m = len(C)
         if m == 1 and self._first_invalid is not None and self._check_motions is not None \
                 and bool(strict[0] and left_known[0] and right_known[0]):
-            # one strict candidate (the improvement phase's usual case): the candidate, then its motions'
-            # screen in bisection order, stopping at the first failure; the motions in full if none
+            # one strict candidate (the improvement phase's usual case): the candidate (the screen is not
+            # even built when it collides), then its motions' screen in bisection order, stopping at the
+            # first failure; the motions in full if none
+            no = np.zeros(1, dtype=bool)
+            if self.first_invalid(C) >= 0:
+                return no, no, no
             A2, B2 = np.concatenate((A, C)), np.concatenate((C, B))
-            i = self.first_invalid(np.concatenate((C, self._screen(A2, B2, bisect=True)[0])))
-            if i >= 0:
-                return np.array([i > 0]), np.zeros(1, dtype=bool), np.zeros(1, dtype=bool)
+            if self.first_invalid(self._screen(A2, B2, bisect=True)[0]) >= 0:
+                return ~no, no, no
             ok = self.check_motions(A2, B2)
             return np.ones(1, dtype=bool), ok[:1], ok[1:]
         vc = self.states(C) if not self.batched else None
