@@ -21,6 +21,7 @@ from __future__ import annotations
 import argparse
 
 import numpy as np
+from _common import length_after
 from ompl import util as ou
 
 import tpee_ompl.planning.dimension_search as dimension_search
@@ -32,13 +33,6 @@ from tpee_ompl.planning.tpee import tpee_dimension_rrt
 from tpee_ompl.resources import default_library_path
 
 _RESPREAD = dimension_search.respread_candidate
-
-
-def _length(ss, planner, budget: float) -> float:
-    ss.clear()
-    ss.setPlanner(planner)
-    ss.solve(budget)
-    return ss.getSolutionPath().length() if ss.haveExactSolutionPath() else float("nan")
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -72,7 +66,7 @@ def main(argv: list[str] | None = None) -> None:
                             planner = (LibraryDimensionRRT(si, lib, i, j, seed=seed, max_samples=cap) if who == "pipeline"
                                        else tpee_dimension_rrt(si, i, j, seed=seed, max_samples=cap,
                                                                release_after=RELEASE_AFTER))
-                            res[(who, part)][on].append(_length(ss, planner, 60.0 if budget is None else budget))
+                            res[(who, part)][on].append(length_after(ss, planner, 60.0 if budget is None else budget))
         dimension_search.respread_candidate = _RESPREAD
         for (who, part), r in res.items():
             off, on = np.array(r[False]), np.array(r[True])

@@ -22,6 +22,7 @@ from __future__ import annotations
 import argparse
 
 import numpy as np
+from _common import length_after
 from ompl import util as ou
 
 from tpee_ompl import PathLibrary, WearerArm, make_simple_setup
@@ -52,13 +53,6 @@ def _joint(on: bool) -> None:
     dimension_rrt.Search = Search if on else _BoxSearch
 
 
-def _length(ss, planner, budget: float) -> float:
-    ss.clear()
-    ss.setPlanner(planner)
-    ss.solve(budget)
-    return ss.getSolutionPath().length() if ss.haveExactSolutionPath() else float("nan")
-
-
 def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--queries", nargs="+", default=["/tmp/heldout/planning_necessary.json",
@@ -87,7 +81,7 @@ def main(argv: list[str] | None = None) -> None:
                             for who in ("pipeline", "released"):
                                 planner = (LibraryDimensionRRT(si, lib, i, j, seed=seed) if who == "pipeline"
                                            else tpee_dimension_rrt(si, i, j, seed=seed, release_after=RELEASE_AFTER))
-                                res[(who, b)][on].append(_length(ss, planner, b))
+                                res[(who, b)][on].append(length_after(ss, planner, b))
             for (who, b), r in res.items():
                 box, joint = np.array(r[False]), np.array(r[True])
                 better = np.fmin(box, joint)
