@@ -149,11 +149,11 @@ class Search:
         if n0 is None and g0 + len(U) - 1 >= self.narrow_after:
             n0 = max(g0, self.narrow_after)
         if n0 is not None:
-            g = g0 + np.arange(len(U))
-            narrow = np.flatnonzero((g >= n0) & (U[:, 0] >= _UNIFORM_FRACTION))
+            g = g0 + np.arange(len(U)) if g0 < n0 or self._cut is None or g0 - n0 < self._cut else None
+            narrow = np.flatnonzero((U[:, 0] >= _UNIFORM_FRACTION) if g0 >= n0 else (g >= n0) & (U[:, 0] >= _UNIFORM_FRACTION))
             if len(narrow):
-                scale = self._scale(g[narrow] - n0)
-                pad = np.maximum(self.range_[gi], span * scale[:, None])
+                # past the memo's cut every padding is range_ (the same values, without the per-sample arrays)
+                pad = self.range_[gi] if g is None else np.maximum(self.range_[gi], span * self._scale(g[narrow] - n0)[:, None])
                 vals = self.W[:, self._dims[gi]]
                 if self._local:
                     m = len(vals) - 2
