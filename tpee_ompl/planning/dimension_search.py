@@ -149,11 +149,12 @@ class Search:
         if n0 is None and g0 + len(U) - 1 >= self.narrow_after:
             n0 = max(g0, self.narrow_after)
         if n0 is not None:
-            g = g0 + np.arange(len(U)) if g0 < n0 or self._cut is None or g0 - n0 < self._cut else None
-            narrow = np.flatnonzero((U[:, 0] >= _UNIFORM_FRACTION) if g0 >= n0 else (g >= n0) & (U[:, 0] >= _UNIFORM_FRACTION))
+            narrow = np.flatnonzero((U[:, 0] >= _UNIFORM_FRACTION) & (g0 + np.arange(len(U)) >= n0))
             if len(narrow):
-                # past the memo's cut every padding is range_ (the same values, without the per-sample arrays)
-                pad = self.range_[gi] if g is None else np.maximum(self.range_[gi], span * self._scale(g[narrow] - n0)[:, None])
+                if self._cut is not None and g0 - n0 >= self._cut:  # every padding is range_ from here on
+                    pad = self.range_[gi]
+                else:
+                    pad = np.maximum(self.range_[gi], span * self._scale(g0 - n0 + narrow)[:, None])
                 vals = self.W[:, self._dims[gi]]
                 if self._local:
                     m = len(vals) - 2
@@ -166,9 +167,8 @@ class Search:
         return C, n0
 
     def _scale(self, k: np.ndarray) -> np.ndarray:
-        """``narrowing ** (k / 100)`` for ascending offsets k >= 0, memoised (``np.power`` is not bit-identical),
-        up to the offset where every padding has reached its ``range_``: later offsets get that one's (the same
-        paddings; the memo stops growing there)."""
+        """``narrowing ** (k / 100)`` for ascending offsets k >= 0, memoised (``np.power`` is not bit-identical) up to
+        the offset where every padding has reached its ``range_`` (later offsets get that one's: the same paddings)."""
         while self._cut is None and int(k[-1]) >= (have := len(self._scales)):
             more = range(have, max(2 * have, 128))
             self._scales = np.concatenate((self._scales, [self.narrowing ** (i / _NARROWING_UNIT) for i in more]))
