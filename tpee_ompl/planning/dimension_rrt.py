@@ -81,29 +81,35 @@ posted while posting costs at most 10 % of the run time and the best one always 
 planner stops once ``opt.isSatisfied(cost)`` (a cost threshold of ``inf`` = first solution);
 :meth:`DimensionRRT.set_intermediate_solution_callback` stands in for OMPL's (refused from Python).
 
+Goal regions: a goal that is not one state (``GoalStates``, e.g. several IK solutions, or any other
+``GoalSampleableRegion``) gives up to ``max_goals`` valid goal states, and each gets its own search
+(:mod:`tpee_ompl.planning.goal_runs`), nearest to the start first, in turns of 100 samples; every
+search's shorter paths go to the same problem definition, and a goal whose start-goal distance is no
+shorter than the best path found stops.  A goal off a prescribed row is skipped.
+
 Spaces: bounded RealVector, SO2 (the short way round, like ``SO2StateSpace``) and compounds of them.
 Here: the settings (:class:`DimensionRRTOptions`) and the planner; the search is :mod:`tpee_ompl.planning.dimension_search`.
 """
 
 from __future__ import annotations
 
-import dataclasses
 import logging
 import math
 import time
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from ompl import base as ob
 from ompl import geometric as og
 
-from ..validation import check_bool, check_int, check_name, check_number
+from ..validation import check_int
+from .dimension_rrt_options import RELEASE_AFTER, DimensionRRTOptions, resolve_options, shortcuts_on
 from .dimension_search import Search
-from .search_checker import Checker
-from .grouped_space import MAX_H, GroupedSpace
+from .goal_runs import GOAL_TURN, GoalRun, goal_states
+from .grouped_space import GroupedSpace
 from .planner_base import PythonPlanner, planner_status
+from .search_checker import Checker
 from .solution_posting import SolutionPoster
 
 __all__ = ["RELEASE_AFTER", "DimensionRRT", "DimensionRRTOptions", "shortcuts_on"]
@@ -113,9 +119,6 @@ log = logging.getLogger(__name__)
 _REFINE_AFTER = 500
 """Samples without a first path after which ``h`` is raised (when ``max_h`` allows; see "Raising h")."""
 
-RELEASE_AFTER = 100
-"""A ``release_after`` that pays (the library pipeline's default; chosen on 36 held-out queries, ``docs/dimension_rrt.md``)."""
-
 _PROGRESS_PERIOD = 0.01
 """Seconds between progress-trace entries (OMPL's benchmark records progress about as often)."""
 
@@ -123,99 +126,6 @@ _PASS_BATCH = 64
 """Most samples per :meth:`Search.iterate` call on a valid path (those the cost test rejects are passed
 over in one vectorised step; the termination condition is asked between calls) or in the connect
 trees (which ask it before each sample, as RRTConnect does)."""
-
-
-@dataclass(frozen=True)
-class DimensionRRTOptions:
-    """Settings of :class:`DimensionRRT`, checked once here.
-
-    Attributes
-    ----------
-    groups : sequence of sequences of int, optional
-        DOF indices per group in planning order (default ``[[0, 1], [2, 3]]`` for 4-D, else pairs).
-    h : int
-        Fake-time steps including start and goal (default 7, the length of the Table 3 rows).
-    max_samples : int, optional
-        Stop after this many samples even if the termination condition still allows time.
-    seed : int, optional
-        Seed of the planner's own ``np.random.Generator`` (OMPL's seed does not cover it).
-    narrow_after : int
-        Samples of a group (and a valid path) before its sampling region narrows (default 200).
-    narrowing : float in (0, 1]
-        Factor by which the padding of the narrowed region shrinks every 100 samples (default 0.5).
-    range_ : float or sequence of float, optional
-        Smallest padding of the narrowed region, in the DOFs' units (default 2 % of each bound width).
-    name : str
-        Planner name (``geometric_<name>`` in a Benchmark database).
-    batch : bool
-        Use the checker's batched ``are_valid`` when it has one (default True).
-    stall_samples : int, optional
-        Stop after this many samples in a row without a shorter valid path (None: as the paper, never).
-    max_h : int, optional
-        Largest number of fake-time steps the feasibility phase may raise ``h`` to (None, the
-        default: ``h`` stays fixed, as in the paper).  See "Raising h" in the module docstring.
-    connect : bool
-        Without prescribed groups, look for the first path with RRTConnect's two trees and fit it to
-        the ``h`` steps (default True); False: the layered trees.  See "Feasibility phase".
-    release_after : int, optional
-        After this many samples in a row without a shorter valid path, the prescribed rows are
-        released (None, the default: kept to the end, as in the paper).  See "Releasing the prescribed rows".
-    shortcuts : bool, optional
-        After each improvement, move every intermediate waypoint towards the point shortest between its
-        neighbours (None, the default: only with a prescribed group, where it pays).  See "Shortcuts".
-    """
-
-    groups: Sequence[Sequence[int]] | None = None
-    h: int = 7
-    max_samples: int | None = None
-    seed: int | None = None
-    narrow_after: int = 200
-    narrowing: float = 0.5
-    range_: float | Sequence[float] | None = None
-    name: str = "DimensionRRT"
-    batch: bool = True
-    stall_samples: int | None = None
-    max_h: int | None = None
-    connect: bool = True
-    release_after: int | None = None
-    shortcuts: bool | None = None
-
-    def __post_init__(self) -> None:
-        check_name("name", self.name)
-        set_ = lambda field_, value: object.__setattr__(self, field_, value)  # noqa: E731 (frozen dataclass)
-        set_("max_samples", check_int("max_samples", self.max_samples, minimum=1, optional=True))
-        set_("seed", check_int("seed", self.seed, minimum=0, optional=True))
-        set_("narrow_after", check_int("narrow_after", self.narrow_after, minimum=0))
-        set_("narrowing", check_number("narrowing", self.narrowing, low=0.0, high=1.0, low_open=True))
-        set_("batch", check_bool("batch", self.batch))
-        set_("connect", check_bool("connect", self.connect))
-        if self.shortcuts is not None:
-            set_("shortcuts", check_bool("shortcuts", self.shortcuts))
-        set_("stall_samples", check_int("stall_samples", self.stall_samples, minimum=1, optional=True))
-        set_("max_h", check_int("max_h", self.max_h, minimum=3, maximum=MAX_H, optional=True))
-        set_("release_after", check_int("release_after", self.release_after, minimum=1, optional=True))
-        if self.range_ is not None:
-            try:
-                arr = np.asarray(self.range_, dtype=float)
-            except (TypeError, ValueError):
-                arr = None
-            if arr is None or arr.ndim > 1 or arr.size == 0 or not np.all(np.isfinite(arr)) or np.any(arr <= 0):
-                raise ValueError(f"range_ must be a positive number or array, got {self.range_!r}")
-
-
-def shortcuts_on(options: DimensionRRTOptions, prescribed: bool) -> bool:
-    """Whether the search takes shortcuts between waypoints: ``options.shortcuts``, or when it is None,
-    whether a group is prescribed (where they pay; see "Shortcuts")."""
-    return prescribed if options.shortcuts is None else options.shortcuts
-
-
-def _resolve_options(options: DimensionRRTOptions | None, overrides: Mapping[str, Any]) -> DimensionRRTOptions:
-    """``options`` (default settings if None) with the keyword overrides applied, validated."""
-    if options is None:
-        options = DimensionRRTOptions()
-    elif not isinstance(options, DimensionRRTOptions):
-        raise ValueError(f"options must be a DimensionRRTOptions, got {type(options).__name__}")
-    return dataclasses.replace(options, **overrides) if overrides else options
 
 
 class DimensionRRT(PythonPlanner):
@@ -257,7 +167,7 @@ class DimensionRRT(PythonPlanner):
     ) -> None:
         # Validate everything BEFORE super().__init__: an exception raised after it leaves a
         # half-constructed nanobind trampoline whose collection crashed the interpreter.
-        opts = _resolve_options(options, overrides)
+        opts = resolve_options(options, overrides)
         if not isinstance(si, ob.SpaceInformation):
             raise ValueError(f"si must be an ompl.base.SpaceInformation, got {type(si).__name__}")
         grouped = GroupedSpace(si, opts.groups, opts.h, prescribed)
@@ -377,6 +287,7 @@ class DimensionRRT(PythonPlanner):
             "connect": str(self.options.connect),
             "shortcuts": str(self.shortcuts),
             "initial_waypoints": "none" if self._initial is None else "set",
+            "max_goals": str(self.options.max_goals),
         }
 
     @staticmethod
@@ -391,13 +302,14 @@ class DimensionRRT(PythonPlanner):
             "progress": [],
             "solutions_posted": 0,
             "released_at": None,
+            "goals": 0,
         }
 
     def last_run_stats(self) -> dict[str, Any]:
         """Statistics of the last solve: samples, h (fake-time steps at the end), collision_checks, first_solution_time (s or None),
         best_cost (inf if none), iterations, progress [(time_s, best_cost, samples), ...],
         solutions_posted (paths added to the problem definition), released_at (samples at which the
-        prescribed rows were released, or None)."""
+        prescribed rows were first released, or None), goals (goal states planned to)."""
         return super().last_run_stats()
 
     def _start_run(self) -> None:
@@ -408,92 +320,123 @@ class DimensionRRT(PythonPlanner):
     def _solve(self, ptc: ob.PlannerTerminationCondition) -> ob.PlannerStatus:
         t0 = time.perf_counter()
         si, pdef = self.getSpaceInformation(), self.getProblemDefinition()
-        ends = self._endpoints()
-        if isinstance(ends, ob.PlannerStatus):
-            return ends
-        start, gstate = ends
-        layout = self.grouped.layout
-        q0, q1 = layout.read(start), layout.read(gstate)
-        mismatch = self.grouped.endpoint_mismatch(q0, q1)
-        if mismatch is not None:
+        layout, grouped = self.grouped.layout, self.grouped
+        start = self._start()
+        Q1 = start if isinstance(start, ob.PlannerStatus) else goal_states(self, ptc, self.options.max_goals, layout.read)
+        if isinstance(Q1, ob.PlannerStatus):
+            return Q1
+        q0 = layout.read(start)
+        fits = [q1 for q1 in Q1 if grouped.endpoint_mismatch(q0, q1) is None]
+        if not fits:
+            mismatch = grouped.endpoint_mismatch(q0, Q1[0])
             log.error("the %s state is not on the prescribed trajectory", mismatch)
             return planner_status(ob.PlannerStatus.INVALID_START if mismatch == "start" else ob.PlannerStatus.INVALID_GOAL)
+        fits.sort(key=lambda q1: float(layout.distance(q0, q1)))  # the nearest goal first (stable: one goal as given)
         checker = Checker(si, layout, self.batch)
         checks0 = checker.counter()
-        search = Search(self.grouped, checker, self._rng, q0, q1, self.narrow_after, self.narrowing, self._ranges(self.grouped),
-                         self._initial, self.options.connect, shortcuts=self.shortcuts)
-        poster = SolutionPoster(self, si, pdef, t0, self.grouped.to_path, self._notify, checker.passed)
+        release = self.options.release_after if grouped.prescribed and grouped.planned else None
+        runs = [GoalRun(q1, grouped, Search(grouped, checker, self._rng, q0, q1, self.narrow_after, self.narrowing,
+                                            self._ranges(grouped), self._initial, self.options.connect,
+                                            shortcuts=self.shortcuts), release, float(layout.distance(q0, q1)))
+                for q1 in fits]
+        runs[0].turn_end = GOAL_TURN
+        poster = SolutionPoster(self, si, pdef, t0, grouped.to_path, self._notify, checker.passed)
         stats = self._stats
         progress = stats["progress"]
-        cap = self.max_samples if self.grouped.planned else 0
-        grouped, done = self.grouped, 0  # ``done``: samples of the searches before the last raise of h
+        cap = self.max_samples if grouped.planned else 0
         max_h = self.options.max_h or 0
         last_log = -math.inf
+        several = len(runs) > 1
+        drawn = 0  # samples of every goal's searches
 
         def record(now: float) -> None:
-            progress.append((now - t0, poster.found_cost, done + search.samples))
+            progress.append((now - t0, poster.found_cost, drawn))
 
-        if search.valid:
-            poster.offer(search.W, search.cost, time.perf_counter())
+        for run in runs:
+            run.best = run.search.cost if run.search.valid else math.inf
+            if run.best < poster.found_cost:
+                poster.offer(run.search.W, run.best, time.perf_counter())
         record(time.perf_counter())
-        stall, improved_at = self.options.stall_samples, 0
-        release = self.options.release_after if grouped.prescribed and grouped.planned else None
+        stall = self.options.stall_samples
         stops = self._sample_checkpoints
-        while not poster.satisfied and not ptc() and (cap is None or done + search.samples < cap):
-            if release is not None and search.valid and search.samples - improved_at >= release:
+        turn = 0
+        while not poster.satisfied and not ptc() and (cap is None or drawn < cap):
+            run = runs[turn]
+            search = run.search
+            if several and (run.stopped or run.samples >= run.turn_end or run.bound >= poster.found_cost - 1e-12):
+                # another goal's turn; a goal that no path beats the best found at (its start-goal distance) stops
+                run.stopped |= run.bound >= poster.found_cost - 1e-12
+                active = [k for k in range(len(runs)) if not runs[k].stopped]
+                if not active:
+                    break
+                turn = next((k for k in active if k > turn), active[0])
+                runs[turn].turn_end = runs[turn].samples + GOAL_TURN
+                continue
+            if run.release is not None and search.valid and search.samples - run.improved_at >= run.release:
                 # converged on the prescribed rows: from this path on, every DOF in one group, around one waypoint
                 # (``improved_at`` shifted so that ``stall`` counts on across the release)
-                grouped, done, release = grouped.released(), done + search.samples, None
-                improved_at -= search.samples
-                search = Search(grouped, checker, self._rng, q0, q1, self.narrow_after, self.narrowing,
-                                self._ranges(grouped), search.W, self.options.connect, shortcuts=self.shortcuts,
-                                local=True)
-                stats["released_at"] = done
-                log.info("DimensionRRT: prescribed rows released after %d samples", done)
+                run.grouped, run.done, run.release = run.grouped.released(), run.samples, None
+                run.improved_at -= search.samples
+                run.search = Search(run.grouped, checker, self._rng, q0, run.goal, self.narrow_after, self.narrowing,
+                                    self._ranges(run.grouped), search.W, self.options.connect, shortcuts=self.shortcuts,
+                                    local=True)
+                if stats["released_at"] is None:
+                    stats["released_at"] = drawn
+                log.info("DimensionRRT: prescribed rows released after %d samples", drawn)
                 continue
-            if stall is not None and math.isfinite(poster.found_cost) and search.samples - improved_at >= stall:
-                break  # converged: nothing shorter in the last ``stall`` samples
-            if (not search.valid and 2 * grouped.h - 1 <= max_h
+            if stall is not None and math.isfinite(poster.found_cost) and search.samples - run.improved_at >= stall:
+                run.stopped = True  # converged: nothing shorter in the last ``stall`` samples
+                if all(r.stopped for r in runs):
+                    break
+                continue
+            if (not search.valid and 2 * run.grouped.h - 1 <= max_h
                     and (search.samples >= _REFINE_AFTER or search.unfitted is not None)):
                 # no path yet, or a connect path with more turns than steps: twice the steps, the
                 # trees start again (that path is fitted to the new steps first)
-                grouped = grouped.refined(q0, q1)
-                done += search.samples
-                search = Search(grouped, checker, self._rng, q0, q1, self.narrow_after, self.narrowing,
-                                self._ranges(grouped), None, self.options.connect, search.unfitted, self.shortcuts)
-                if search.valid:
-                    poster.offer(search.W, search.cost, time.perf_counter())
+                run.grouped = run.grouped.refined(q0, run.goal)
+                run.done = run.samples
+                run.search = Search(run.grouped, checker, self._rng, q0, run.goal, self.narrow_after, self.narrowing,
+                                    self._ranges(run.grouped), None, self.options.connect, search.unfitted, self.shortcuts)
+                run.best = run.search.cost if run.search.valid else math.inf
+                if run.best < poster.found_cost:
+                    poster.offer(run.search.W, run.best, time.perf_counter())
                     record(time.perf_counter())
-                log.info("DimensionRRT: no path after %d samples, h raised to %d", done, grouped.h)
+                log.info("DimensionRRT: no path after %d samples, h raised to %d", run.done, run.grouped.h)
                 continue
-            drawn = done + search.samples
             limit = _PASS_BATCH if cap is None else min(_PASS_BATCH, cap - drawn)
             if stall is not None:
-                limit = min(limit, stall - (search.samples - improved_at))
-            if release is not None and search.valid:
-                limit = min(limit, release - (search.samples - improved_at))
+                limit = min(limit, stall - (search.samples - run.improved_at))
+            if run.release is not None and search.valid:
+                limit = min(limit, run.release - (search.samples - run.improved_at))
             if stops and drawn < stops[-1]:
                 limit = min(limit, next(s for s in stops if s > drawn) - drawn)
+            if several:
+                limit = min(limit, run.turn_end - run.samples)
+            before = search.samples
             accepted = search.iterate(max(1, limit), ptc)
-            self._samples_drawn = done + search.samples
+            drawn += search.samples - before
+            self._samples_drawn = drawn
             now = time.perf_counter()
-            if accepted and search.valid and search.cost < poster.found_cost:
-                poster.offer(search.W, search.cost, now)
-                record(now)
-                last_log, improved_at = now, search.samples
-                continue
+            if accepted and search.valid and search.cost < run.best:
+                run.best, run.improved_at = search.cost, search.samples
+                if search.cost < poster.found_cost:
+                    poster.offer(search.W, search.cost, now)
+                    record(now)
+                    last_log = now
+                    continue
             if now - last_log >= _PROGRESS_PERIOD:
                 record(now)
                 last_log = now
         poster.flush()
         record(time.perf_counter())
         stats.update(
-            h=grouped.h,
-            samples=done + search.samples,
-            iterations=done + search.samples,
+            h=max(run.grouped.h for run in runs),
+            samples=drawn,
+            iterations=drawn,
             collision_checks=checker.counter() - checks0,
             first_solution_time=poster.first_time,
             best_cost=poster.best_cost,
             solutions_posted=poster.posted,
+            goals=len(runs),
         )
         return planner_status(ob.PlannerStatus.EXACT_SOLUTION if poster.posted else ob.PlannerStatus.TIMEOUT)

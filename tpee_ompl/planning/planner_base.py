@@ -75,9 +75,8 @@ class PythonPlanner(ob.Planner):
     def _solve(self, ptc: ob.PlannerTerminationCondition) -> ob.PlannerStatus:
         raise NotImplementedError
 
-    def _endpoints(self) -> tuple[ob.State, ob.State] | ob.PlannerStatus:
-        """The start and the goal state, both within bounds and valid, or the status saying which is not."""
-        si, pdef = self.getSpaceInformation(), self.getProblemDefinition()
+    def _start(self) -> ob.State | ob.PlannerStatus:
+        """The (first) start state, within bounds and valid, or INVALID_START."""
         pis = self.getPlannerInputStates()
         start = pis.nextStart()
         if start is None and pis.getSeenStartStatesCount() > 0:  # solve() again without clear()
@@ -85,6 +84,14 @@ class PythonPlanner(ob.Planner):
             start = pis.nextStart()
         if start is None:  # nextStart() skips start states out of bounds or invalid (OMPL checks them itself)
             return planner_status(ob.PlannerStatus.INVALID_START)
+        return start
+
+    def _endpoints(self) -> tuple[ob.State, ob.State] | ob.PlannerStatus:
+        """The start and the goal state, both within bounds and valid, or the status saying which is not."""
+        si, pdef = self.getSpaceInformation(), self.getProblemDefinition()
+        start = self._start()
+        if isinstance(start, ob.PlannerStatus):
+            return start
         goal = pdef.getGoal()
         if not isinstance(goal, ob.GoalState):
             log.error("%s needs a goal that is a single state, got %s", self.getName(), type(goal).__name__)

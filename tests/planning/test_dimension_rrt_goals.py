@@ -1,0 +1,175 @@
+"""Dimension-RRT with goal regions: several goal states (``GoalStates``), a sampleable region, a refused one."""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+import numpy as np
+import pytest
+from ompl import base as ob
+from ompl import geometric as og
+
+from tpee_ompl.planning.dimension_rrt import DimensionRRT
+from tpee_ompl.planning.paths import path_to_array, set_state
+
+_WALL = (0.45, 0.55)  # a wall across x0 with a gap at x1 > 0.8
+_BOX = (0.75, 0.3)  # the walls x = 0.75 and y = 0.3 close off the corner around (0.9, 0.1)
+
+
+def _free(x: float, y: float) -> bool:
+    if _WALL[0] < x < _WALL[1] and y < 0.8:
+        return False
+    x0, y1 = _BOX
+    on_box = (x0 - 0.02 < x < x0 + 0.02 and y < y1) or (x0 < x and y1 - 0.02 < y < y1 + 0.02)
+    return not on_box
+
+
+def _point_setup() -> og.SimpleSetup:
+    """A 2-D point in the unit square: a wall with a gap at the top, and a closed box in the bottom right."""
+    space = ob.RealVectorStateSpace(2)
+    space.setBounds(0.0, 1.0)
+    ss = og.SimpleSetup(space)
+    def valid(s: ob.State) -> bool:
+        return _free(s[0], s[1])
+
+    ss.setStateValidityChecker(valid)
+    ss._valid = valid  # type: ignore[attr-defined]  # keep the Python checker alive
+    si = ss.getSpaceInformation()
+    si.setStateValidityCheckingResolution(0.005)
+    ss.setOptimizationObjective(ob.PathLengthOptimizationObjective(si))
+    ss.setStartState(set_state(si.allocState(), (0.1, 0.1)))
+    return ss
+
+
+def _goal_states(ss: og.SimpleSetup, points) -> ob.GoalStates:
+    goal = ob.GoalStates(ss.getSpaceInformation())
+    for p in points:
+        goal.addState(set_state(ss.getSpaceInformation().allocState(), p))
+    return goal
+
+
+def _solve(ss: og.SimpleSetup, goal: ob.Goal, **options) -> tuple[ob.PlannerStatus, DimensionRRT]:
+    ss.setGoal(goal)
+    planner = DimensionRRT(ss.getSpaceInformation(), groups=[[0, 1]], seed=3, **options)
+    ss.setPlanner(planner)
+    return ss.solve(10.0), planner
+
+
+def _proven(ss: og.SimpleSetup) -> np.ndarray:
+    path = ss.getSolutionPath()
+    assert ss.haveExactSolutionPath() and path.check()
+    states = path.getStates()
+    si = ss.getSpaceInformation()
+    assert all(si.checkMotion(a, b) for a, b in itertools.pairwise(states))
+    return path_to_array(path, 2)
+
+
+def test_several_goal_states_reach_the_one_a_path_leads_to() -> None:
+    ss = _point_setup()
+    # the nearest goal lies inside the closed box: only the far one can be reached, over the wall
+    status, planner = _solve(ss, _goal_states(ss, [(0.9, 0.1), (0.9, 0.5)]), max_samples=3000)
+    assert status == ob.PlannerStatus.EXACT_SOLUTION
+    W = _proven(ss)
+    np.testing.assert_allclose(W[-1], (0.9, 0.5))
+    assert W[:, 1].max() > 0.8  # through the gap
+    assert planner.last_run_stats()["goals"] == 2
+
+
+def test_with_free_straight_paths_the_nearest_goal_is_kept_and_the_others_stop() -> None:
+    ss = _point_setup()
+    status, planner = _solve(ss, _goal_states(ss, [(0.3, 0.6), (0.2, 0.2), (0.4, 0.1)]), max_samples=5000)
+    assert status == ob.PlannerStatus.EXACT_SOLUTION
+    W = _proven(ss)
+    np.testing.assert_allclose(W[-1], (0.2, 0.2))
+    # the straight path to the nearest goal is the shortest there is: every goal's search stops
+    assert planner.last_run_stats()["samples"] < 5000
+
+
+def test_a_sampleable_goal_region_gives_a_path_that_ends_inside_it() -> None:
+    class Disc(ob.GoalSampleableRegion):
+        def __init__(self, si: ob.SpaceInformation) -> None:
+            super().__init__(si)
+            self.setThreshold(1e-9)
+            self.k = 0
+
+        def distanceGoal(self, s: ob.State) -> float:
+            return max(0.0, math.hypot(s[0] - 0.9, s[1] - 0.6) - 0.05)
+
+        def sampleGoal(self, s: ob.State) -> None:
+            a, self.k = 2.4 * self.k, self.k + 1
+            s[0], s[1] = 0.9 + 0.04 * math.cos(a), 0.6 + 0.04 * math.sin(a)
+
+        def maxSampleCount(self) -> int:
+            return 1000
+
+    ss = _point_setup()
+    goal = Disc(ss.getSpaceInformation())
+    status, planner = _solve(ss, goal, max_samples=3000, max_goals=4)
+    assert status == ob.PlannerStatus.EXACT_SOLUTION
+    W = _proven(ss)
+    assert math.hypot(W[-1][0] - 0.9, W[-1][1] - 0.6) <= 0.05
+    assert planner.last_run_stats()["goals"] == 4
+
+
+def test_a_goal_region_that_cannot_be_sampled_is_refused() -> None:
+    class Far(ob.GoalRegion):
+        def __init__(self, si: ob.SpaceInformation) -> None:
+            super().__init__(si)
+            self.setThreshold(0.05)
+
+        def distanceGoal(self, s: ob.State) -> float:
+            return math.hypot(s[0] - 0.9, s[1] - 0.6)
+
+    ss = _point_setup()
+    status, _ = _solve(ss, Far(ss.getSpaceInformation()), max_samples=10)
+    assert status == ob.PlannerStatus.UNRECOGNIZED_GOAL_TYPE
+    assert not ss.haveSolutionPath()
+
+
+def test_goal_states_that_are_all_invalid_give_invalid_goal() -> None:
+    ss = _point_setup()
+    status, _ = _solve(ss, _goal_states(ss, [(0.5, 0.1), (0.5, 0.5)]), max_samples=10)  # both inside the wall
+    assert status == ob.PlannerStatus.INVALID_GOAL
+
+
+def test_solving_again_without_clear_plans_to_the_goal_states_again() -> None:
+    ss = _point_setup()
+    ss.setGoal(_goal_states(ss, [(0.9, 0.1), (0.9, 0.5)]))
+    planner = DimensionRRT(ss.getSpaceInformation(), groups=[[0, 1]], seed=3, max_samples=3000)
+    ss.setPlanner(planner)
+    for _ in range(2):  # SimpleSetup.solve does not clear the planner
+        assert ss.solve(10.0) == ob.PlannerStatus.EXACT_SOLUTION
+        assert planner.last_run_stats()["goals"] == 2
+
+
+def test_same_seed_same_path_with_several_goals() -> None:
+    paths = []
+    for _ in range(2):
+        ss = _point_setup()
+        _solve(ss, _goal_states(ss, [(0.9, 0.1), (0.9, 0.5), (0.7, 0.9)]), max_samples=1500)
+        paths.append(_proven(ss))
+    np.testing.assert_array_equal(paths[0], paths[1])
+
+
+def test_goal_states_off_the_prescribed_trajectory_are_skipped() -> None:
+    space = ob.RealVectorStateSpace(3)
+    space.setBounds(0.0, 1.0)
+    ss = og.SimpleSetup(space)
+    ss.setStateValidityChecker(lambda s: True)
+    si = ss.getSpaceInformation()
+    ss.setStartState(set_state(si.allocState(), (0.0, 0.1, 0.1)))
+    prescribed = {0: np.linspace(0.0, 1.0, 7)[:, None]}  # DOF 0 goes from 0 to 1
+    ss.setGoal(_goal_states(ss, [(0.5, 0.2, 0.2), (1.0, 0.9, 0.9)]))
+    planner = DimensionRRT(si, groups=[[0], [1, 2]], prescribed=prescribed, seed=0, max_samples=300)
+    ss.setPlanner(planner)
+    assert ss.solve(10.0) == ob.PlannerStatus.EXACT_SOLUTION
+    np.testing.assert_allclose(path_to_array(ss.getSolutionPath(), 3)[-1], (1.0, 0.9, 0.9))
+    assert planner.last_run_stats()["goals"] == 1
+
+
+@pytest.mark.parametrize("value", [0, -1, 2.5])
+def test_bad_max_goals_is_refused_naming_it(value) -> None:
+    ss = _point_setup()
+    with pytest.raises(ValueError, match="max_goals"):
+        DimensionRRT(ss.getSpaceInformation(), max_goals=value)
