@@ -1,6 +1,6 @@
 """Several goal states (OMPL's ``GoalStates``): a planar arm whose tip must reach a point, with its IK solutions.
 
-    PYTHONPATH=. .venv/bin/python experiments/goal_states.py                 # 6 targets x 3 seeds, ~2 min
+    PYTHONPATH=. .venv/bin/python experiments/goal_states.py                 # 6 targets x 3 seeds, ~40 s
     PYTHONPATH=. .venv/bin/python experiments/goal_states.py --targets 10 --seeds 5 --time 2
 
 Set up with plain OMPL + numpy, as a user would: a 6-joint planar arm (links 0.25, joints in [-pi, pi])

@@ -82,8 +82,45 @@ def test_with_free_straight_paths_the_nearest_goal_is_kept_and_the_others_stop()
     assert status == ob.PlannerStatus.EXACT_SOLUTION
     W = _proven(ss)
     np.testing.assert_allclose(W[-1], (0.2, 0.2))
-    # the straight path to the nearest goal is the shortest there is: every goal's search stops
-    assert planner.last_run_stats()["samples"] < 5000
+    # the straight path to the nearest goal is the shortest there is: every goal's search stops at once
+    assert planner.last_run_stats()["samples"] == 0
+
+
+def test_of_more_goal_states_than_max_goals_the_nearest_are_kept_on_every_solve() -> None:
+    ss = _point_setup()
+    # the nearest two are in the closed corner; OMPL hands GoalStates out from a rotating position
+    ss.setGoal(_goal_states(ss, [(0.9, 0.5), (0.85, 0.15), (0.9, 0.9), (0.95, 0.1)]))
+    planner = DimensionRRT(ss.getSpaceInformation(), groups=[[0, 1]], seed=3, max_samples=400, max_goals=2)
+    ss.setPlanner(planner)
+    for _ in range(3):
+        ss.clear()
+        assert ss.solve(10.0) == ob.PlannerStatus.TIMEOUT  # both kept goals are unreachable
+        assert planner.last_run_stats()["goals"] == 2
+        assert planner.last_run_stats()["samples"] == 400  # the cap counts the samples of all goals
+
+
+def test_one_goal_state_as_goal_states_gives_the_goal_state_path() -> None:
+    paths = []
+    for several in (False, True):
+        ss = _point_setup()
+        goal = _goal_states(ss, [(0.9, 0.5)]) if several else ob.GoalState(ss.getSpaceInformation())
+        if not several:
+            goal.setState(set_state(ss.getSpaceInformation().allocState(), (0.9, 0.5)))
+        status, planner = _solve(ss, goal, max_samples=800)
+        assert status == ob.PlannerStatus.EXACT_SOLUTION
+        paths.append((_proven(ss), planner.last_run_stats()["progress"]))
+    np.testing.assert_array_equal(paths[0][0], paths[1][0])
+    assert [(c, n) for _, c, n in paths[0][1]] == [(c, n) for _, c, n in paths[1][1]]
+
+
+def test_with_several_goals_stall_samples_count_per_goal() -> None:
+    ss = _point_setup()
+    status, planner = _solve(ss, _goal_states(ss, [(0.9, 0.1), (0.9, 0.5), (0.7, 0.9)]), max_samples=20000,
+                             stall_samples=150)
+    assert status == ob.PlannerStatus.EXACT_SOLUTION
+    stats = planner.last_run_stats()
+    assert stats["samples"] < 20000  # every goal stopped: the unreachable one after 150 samples without a path
+    _proven(ss)
 
 
 def test_a_sampleable_goal_region_gives_a_path_that_ends_inside_it() -> None:

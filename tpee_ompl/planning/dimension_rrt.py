@@ -331,14 +331,16 @@ class DimensionRRT(PythonPlanner):
             mismatch = grouped.endpoint_mismatch(q0, Q1[0])
             log.error("the %s state is not on the prescribed trajectory", mismatch)
             return planner_status(ob.PlannerStatus.INVALID_START if mismatch == "start" else ob.PlannerStatus.INVALID_GOAL)
-        fits.sort(key=lambda q1: float(layout.distance(q0, q1)))  # the nearest goal first (stable: one goal as given)
+        if len(fits) < len(Q1):
+            log.info("DimensionRRT: %d of %d goal states are off the prescribed trajectory", len(Q1) - len(fits), len(Q1))
+        fits.sort(key=lambda q1: float(layout.distance(q0, q1)))  # nearest first (stable: one goal as given)
         checker = Checker(si, layout, self.batch)
         checks0 = checker.counter()
         release = self.options.release_after if grouped.prescribed and grouped.planned else None
         runs = [GoalRun(q1, grouped, Search(grouped, checker, self._rng, q0, q1, self.narrow_after, self.narrowing,
                                             self._ranges(grouped), self._initial, self.options.connect,
                                             shortcuts=self.shortcuts), release, float(layout.distance(q0, q1)))
-                for q1 in fits]
+                for q1 in fits[: self.options.max_goals]]
         runs[0].turn_end = GOAL_TURN
         poster = SolutionPoster(self, si, pdef, t0, grouped.to_path, self._notify, checker.passed)
         stats = self._stats
@@ -353,7 +355,6 @@ class DimensionRRT(PythonPlanner):
             progress.append((now - t0, poster.found_cost, drawn))
 
         for run in runs:
-            run.best = run.search.cost if run.search.valid else math.inf
             if run.best < poster.found_cost:
                 poster.offer(run.search.W, run.best, time.perf_counter())
         record(time.perf_counter())
@@ -363,9 +364,9 @@ class DimensionRRT(PythonPlanner):
         while not poster.satisfied and not ptc() and (cap is None or drawn < cap):
             run = runs[turn]
             search = run.search
-            if several and (run.stopped or run.samples >= run.turn_end or run.bound >= poster.found_cost - 1e-12):
-                # another goal's turn; a goal that no path beats the best found at (its start-goal distance) stops
+            if several:  # a goal no path to which beats the best found (its start-goal distance is no shorter) stops
                 run.stopped |= run.bound >= poster.found_cost - 1e-12
+            if several and (run.stopped or run.samples >= run.turn_end):  # another goal's turn
                 active = [k for k in range(len(runs)) if not runs[k].stopped]
                 if not active:
                     break

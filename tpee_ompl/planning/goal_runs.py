@@ -3,11 +3,17 @@
 OMPL problems state their goal as one state (``GoalState``), several (``GoalStates``: e.g. the inverse
 kinematics solutions of one end-effector pose) or a region that can be sampled
 (``GoalSampleableRegion``, ``GoalSpace``, ``GoalLazySamples``, a Python subclass).  Dimension-RRT's
-search runs between two fixed configurations, so :func:`goal_states` takes up to ``max_goals`` valid goal
-states from the region (OMPL's ``PlannerInputStates.nextGoal``, which checks bounds and validity), and
-:class:`~tpee_ompl.planning.dimension_rrt.DimensionRRT` runs one :class:`GoalRun` per goal state, nearest
-to the start first, in turns of :data:`GOAL_TURN` samples; every run's shorter paths go to the same
-problem definition.  A region that cannot be sampled (a bare ``GoalRegion``) is refused.
+search runs between two fixed configurations, so :func:`goal_states` reads the goal's valid states
+(OMPL's ``PlannerInputStates.nextGoal``, which checks bounds and validity) and
+:class:`~tpee_ompl.planning.dimension_rrt.DimensionRRT` keeps the ``max_goals`` nearest the start, runs
+one :class:`GoalRun` per goal state, nearest first, in turns of :data:`GOAL_TURN` samples, and posts every
+shorter path to the same problem definition.  ``max_samples`` counts the samples of all goals;
+``stall_samples`` counts per goal (a goal with no path yet stops after that many samples once another
+has one), so a converged solve ends at most one stall per goal after its last shorter path; a goal whose
+start-goal distance is no shorter than the best path found stops at once.  A region that cannot be
+sampled (a bare ``GoalRegion``) is refused.  A ``GoalLazySamples`` whose sampler is a Python function
+cannot deliver while the planner waits for its first goal (the wait holds the interpreter; OMPL's
+RRTConnect waits the same way from Python): give such a goal states up front (``GoalStates``).
 """
 
 from __future__ import annotations
@@ -25,8 +31,9 @@ from .planner_base import planner_status
 if TYPE_CHECKING:  # pragma: no cover
     from .dimension_search import Search
     from .grouped_space import GroupedSpace
+    from .planner_base import PythonPlanner
 
-__all__ = ["GOAL_TURN", "GoalRun", "goal_states"]
+__all__ = ["GOAL_TURN", "MAX_GOAL_STATES", "GoalRun", "goal_states"]
 
 log = logging.getLogger("tpee_ompl.planning.dimension_rrt")
 
@@ -34,6 +41,8 @@ GOAL_TURN = 100
 """Samples a goal's search draws before the next goal's takes its turn (with several goal states)."""
 _GOAL_TRIES = 100
 """Draws from a goal region per goal state wanted before it counts as having no more valid ones."""
+MAX_GOAL_STATES = 1000
+"""Most states of a ``GoalStates`` read to pick the nearest ``max_goals`` from."""
 
 
 @dataclass
@@ -42,8 +51,8 @@ class GoalRun:
 
     ``done`` counts the samples of this goal's earlier searches (before ``h`` was raised or the rows were
     released); ``improved_at`` is the search's sample count at its last shorter path (``stall_samples`` and
-    ``release_after`` count from there); ``bound`` is the start-goal distance, which no path to this goal
-    beats."""
+    ``release_after`` count from there); ``best`` is its shortest path so far; ``bound`` is the start-goal
+    distance, which no path to this goal beats."""
 
     goal: np.ndarray
     grouped: GroupedSpace
@@ -60,41 +69,46 @@ class GoalRun:
     def samples(self) -> int:
         return self.done + self.search.samples
 
+    def __post_init__(self) -> None:
+        self.best = self.search.cost if self.search.valid else np.inf
 
-def goal_states(planner: ob.Planner, ptc: ob.PlannerTerminationCondition, max_goals: int,
+
+def goal_states(planner: PythonPlanner, ptc: ob.PlannerTerminationCondition, max_goals: int,
                 read: Callable[[ob.State], np.ndarray]) -> list[np.ndarray] | ob.PlannerStatus:
-    """The goal states of ``planner``'s problem to plan to (as ``read`` gives their values), or the status
-    saying why there are none.
+    """The distinct goal states of ``planner``'s problem (as ``read`` gives their values) that a solve may
+    plan to, or the status saying why there are none.
 
-    A ``GoalState``: its state, INVALID_GOAL when it is out of bounds or invalid.  Any other
-    ``GoalSampleableRegion``: up to ``max_goals`` valid states drawn from it (a ``GoalLazySamples`` with
-    none yet: its first waited for until ``ptc``); INVALID_GOAL when none is found.  Another goal type: UNRECOGNIZED_GOAL_TYPE, with an error naming it."""
-    si, goal = planner.getSpaceInformation(), planner.getProblemDefinition().getGoal()
+    A ``GoalState``: its state (INVALID_GOAL when it is out of bounds or invalid).  ``GoalStates``: every
+    valid one (up to :data:`MAX_GOAL_STATES`; the caller keeps the ``max_goals`` nearest, so the choice
+    does not depend on OMPL's rotating sample position).  Any other ``GoalSampleableRegion``: up to
+    ``max_goals`` valid states drawn from it (with OMPL's random numbers, not the planner's seed; a
+    ``GoalLazySamples`` with none yet: the first waited for until ``ptc``); INVALID_GOAL when none is
+    found.  Another goal type: UNRECOGNIZED_GOAL_TYPE, with an error naming it."""
+    goal = planner.getProblemDefinition().getGoal()
     if isinstance(goal, ob.GoalState):
-        state = goal.getState()
-        if not (si.satisfiesBounds(state) and si.isValid(state)):
-            return planner_status(ob.PlannerStatus.INVALID_GOAL)
-        return [read(state)]
+        state = planner._goal_state()
+        return state if isinstance(state, ob.PlannerStatus) else [read(state)]
     if not isinstance(goal, ob.GoalSampleableRegion):
         log.error("%s needs a goal it can sample states from (GoalState, GoalStates or another GoalSampleableRegion), "
                   "got %s", planner.getName(), type(goal).__name__)
         return planner_status(ob.PlannerStatus.UNRECOGNIZED_GOAL_TYPE)
+    want = min(goal.maxSampleCount(), MAX_GOAL_STATES) if isinstance(goal, ob.GoalStates) else max_goals
     pis = planner.getPlannerInputStates()
     if pis.getSampledGoalsCount() > 0:  # solve() again without clear(): the goal states were drawn already
         pis.restart()
-    states: list[np.ndarray] = []
-    tries = 0  # nextGoal() draws one state and returns None when it is invalid (nextGoal() reuses one state:
-    # read at once); a region whose states are all invalid ends after _GOAL_TRIES per goal wanted
-    while len(states) < max_goals and pis.haveMoreGoalStates() and tries < _GOAL_TRIES * max_goals and not (tries and ptc()):
+    states: dict[bytes, np.ndarray] = {}  # distinct values, in the order drawn
+    tries = 0  # nextGoal() draws one state, None when it is invalid; it reuses one state, so read at once
+    while len(states) < want and pis.haveMoreGoalStates() and tries < _GOAL_TRIES * want and not (tries and ptc()):
         tries += 1
         state = pis.nextGoal()
         if state is not None:
-            states.append(read(state))
+            q = read(state)
+            states.setdefault(q.tobytes(), q)
     if not states and isinstance(goal, ob.GoalLazySamples):
         state = pis.nextGoal(ptc)  # a sampler thread may need time for its first goal: waited for until ptc
         if state is not None:
-            states.append(read(state))
+            states[b""] = read(state)
     if not states:
         log.error("%s: no valid goal state could be drawn from the goal region", planner.getName())
         return planner_status(ob.PlannerStatus.INVALID_GOAL)
-    return states
+    return list(states.values())

@@ -76,7 +76,7 @@ class PythonPlanner(ob.Planner):
         raise NotImplementedError
 
     def _start(self) -> ob.State | ob.PlannerStatus:
-        """The (first) start state, within bounds and valid, or INVALID_START."""
+        """The next valid start state within bounds (the problem's first on a new run), or INVALID_START."""
         pis = self.getPlannerInputStates()
         start = pis.nextStart()
         if start is None and pis.getSeenStartStatesCount() > 0:  # solve() again without clear()
@@ -86,17 +86,24 @@ class PythonPlanner(ob.Planner):
             return planner_status(ob.PlannerStatus.INVALID_START)
         return start
 
-    def _endpoints(self) -> tuple[ob.State, ob.State] | ob.PlannerStatus:
-        """The start and the goal state, both within bounds and valid, or the status saying which is not."""
-        si, pdef = self.getSpaceInformation(), self.getProblemDefinition()
-        start = self._start()
-        if isinstance(start, ob.PlannerStatus):
-            return start
-        goal = pdef.getGoal()
+    def _goal_state(self) -> ob.State | ob.PlannerStatus:
+        """The goal's state, within bounds and valid; else INVALID_GOAL, or UNRECOGNIZED_GOAL_TYPE (logged)
+        when the goal is not an ``ob.GoalState``."""
+        si, goal = self.getSpaceInformation(), self.getProblemDefinition().getGoal()
         if not isinstance(goal, ob.GoalState):
             log.error("%s needs a goal that is a single state, got %s", self.getName(), type(goal).__name__)
             return planner_status(ob.PlannerStatus.UNRECOGNIZED_GOAL_TYPE)
         gstate = goal.getState()
         if not (si.satisfiesBounds(gstate) and si.isValid(gstate)):
             return planner_status(ob.PlannerStatus.INVALID_GOAL)
+        return gstate
+
+    def _endpoints(self) -> tuple[ob.State, ob.State] | ob.PlannerStatus:
+        """The start and the goal state, both within bounds and valid, or the status saying which is not."""
+        start = self._start()
+        if isinstance(start, ob.PlannerStatus):
+            return start
+        gstate = self._goal_state()
+        if isinstance(gstate, ob.PlannerStatus):
+            return gstate
         return start, gstate

@@ -63,7 +63,7 @@ class SolutionPoster:
         self._pending = None
         planner = self.planner
         path = self.to_path(self.si, W)
-        # the start state was checked by _endpoints; a segment that already passed si.checkMotion
+        # the start state was checked when it was read (OMPL's nextStart); a segment that already passed si.checkMotion
         # (same two waypoints in an earlier posted path) is not checked again
         keys = [W[k : k + 2].tobytes() for k in range(len(W) - 1)]
         states = path.getStates()
