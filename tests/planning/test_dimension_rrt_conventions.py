@@ -59,6 +59,38 @@ def test_finite_cost_threshold_stops_once_satisfied() -> None:
     assert stats["best_cost"] <= threshold and stats["samples"] < CAP
 
 
+class _Costly(ob.OptimizationObjective):
+    """A motion costs 100 per unit of length: the objective's cost of a path is 100 times its length
+    (a direct ``OptimizationObjective`` subclass: OMPL calls its Python ``motionCost``)."""
+
+    def __init__(self, si: ob.SpaceInformation) -> None:
+        super().__init__(si)
+        self._si = si
+
+    def stateCost(self, s: ob.State) -> ob.Cost:
+        return ob.Cost(0.0)
+
+    def motionCost(self, a: ob.State, b: ob.State) -> ob.Cost:
+        return ob.Cost(100.0 * self._si.distance(a, b))
+
+
+def test_another_objectives_threshold_is_asked_with_its_own_cost(caplog: pytest.LogCaptureFixture) -> None:
+    ss = make_planar_arm_setup()
+    first = _run(ss, seed=5, max_samples=400)[0].last_run_stats()["progress"]
+    length = next(c for _, c, _ in first if math.isfinite(c))
+    opt = _Costly(ss.getSpaceInformation())
+    opt.setCostThreshold(ob.Cost(2.0 * length))  # any path's length is below it; no path's cost (100 x length) is
+    ss.setOptimizationObjective(opt)
+    with caplog.at_level(logging.WARNING):
+        planner, status = _run(ss, seed=5, max_samples=400)
+    assert status == ob.PlannerStatus.EXACT_SOLUTION
+    assert planner.last_run_stats()["samples"] == 400  # never satisfied: the whole budget, not the first path
+    assert "minimises path length" in caplog.text
+    opt.setCostThreshold(ob.Cost(200.0 * length))  # the first path's cost satisfies this one
+    planner, status = _run(ss, seed=5, max_samples=400)
+    assert status == ob.PlannerStatus.EXACT_SOLUTION and planner.last_run_stats()["samples"] < 400
+
+
 def test_callback_sees_every_posted_path_checked_and_improving() -> None:
     ss = make_planar_arm_setup()
     si = ss.getSpaceInformation()

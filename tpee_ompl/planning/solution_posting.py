@@ -35,6 +35,11 @@ class SolutionPoster:
         self.planner, self.si, self.pdef, self.t0 = planner, si, pdef, t0
         self.to_path, self.notify = to_path, notify
         self.opt = pdef.getOptimizationObjective() if pdef.hasOptimizationObjective() else None
+        self._own_cost = self.opt is not None and not isinstance(self.opt, ob.PathLengthOptimizationObjective)
+        """The objective is not path length: whether a path satisfies it is asked with its own cost of the path."""
+        if self._own_cost:
+            log.warning("%s minimises path length; the objective '%s' only says when a path is good enough",
+                        planner.getName(), self.opt.getDescription())
         self.found_cost = math.inf  # best cost the search found
         self.best_cost = math.inf  # best cost posted (checked by si.checkMotion)
         self.first_time: float | None = None
@@ -49,7 +54,10 @@ class SolutionPoster:
     def offer(self, W: np.ndarray, cost: float, now: float) -> None:
         self.found_cost = cost
         self._pending = (W.copy(), cost)
-        sat = self.opt is not None and bool(self.opt.isSatisfied(ob.Cost(cost)))
+        if self._own_cost:
+            sat = bool(self.opt.isSatisfied(self.to_path(self.si, W).cost(self.opt)))
+        else:
+            sat = self.opt is not None and bool(self.opt.isSatisfied(ob.Cost(cost)))
         if self.posted == 0 or sat or self._spent <= _POST_SHARE * (now - self.t0):
             self.flush()
             self.satisfied = sat and self.posted > 0 and self.best_cost == cost
