@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 from helpers.library_standins import sampler
 from ompl import base as ob
+from ompl import geometric as og
 
 from tpee_ompl.library import PathLibrary
 from tpee_ompl.library.planner import LibraryDimensionRRT, infer_sector
@@ -13,7 +14,7 @@ from tpee_ompl.model.queries import load_queries
 from tpee_ompl.model.sectors import posture_preset
 from tpee_ompl.model.wearer_arm import WearerArm
 from tpee_ompl.planning.dimension_rrt import RELEASE_AFTER, DimensionRRTOptions
-from tpee_ompl.planning.paths import path_passes_motion_checks, path_to_array
+from tpee_ompl.planning.paths import path_passes_motion_checks, path_to_array, set_state
 from tpee_ompl.planning.setup import make_simple_setup
 
 
@@ -199,3 +200,17 @@ def test_a_second_run_of_one_pipeline_draws_other_samples_and_a_new_planner_repe
     ss2 = make_simple_setup(robot, q.start, q.goal)
     ss2.setPlanner(LibraryDimensionRRT(ss2.getSpaceInformation(), library, max_samples=400, seed=3))
     np.testing.assert_array_equal(runs(ss2, 1)[0], first)
+
+
+def test_a_setup_without_an_objective_is_planned_with_path_length(robot, library):
+    start, goal = _query(robot, 1, 2, 0)
+    si = make_simple_setup(robot, start, goal).getSpaceInformation()
+    ss = og.SimpleSetup(si)  # a plain SimpleSetup: no optimization objective
+    ss.setStartAndGoalStates(set_state(si.allocState(), start), set_state(si.allocState(), goal))
+    planner = LibraryDimensionRRT(si, library, max_samples=100, seed=0)
+    ss.setPlanner(planner)
+    assert ss.solve(5.0) == ob.PlannerStatus.EXACT_SOLUTION
+    assert not ss.getProblemDefinition().hasOptimizationObjective()
+    stats = planner.last_run_stats()
+    assert ss.getSolutionPath().length() == pytest.approx(stats["best_cost"])
+    assert path_passes_motion_checks(si, ss.getSolutionPath())

@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 from ompl import base as ob
+from ompl import geometric as og
 
 from ..model.queries import straight_motion
 from ..model.sectors import SECTORS, check_sector, posture_preset
@@ -161,6 +162,7 @@ class LibraryDimensionRRT(PythonPlanner):
                       "(give from_sector/to_sector); start DOF1/DOF2 %s, goal %s", start[:2], goal[:2])
             return planner_status(ob.PlannerStatus.INVALID_START if i is None else ob.PlannerStatus.INVALID_GOAL)
         stats, progress = self._stats, self._stats["progress"]
+        opt = pdef.getOptimizationObjective() if pdef.hasOptimizationObjective() else None
         lib = self.library
         have_exact = False
         seed = None
@@ -173,7 +175,7 @@ class LibraryDimensionRRT(PythonPlanner):
                 if path_passes_motion_checks(si, path):
                     pdef.addSolutionPath(path, False, 0.0, self.getName())
                     now = time.perf_counter() - t0
-                    cost = float(path.cost(pdef.getOptimizationObjective()).value())
+                    cost = _cost(path, opt)
                     stats.update(library_outcome="dmp" if rank == 0 else "repaired", first_solution_time=now,
                                  best_cost=cost)
                     progress.append((now, cost, 0))
@@ -187,19 +189,18 @@ class LibraryDimensionRRT(PythonPlanner):
             if path_passes_motion_checks(si, path):
                 pdef.addSolutionPath(path, False, 0.0, self.getName())
                 now = time.perf_counter() - t0
-                cost = float(path.cost(pdef.getOptimizationObjective()).value())
+                cost = _cost(path, opt)
                 stats.update(library_outcome="straight", first_solution_time=now, best_cost=cost)
                 progress.append((now, cost, 0))
                 have_exact = True
         stats["library_seconds"] = time.perf_counter() - t0
-        opt = pdef.getOptimizationObjective()
-        if have_exact and (ptc() or opt.isSatisfied(ob.Cost(stats["best_cost"]))):
+        if have_exact and (ptc() or (opt is not None and opt.isSatisfied(ob.Cost(stats["best_cost"])))):
             return planner_status(ob.PlannerStatus.EXACT_SOLUTION)
         # the direct joint-space motion, when free, is the shortest path there is: nothing to refine
         direct = array_to_path(si, np.stack([start, goal]))
         if path_passes_motion_checks(si, direct):
             now = time.perf_counter() - t0
-            cost = float(direct.cost(opt).value())
+            cost = _cost(direct, opt)
             if not have_exact or cost < stats["best_cost"]:
                 pdef.addSolutionPath(direct, False, 0.0, self.getName())
                 if not have_exact:
@@ -233,3 +234,8 @@ class LibraryDimensionRRT(PythonPlanner):
             return planner_status(ob.PlannerStatus.EXACT_SOLUTION)
         stats["library_outcome"] = "failed"
         return status
+
+
+def _cost(path: og.PathGeometric, opt: ob.OptimizationObjective | None) -> float:
+    """The path's cost under the problem's objective; its length when the problem has none (a plain SimpleSetup)."""
+    return float(path.cost(opt).value()) if opt is not None else float(path.length())
