@@ -8,11 +8,12 @@ import math
 import numpy as np
 import pytest
 from ompl import base as ob
+from ompl import geometric as og
 
 from tests.helpers.planning_arms import planar_arm_setup
 from tpee_ompl.examples.planar_arm import make_planar_arm_setup
 from tpee_ompl.planning.dimension_rrt import DimensionRRT
-from tpee_ompl.planning.paths import path_passes_motion_checks
+from tpee_ompl.planning.paths import path_passes_motion_checks, set_state
 
 CAP = 3000
 
@@ -191,3 +192,25 @@ def test_continuous_joints_with_a_prescribed_row_are_shortcut_the_short_way_roun
     assert planner.last_run_stats()["progress"][0][1] > bound + 0.5  # the guess, posted first
     assert bound - 1e-9 < path.length() < bound + 0.05  # the detour's 0.53 rad nearly gone (seeds 0-4 of the
     # paper's rule alone leave 0-0.33)
+
+
+def test_solved_without_setup_it_sets_the_space_up_as_ompls_planners_do() -> None:
+    space = ob.RealVectorStateSpace(2)
+    space.setBounds(0.0, 1.0)
+    ss = og.SimpleSetup(space)
+    ss.setStateValidityChecker(lambda s: not (0.4 < s[0] < 0.6 and s[1] < 0.7))
+    si = ss.getSpaceInformation()
+    ss.setStartAndGoalStates(set_state(si.allocState(), (0.1, 0.1)), set_state(si.allocState(), (0.9, 0.1)))
+    assert not si.isSetup()
+    planner = DimensionRRT(si, seed=3, max_samples=300)
+    planner.setProblemDefinition(ss.getProblemDefinition())
+    assert ob.Planner.solve(planner, 10.0) == ob.PlannerStatus.EXACT_SOLUTION
+    assert si.isSetup()
+    assert path_passes_motion_checks(si, ss.getProblemDefinition().getSolutionPath())
+
+
+def test_max_h_below_h_is_refused_naming_it() -> None:
+    ss = make_planar_arm_setup()
+    with pytest.raises(ValueError, match="max_h must be at least h"):
+        DimensionRRT(ss.getSpaceInformation(), h=7, max_h=5)
+

@@ -126,6 +126,26 @@ def test_so2_leaves_wrap_around_like_the_space() -> None:
     assert abs(abs(mid[0]) - np.pi) < 1e-9
 
 
+def test_wrapped_so2_values_stay_below_pi_where_rounding_gives_pi() -> None:
+    space = ob.SO2StateSpace()
+    si = ob.SpaceInformation(space)
+    si.setStateValidityChecker(lambda s: True)
+    si.setup()
+    lay = RealVectorLayout(space)
+    x = np.nextafter(-np.pi, -10.0)  # np.mod(x + pi, 2 pi) - pi rounds to +pi, outside [-pi, pi)
+    w = lay.wrap(np.array([[x], [np.pi], [-np.pi], [0.5]]))[:, 0]
+    assert np.all((w >= -np.pi) & (w < np.pi))
+    np.testing.assert_allclose(w, [-np.pi, -np.pi, -np.pi, 0.5], atol=1e-15)
+    assert si.satisfiesBounds(lay.write(si.allocState(), w[:1]))
+
+
+def test_groups_given_as_a_numpy_array_are_taken_as_lists() -> None:
+    space = ob.RealVectorStateSpace(4)
+    space.setBounds(-1.0, 1.0)
+    si = ob.SpaceInformation(space)
+    assert GroupedSpace(si, np.array([[0, 1], [2, 3]]), 7).groups == [[0, 1], [2, 3]]
+
+
 def test_plain_layout_writes_and_reads_a_state_exactly() -> None:
     space = ob.RealVectorStateSpace(5)
     space.setBounds(-2.0, 2.0)

@@ -90,6 +90,8 @@ class DimensionRRTOptions:
             set_("shortcuts", check_bool("shortcuts", self.shortcuts))
         set_("stall_samples", check_int("stall_samples", self.stall_samples, minimum=1, optional=True))
         set_("max_h", check_int("max_h", self.max_h, minimum=3, maximum=MAX_H, optional=True))
+        if self.max_h is not None and isinstance(self.h, int) and self.max_h < self.h:
+            raise ValueError(f"max_h must be at least h ({self.h}), got {self.max_h}")
         set_("release_after", check_int("release_after", self.release_after, minimum=1, optional=True))
         set_("max_goals", check_int("max_goals", self.max_goals, minimum=1))
         if self.range_ is not None:

@@ -62,6 +62,8 @@ def validate_groups(groups: Sequence[Sequence[int]], n: int) -> list[list[int]]:
     ValueError
         On an empty group, an index out of range, an index in two groups or an index in none.
     """
+    if isinstance(groups, np.ndarray):
+        groups = groups.tolist()
     if isinstance(groups, (str, bytes)) or not isinstance(groups, Sequence) or len(groups) == 0:
         raise ValueError(f"groups must be a non-empty list of lists of DOF indices, got {groups!r}")
     out: list[list[int]] = []
@@ -235,7 +237,9 @@ class RealVectorLayout:
         if not self.has_circular:
             return X
         X = np.array(X, dtype=float, copy=True)
-        X[..., self.circular] = np.mod(X[..., self.circular] + math.pi, 2.0 * math.pi) - math.pi
+        C = np.mod(X[..., self.circular] + math.pi, 2.0 * math.pi) - math.pi
+        C[C >= math.pi] -= 2.0 * math.pi  # rounding can give +pi, outside SO2's bounds
+        X[..., self.circular] = C
         return X
 
     def delta(self, A: np.ndarray, B: np.ndarray, dims: np.ndarray | None = None) -> np.ndarray:

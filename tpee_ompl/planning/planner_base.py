@@ -67,6 +67,8 @@ class PythonPlanner(ob.Planner):
                 log.error("%s: no problem definition; call setProblemDefinition(pdef) or solve through "
                           "og.SimpleSetup", self.getName())
                 return planner_status(ob.PlannerStatus.ABORT)
+            if not self.getSpaceInformation().isSetup():  # solved without setup(): set it up, as OMPL's planners do
+                self.setup()
             return self._solve(ptc)
         except Exception:  # an exception escaping into ot.Benchmark would abort the whole benchmark
             log.exception("%s.solve failed", self.getName())

@@ -39,7 +39,7 @@ class SolutionPoster:
         """The objective is not path length: whether a path satisfies it is asked with its own cost of the path."""
         if self._own_cost:
             log.warning("%s minimises path length; the objective '%s' only says when a path is good enough",
-                        planner.getName(), self.opt.getDescription())
+                        planner.getName(), self.opt.getDescription() or type(self.opt).__name__)
         self.found_cost = math.inf  # best cost the search found
         self.best_cost = math.inf  # best cost posted (checked by si.checkMotion)
         self.first_time: float | None = None
