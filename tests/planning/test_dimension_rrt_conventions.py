@@ -214,3 +214,25 @@ def test_max_h_below_h_is_refused_naming_it() -> None:
     with pytest.raises(ValueError, match="max_h must be at least h"):
         DimensionRRT(ss.getSpaceInformation(), h=7, max_h=5)
 
+
+
+def test_a_batched_checker_answering_the_wrong_shape_is_named_in_the_error(caplog: pytest.LogCaptureFixture) -> None:
+    space = ob.RealVectorStateSpace(2)
+    space.setBounds(0.0, 1.0)
+    ss = og.SimpleSetup(space)
+
+    class Checker(ob.StateValidityChecker):
+        def isValid(self, s: ob.State) -> bool:
+            return not (0.4 < s[0] < 0.6 and s[1] < 0.7)
+
+        def are_valid(self, Q: np.ndarray) -> np.ndarray:
+            return np.ones(len(Q) + 1, dtype=bool)  # one answer too many
+
+    si = ss.getSpaceInformation()
+    checker = Checker(si)
+    ss.setStateValidityChecker(checker)
+    ss.setStartAndGoalStates(set_state(si.allocState(), (0.1, 0.1)), set_state(si.allocState(), (0.9, 0.1)))
+    with caplog.at_level(logging.ERROR):
+        status = _run(ss, seed=0, max_samples=50)[1]
+    assert status == ob.PlannerStatus.CRASH
+    assert "are_valid returned shape" in caplog.text

@@ -110,7 +110,11 @@ class Checker:
             return np.zeros(0, dtype=bool)
         self.own_checks += len(Q)
         if self._are_valid is not None:
-            return np.asarray(self._are_valid(Q), dtype=bool)
+            ok = np.asarray(self._are_valid(Q), dtype=bool)
+            if ok.shape != (len(Q),):
+                raise ValueError(f"the validity checker's are_valid returned shape {ok.shape} for {len(Q)} states "
+                                 "(one bool per row wanted)")
+            return ok
         s = self._s1
         out = np.empty(len(Q), dtype=bool)
         for k, q in enumerate(Q):
