@@ -83,7 +83,8 @@ objective other than path length, which the search still minimises, its own cost
 :meth:`DimensionRRT.set_intermediate_solution_callback` stands in for OMPL's (refused from Python).
 
 Goal regions: a goal that is not one state (``GoalStates``, e.g. several IK solutions, or any other
-``GoalSampleableRegion``) gives up to ``max_goals`` valid goal states, and each gets its own search
+``GoalSampleableRegion``) gives its ``max_goals`` valid goal states nearest the start (of a region: of
+``max_goals`` drawn), and each gets its own search
 (:mod:`tpee_ompl.planning.goal_runs`), nearest to the start first, in turns of 100 samples; every
 search's shorter paths go to the same problem definition, and a goal whose start-goal distance is no
 shorter than the best path found stops.  A goal off a prescribed row is skipped.

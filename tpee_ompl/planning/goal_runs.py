@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -61,7 +61,7 @@ class GoalRun:
     bound: float
     done: int = 0
     improved_at: int = 0
-    best: float = np.inf
+    best: float = field(init=False)
     turn_end: int = 0
     stopped: bool = False
 
