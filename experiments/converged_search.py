@@ -1,6 +1,6 @@
 """Where the library pipeline's samples go once its path has converged: what limits its length at 0.1 s.
 
-    PYTHONPATH=. .venv/bin/python experiments/converged_search.py                  # 24 queries at 0.1 s, ~10 s
+    PYTHONPATH=. .venv/bin/python experiments/converged_search.py                  # 24 queries at 0.1 s, ~5 s
     PYTHONPATH=. .venv/bin/python experiments/converged_search.py --budget 1 --queries paper_random
 
 Runs ``LibraryDimensionRRT`` (seed = query index) on the stratified queries of a set, each solved once to
@@ -10,7 +10,8 @@ reach the paper's rule, i.e. would shorten the path at some step (the others are
 vectorised test); how many of those were accepted; shortcut sweeps; the final path's intermediate
 waypoints that bend (their two segments longer than the chord between their neighbours by more than
 1e-4 of the path's length; the others lie on that chord or within 1e-4 of it); and the time in
-Pinocchio's collision calls against the rest of the run.
+Pinocchio's batched collision calls (``computeCollisionsInParallel``, which the search checks through)
+against the rest of the run.
 """
 
 from __future__ import annotations
@@ -107,7 +108,7 @@ def main(argv: list[str] | None = None) -> None:
     print(f"\nall {len(rows)} queries at {args.budget} s: {n} samples; {totals['rule']} reach the paper's rule "
           f"({100 * totals['rule'] / n:.1f} %), {totals['accepted']} accepted ({100 * totals['accepted'] / max(1, totals['rule']):.1f} % "
           f"of those); {totals['sweeps']} sweeps; bending waypoints per path median {statistics.median(bends)}; "
-          f"time in Pinocchio's collision calls {100 * totals['pin'] / (totals['pin'] + totals['rest']):.0f} %")
+          f"time in Pinocchio's batched collision calls {100 * totals['pin'] / (totals['pin'] + totals['rest']):.0f} %")
 
 
 if __name__ == "__main__":

@@ -21,13 +21,12 @@ from typing import Any
 
 import numpy as np
 from ompl import base as ob
-from ompl import geometric as og
 
 from ..model.queries import straight_motion
 from ..model.sectors import SECTORS, check_sector, posture_preset
 from ..planning.dimension_rrt import RELEASE_AFTER, DimensionRRT, DimensionRRTOptions, shortcuts_on
 from ..planning.paths import array_to_path, path_passes_motion_checks, state_to_array
-from ..planning.planner_base import PythonPlanner, planner_status
+from ..planning.planner_base import PythonPlanner, planner_status, problem_objective
 from ..planning.tpee import tpee_dimension_rrt
 from ..validation import sub_seed
 from .path_library import PathLibrary
@@ -162,7 +161,8 @@ class LibraryDimensionRRT(PythonPlanner):
                       "(give from_sector/to_sector); start DOF1/DOF2 %s, goal %s", start[:2], goal[:2])
             return planner_status(ob.PlannerStatus.INVALID_START if i is None else ob.PlannerStatus.INVALID_GOAL)
         stats, progress = self._stats, self._stats["progress"]
-        opt = pdef.getOptimizationObjective() if pdef.hasOptimizationObjective() else None
+        opt = problem_objective(pdef)  # asked with its own cost of a path; the costs here are lengths
+        best_path = None
         lib = self.library
         have_exact = False
         seed = None
@@ -175,7 +175,7 @@ class LibraryDimensionRRT(PythonPlanner):
                 if path_passes_motion_checks(si, path):
                     pdef.addSolutionPath(path, False, 0.0, self.getName())
                     now = time.perf_counter() - t0
-                    cost = _cost(path, opt)
+                    cost, best_path = path.length(), path
                     stats.update(library_outcome="dmp" if rank == 0 else "repaired", first_solution_time=now,
                                  best_cost=cost)
                     progress.append((now, cost, 0))
@@ -189,18 +189,18 @@ class LibraryDimensionRRT(PythonPlanner):
             if path_passes_motion_checks(si, path):
                 pdef.addSolutionPath(path, False, 0.0, self.getName())
                 now = time.perf_counter() - t0
-                cost = _cost(path, opt)
+                cost, best_path = path.length(), path
                 stats.update(library_outcome="straight", first_solution_time=now, best_cost=cost)
                 progress.append((now, cost, 0))
                 have_exact = True
         stats["library_seconds"] = time.perf_counter() - t0
-        if have_exact and (ptc() or (opt is not None and opt.isSatisfied(ob.Cost(stats["best_cost"])))):
+        if have_exact and (ptc() or (opt is not None and opt.isSatisfied(best_path.cost(opt)))):
             return planner_status(ob.PlannerStatus.EXACT_SOLUTION)
         # the direct joint-space motion, when free, is the shortest path there is: nothing to refine
         direct = array_to_path(si, np.stack([start, goal]))
         if path_passes_motion_checks(si, direct):
             now = time.perf_counter() - t0
-            cost = _cost(direct, opt)
+            cost = direct.length()
             if not have_exact or cost < stats["best_cost"]:
                 pdef.addSolutionPath(direct, False, 0.0, self.getName())
                 if not have_exact:
@@ -235,7 +235,3 @@ class LibraryDimensionRRT(PythonPlanner):
         stats["library_outcome"] = "failed"
         return status
 
-
-def _cost(path: og.PathGeometric, opt: ob.OptimizationObjective | None) -> float:
-    """The path's cost under the problem's objective; its length when the problem has none (a plain SimpleSetup)."""
-    return float(path.cost(opt).value()) if opt is not None else float(path.length())

@@ -90,7 +90,8 @@ search's shorter paths go to the same problem definition, and a goal whose start
 shorter than the best path found stops.  A goal off a prescribed row is skipped.
 
 Spaces: bounded RealVector, SO2 (the short way round, like ``SO2StateSpace``) and compounds of them.
-Here: the settings (:class:`DimensionRRTOptions`) and the planner; the search is :mod:`tpee_ompl.planning.dimension_search`.
+Here: the planner; its settings (:class:`DimensionRRTOptions`) are in :mod:`tpee_ompl.planning.dimension_rrt_options`,
+the search in :mod:`tpee_ompl.planning.dimension_search`, the goal states in :mod:`tpee_ompl.planning.goal_runs`.
 """
 
 from __future__ import annotations
@@ -151,9 +152,9 @@ class DimensionRRT(PythonPlanner):
     Raises
     ------
     ValueError
-        Overlapping, missing or out-of-range DOF indices, ``h < 3``, ``max_samples < 1``, bad
-        ``narrowing``/``narrow_after``/``range_``, a space type other than RealVector/SO2/compound
-        (named in the message), or a RealVector space without bounds.
+        Overlapping, missing or out-of-range DOF indices, ``h < 3``, ``max_samples < 1``, ``max_h < h``,
+        ``max_goals < 1``, bad ``narrowing``/``narrow_after``/``range_``, a space type other than
+        RealVector/SO2/compound (named in the message), or a RealVector space without bounds.
     TypeError
         An override that is not a field of :class:`DimensionRRTOptions` (named).
     """
@@ -308,7 +309,8 @@ class DimensionRRT(PythonPlanner):
         }
 
     def last_run_stats(self) -> dict[str, Any]:
-        """Statistics of the last solve: samples, h (fake-time steps at the end), collision_checks, first_solution_time (s or None),
+        """Statistics of the last solve: samples, h (fake-time steps at the end; with several goal states the
+        most any goal's search used), collision_checks, first_solution_time (s or None),
         best_cost (inf if none), iterations, progress [(time_s, best_cost, samples), ...],
         solutions_posted (paths added to the problem definition), released_at (samples at which the
         prescribed rows were first released, or None), goals (goal states planned to)."""
@@ -339,9 +341,13 @@ class DimensionRRT(PythonPlanner):
         checker = Checker(si, layout, self.batch)
         checks0 = checker.counter()
         release = self.options.release_after if grouped.prescribed and grouped.planned else None
-        runs = [GoalRun(q1, grouped, Search(grouped, checker, self._rng, q0, q1, self.narrow_after, self.narrowing,
-                                            self._ranges(grouped), self._initial, self.options.connect,
-                                            shortcuts=self.shortcuts), release, float(layout.distance(q0, q1)))
+
+        def new_search(grouped_: GroupedSpace, goal: np.ndarray, initial: np.ndarray | None,
+                       turns: np.ndarray | None = None, local: bool = False) -> Search:
+            return Search(grouped_, checker, self._rng, q0, goal, self.narrow_after, self.narrowing, self._ranges(grouped_),
+                          initial, self.options.connect, turns, self.shortcuts, local)
+
+        runs = [GoalRun(q1, grouped, new_search(grouped, q1, self._initial), release, float(layout.distance(q0, q1)))
                 for q1 in fits[: self.options.max_goals]]
         runs[0].turn_end = GOAL_TURN
         poster = SolutionPoster(self, si, pdef, t0, grouped.to_path, self._notify, checker.passed)
@@ -378,11 +384,10 @@ class DimensionRRT(PythonPlanner):
             if run.release is not None and search.valid and search.samples - run.improved_at >= run.release:
                 # converged on the prescribed rows: from this path on, every DOF in one group, around one waypoint
                 # (``improved_at`` shifted so that ``stall`` counts on across the release)
-                run.grouped, run.done, run.release = run.grouped.released(), run.samples, None
+                released = run.grouped.released()
+                run.restart(released, new_search(released, run.goal, search.W, local=True))
+                run.release = None
                 run.improved_at -= search.samples
-                run.search = Search(run.grouped, checker, self._rng, q0, run.goal, self.narrow_after, self.narrowing,
-                                    self._ranges(run.grouped), search.W, self.options.connect, shortcuts=self.shortcuts,
-                                    local=True)
                 if stats["released_at"] is None:
                     stats["released_at"] = drawn
                 log.info("DimensionRRT: prescribed rows released after %d samples", drawn)
@@ -396,10 +401,8 @@ class DimensionRRT(PythonPlanner):
                     and (search.samples >= _REFINE_AFTER or search.unfitted is not None)):
                 # no path yet, or a connect path with more turns than steps: twice the steps, the
                 # trees start again (that path is fitted to the new steps first)
-                run.grouped = run.grouped.refined(q0, run.goal)
-                run.done = run.samples
-                run.search = Search(run.grouped, checker, self._rng, q0, run.goal, self.narrow_after, self.narrowing,
-                                    self._ranges(run.grouped), None, self.options.connect, search.unfitted, self.shortcuts)
+                refined = run.grouped.refined(q0, run.goal)
+                run.restart(refined, new_search(refined, run.goal, None, search.unfitted))
                 run.best = run.search.cost if run.search.valid else math.inf
                 if run.best < poster.found_cost:
                     poster.offer(run.search.W, run.best, time.perf_counter())

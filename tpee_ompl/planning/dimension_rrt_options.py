@@ -18,9 +18,11 @@ __all__ = ["RELEASE_AFTER", "DimensionRRTOptions", "resolve_options", "shortcuts
 RELEASE_AFTER = 100
 """A ``release_after`` that pays (the library pipeline's default; chosen on 36 held-out queries, ``docs/dimension_rrt.md``)."""
 
+
 @dataclass(frozen=True)
 class DimensionRRTOptions:
-    """Settings of :class:`DimensionRRT`, checked once here.
+    """Settings of :class:`~tpee_ompl.planning.dimension_rrt.DimensionRRT`, checked once here (the sections
+    named below are those of that module's docstring).
 
     Attributes
     ----------
@@ -43,10 +45,11 @@ class DimensionRRTOptions:
     batch : bool
         Use the checker's batched ``are_valid`` when it has one (default True).
     stall_samples : int, optional
-        Stop after this many samples in a row without a shorter valid path (None: as the paper, never).
+        Stop after this many samples in a row without a shorter valid path (None: as the paper, never);
+        with several goal states, per goal state (see "Goal regions").
     max_h : int, optional
-        Largest number of fake-time steps the feasibility phase may raise ``h`` to (None, the
-        default: ``h`` stays fixed, as in the paper).  See "Raising h" in the module docstring.
+        Largest number of fake-time steps the feasibility phase may raise ``h`` to, at least ``h`` (None,
+        the default: ``h`` stays fixed, as in the paper).  See "Raising h".
     connect : bool
         Without prescribed groups, look for the first path with RRTConnect's two trees and fit it to
         the ``h`` steps (default True); False: the layered trees.  See "Feasibility phase".

@@ -51,8 +51,9 @@ class GoalRun:
 
     ``done`` counts the samples of this goal's earlier searches (before ``h`` was raised or the rows were
     released); ``improved_at`` is the search's sample count at its last shorter path (``stall_samples`` and
-    ``release_after`` count from there); ``best`` is its shortest path so far; ``bound`` is the start-goal
-    distance, which no path to this goal beats."""
+    ``release_after`` count from there); ``best`` is the length of its shortest path so far; ``bound`` is
+    the start-goal distance, which no path to this goal beats; ``turn_end`` is the sample count at which
+    its turn ends; ``stopped``: converged (``stall_samples``) or beaten (``bound``), it gets no more turns."""
 
     goal: np.ndarray
     grouped: GroupedSpace
@@ -72,18 +73,23 @@ class GoalRun:
     def __post_init__(self) -> None:
         self.best = self.search.cost if self.search.valid else np.inf
 
+    def restart(self, grouped: GroupedSpace, search: Search) -> None:
+        """Go on with a new search (``h`` raised, or the rows released); its samples count on from the last's."""
+        self.done = self.samples
+        self.grouped, self.search = grouped, search
+
 
 def goal_states(planner: PythonPlanner, ptc: ob.PlannerTerminationCondition, max_goals: int,
                 read: Callable[[ob.State], np.ndarray]) -> list[np.ndarray] | ob.PlannerStatus:
     """The distinct goal states of ``planner``'s problem (as ``read`` gives their values) that a solve may
     plan to, or the status saying why there are none.
 
-    A ``GoalState``: its state (INVALID_GOAL when it is out of bounds or invalid).  ``GoalStates``: every
-    valid one (up to :data:`MAX_GOAL_STATES`; the caller keeps the ``max_goals`` nearest, so the choice
-    does not depend on OMPL's rotating sample position).  Any other ``GoalSampleableRegion``: up to
-    ``max_goals`` valid states drawn from it (with OMPL's random numbers, not the planner's seed; a
-    ``GoalLazySamples`` with none yet: the first waited for until ``ptc``); INVALID_GOAL when none is
-    found.  Another goal type: UNRECOGNIZED_GOAL_TYPE, with an error naming it."""
+    A ``GoalState``: its state (INVALID_GOAL when it is out of bounds or invalid).  ``GoalStates`` (and
+    its subclass ``GoalLazySamples``): every valid one it holds, up to :data:`MAX_GOAL_STATES` (the caller
+    keeps the ``max_goals`` nearest, so below that cap the choice does not depend on OMPL's rotating sample
+    position; a ``GoalLazySamples`` holding none yet: its first waited for until ``ptc``).  Any other
+    ``GoalSampleableRegion``: the first ``max_goals`` valid states drawn from it (with OMPL's random
+    numbers, not the planner's seed); INVALID_GOAL when none is found.  Another goal type: UNRECOGNIZED_GOAL_TYPE, with an error naming it."""
     goal = planner.getProblemDefinition().getGoal()
     if isinstance(goal, ob.GoalState):
         state = planner._goal_state()

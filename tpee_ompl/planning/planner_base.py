@@ -20,6 +20,11 @@ __all__ = ["PythonPlanner", "planner_status"]
 log = logging.getLogger(__name__)
 
 
+def problem_objective(pdef: ob.ProblemDefinition) -> ob.OptimizationObjective | None:
+    """The problem's optimization objective, or None when it has none (a plain ``og.SimpleSetup``)."""
+    return pdef.getOptimizationObjective() if pdef.hasOptimizationObjective() else None
+
+
 def planner_status(code: Any) -> ob.PlannerStatus:
     """An ``ob.PlannerStatus`` object (OMPL needs the object, not the enum value)."""
     return ob.PlannerStatus(code)

@@ -12,6 +12,7 @@ from ompl import base as ob
 from ompl import geometric as og
 
 from .paths import path_passes_motion_checks
+from .planner_base import problem_objective
 
 __all__ = ["SolutionPoster"]
 
@@ -34,7 +35,7 @@ class SolutionPoster:
                  notify: Callable[[og.PathGeometric, float], None], passed: set[bytes] | None = None) -> None:
         self.planner, self.si, self.pdef, self.t0 = planner, si, pdef, t0
         self.to_path, self.notify = to_path, notify
-        self.opt = pdef.getOptimizationObjective() if pdef.hasOptimizationObjective() else None
+        self.opt = problem_objective(pdef)
         self._own_cost = self.opt is not None and not isinstance(self.opt, ob.PathLengthOptimizationObjective)
         """The objective is not path length: whether a path satisfies it is asked with its own cost of the path."""
         if self._own_cost:
