@@ -214,3 +214,30 @@ def test_a_setup_without_an_objective_is_planned_with_path_length(robot, library
     stats = planner.last_run_stats()
     assert ss.getSolutionPath().length() == pytest.approx(stats["best_cost"])
     assert path_passes_motion_checks(si, ss.getSolutionPath())
+
+
+def test_another_objective_is_asked_with_its_own_cost_and_the_costs_stay_lengths(robot, library):
+    class Costly(ob.OptimizationObjective):  # a motion costs 100 x its length
+        def __init__(self, si: ob.SpaceInformation) -> None:
+            super().__init__(si)
+            self._si = si
+
+        def stateCost(self, s: ob.State) -> ob.Cost:
+            return ob.Cost(0.0)
+
+        def motionCost(self, a: ob.State, b: ob.State) -> ob.Cost:
+            return ob.Cost(100.0 * self._si.distance(a, b))
+
+    start, goal = _query(robot, 1, 2, 4)  # a query whose direct motion collides: refinement has work to do
+    ss = make_simple_setup(robot, start, goal)
+    opt = Costly(ss.getSpaceInformation())
+    opt.setCostThreshold(ob.Cost(50.0))  # every path's length is below 50, no path's cost is
+    ss.setOptimizationObjective(opt)
+    planner = LibraryDimensionRRT(ss.getSpaceInformation(), library, max_samples=100, seed=0)
+    ss.setPlanner(planner)
+    assert ss.solve(30.0) == ob.PlannerStatus.EXACT_SOLUTION
+    stats = planner.last_run_stats()
+    assert stats["samples"] == 100  # never satisfied: refined to the cap, not stopped at the library path
+    assert stats["library_outcome"] in ("dmp", "repaired"), stats["library_outcome"]
+    assert all(c < 50.0 for _, c, _ in stats["progress"])  # the library path's cost too is a length
+    assert ss.getSolutionPath().length() == pytest.approx(stats["best_cost"])
