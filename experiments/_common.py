@@ -5,6 +5,10 @@ from __future__ import annotations
 from ompl import base as ob
 from ompl import geometric as og
 
+from tpee_ompl import PathLibrary, WearerArm
+from tpee_ompl.bench.campaign import query_rows, stratified_subset
+from tpee_ompl.resources import default_library_path
+
 
 def length_after(ss: og.SimpleSetup, planner: ob.Planner, seconds: float) -> float:
     """The length of ``planner``'s exact path after ``ss.solve(seconds)`` from a cleared setup (NaN if none)."""
@@ -12,3 +16,12 @@ def length_after(ss: og.SimpleSetup, planner: ob.Planner, seconds: float) -> flo
     ss.setPlanner(planner)
     ss.solve(seconds)
     return ss.getSolutionPath().length() if ss.haveExactSolutionPath() else float("nan")
+
+
+def wearer_library_queries(queries: str, max_queries: int) -> tuple[WearerArm, PathLibrary, list[dict]]:
+    """The wearer, its default path library and the stratified ``max_queries`` of a query set (name or JSON file)."""
+    robot = WearerArm()
+    library = PathLibrary.load(default_library_path(), robot)
+    _, rows = query_rows(queries, robot)
+    return robot, library, stratified_subset(rows, max_queries)
+

@@ -22,15 +22,14 @@ import time
 
 import numpy as np
 import pinocchio as pin
+from _common import wearer_library_queries
 from ompl import util as ou
 
-from tpee_ompl import PathLibrary, WearerArm, make_simple_setup
-from tpee_ompl.bench.campaign import query_rows, stratified_subset
+from tpee_ompl import make_simple_setup
 from tpee_ompl.library.planner import LibraryDimensionRRT
 from tpee_ompl.model import robot_checker
 from tpee_ompl.planning import dimension_search
 from tpee_ompl.planning.paths import path_to_array
-from tpee_ompl.resources import default_library_path
 
 _COUNTS = {"rule": 0, "accepted": 0, "sweeps": 0, "pin_calls": 0, "pin_time": 0.0}
 
@@ -74,10 +73,7 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--budget", type=float, default=0.1, help="time per run, s")
     args = ap.parse_args(argv)
     ou.setLogLevel(ou.LOG_NONE)
-    robot = WearerArm()
-    lib = PathLibrary.load(default_library_path(), robot)
-    _, rows = query_rows(args.queries, robot)
-    rows = stratified_subset(rows, args.max_queries)
+    robot, lib, rows = wearer_library_queries(args.queries, args.max_queries)
     _instrument()
     print("query  length   samples  to the rule  accepted  sweeps  bends/interior  Pinocchio / rest (ms)")
     totals = {"samples": 0, "rule": 0, "accepted": 0, "sweeps": 0, "pin": 0.0, "rest": 0.0}

@@ -15,12 +15,11 @@ from __future__ import annotations
 import argparse
 
 import numpy as np
+from _common import wearer_library_queries
 from ompl import util as ou
 
-from tpee_ompl import PathLibrary, WearerArm, make_simple_setup
-from tpee_ompl.bench.campaign import query_rows, stratified_subset
+from tpee_ompl import make_simple_setup
 from tpee_ompl.library.planner import LibraryDimensionRRT
-from tpee_ompl.resources import default_library_path
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -30,10 +29,7 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--budgets", type=float, nargs="+", default=[0.1, 1.0, 10.0])
     args = ap.parse_args(argv)
     ou.setLogLevel(ou.LOG_NONE)
-    robot = WearerArm()
-    lib = PathLibrary.load(default_library_path(), robot)
-    _, rows = query_rows(args.queries, robot)
-    rows = stratified_subset(rows, args.max_queries)
+    robot, lib, rows = wearer_library_queries(args.queries, args.max_queries)
     cost = {b: [] for b in args.budgets}
     samples = {b: [] for b in args.budgets}
     for k, q in enumerate(rows):

@@ -45,3 +45,19 @@ def free_so2_space(n: int = 2) -> ob.SpaceInformation:
     si.setStateValidityChecker(lambda s: True)
     si.setup()
     return si
+
+
+class LengthTimes100(ob.OptimizationObjective):
+    """An objective other than path length: a motion costs 100 x its length (a direct ``OptimizationObjective``
+    subclass, so OMPL calls its Python ``motionCost``; a ``StateCostIntegralObjective`` subclass's is not called)."""
+
+    def __init__(self, si: ob.SpaceInformation) -> None:
+        super().__init__(si)
+        self._si = si
+
+    def stateCost(self, s: ob.State) -> ob.Cost:
+        return ob.Cost(0.0)
+
+    def motionCost(self, a: ob.State, b: ob.State) -> ob.Cost:
+        return ob.Cost(100.0 * self._si.distance(a, b))
+

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from helpers.library_standins import sampler
+from helpers.planning_spaces import LengthTimes100
 from ompl import base as ob
 from ompl import geometric as og
 
@@ -217,20 +218,9 @@ def test_a_setup_without_an_objective_is_planned_with_path_length(robot, library
 
 
 def test_another_objective_is_asked_with_its_own_cost_and_the_costs_stay_lengths(robot, library):
-    class Costly(ob.OptimizationObjective):  # a motion costs 100 x its length
-        def __init__(self, si: ob.SpaceInformation) -> None:
-            super().__init__(si)
-            self._si = si
-
-        def stateCost(self, s: ob.State) -> ob.Cost:
-            return ob.Cost(0.0)
-
-        def motionCost(self, a: ob.State, b: ob.State) -> ob.Cost:
-            return ob.Cost(100.0 * self._si.distance(a, b))
-
     start, goal = _query(robot, 1, 2, 4)  # a query whose direct motion collides: refinement has work to do
     ss = make_simple_setup(robot, start, goal)
-    opt = Costly(ss.getSpaceInformation())
+    opt = LengthTimes100(ss.getSpaceInformation())  # a motion costs 100 x its length
     opt.setCostThreshold(ob.Cost(50.0))  # every path's length is below 50, no path's cost is
     ss.setOptimizationObjective(opt)
     planner = LibraryDimensionRRT(ss.getSpaceInformation(), library, max_samples=100, seed=0)

@@ -11,6 +11,7 @@ from ompl import base as ob
 from ompl import geometric as og
 
 from tests.helpers.planning_arms import planar_arm_setup
+from tests.helpers.planning_spaces import LengthTimes100
 from tpee_ompl.examples.planar_arm import make_planar_arm_setup
 from tpee_ompl.planning.dimension_rrt import DimensionRRT
 from tpee_ompl.planning.paths import path_passes_motion_checks, set_state
@@ -60,26 +61,11 @@ def test_finite_cost_threshold_stops_once_satisfied() -> None:
     assert stats["best_cost"] <= threshold and stats["samples"] < CAP
 
 
-class _Costly(ob.OptimizationObjective):
-    """A motion costs 100 per unit of length: the objective's cost of a path is 100 times its length
-    (a direct ``OptimizationObjective`` subclass: OMPL calls its Python ``motionCost``)."""
-
-    def __init__(self, si: ob.SpaceInformation) -> None:
-        super().__init__(si)
-        self._si = si
-
-    def stateCost(self, s: ob.State) -> ob.Cost:
-        return ob.Cost(0.0)
-
-    def motionCost(self, a: ob.State, b: ob.State) -> ob.Cost:
-        return ob.Cost(100.0 * self._si.distance(a, b))
-
-
 def test_another_objectives_threshold_is_asked_with_its_own_cost(caplog: pytest.LogCaptureFixture) -> None:
     ss = make_planar_arm_setup()
     first = _run(ss, seed=5, max_samples=400)[0].last_run_stats()["progress"]
     length = next(c for _, c, _ in first if math.isfinite(c))
-    opt = _Costly(ss.getSpaceInformation())
+    opt = LengthTimes100(ss.getSpaceInformation())
     opt.setCostThreshold(ob.Cost(2.0 * length))  # any path's length is below it; no path's cost (100 x length) is
     ss.setOptimizationObjective(opt)
     with caplog.at_level(logging.WARNING):
