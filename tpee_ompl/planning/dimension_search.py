@@ -365,11 +365,11 @@ class Search:
         tried = -1
         joined: set[int] = set()  # holding: the trees c joined already
         if len(both):
-            A = base[ts_a[both] - 1].copy()
-            B = base[ts_a[both] + 1].copy()
-            A[:, d] = tree.fwd.values[fi[both]]
-            B[:, d] = tree.bwd.values[bi[both]]
-            k = int(both[np.argmin(self.dist(A, C[both]) + self.dist(C[both], B))])
+            k = int(both[0])  # the step with the shortest motions
+            if len(both) > 1:
+                A, B = base[ts_a[both] - 1].copy(), base[ts_a[both] + 1].copy()
+                A[:, d], B[:, d] = tree.fwd.values[fi[both]], tree.bwd.values[bi[both]]
+                k = int(both[np.argmin(self.dist(A, C[both]) + self.dist(C[both], B))])
             tried, t = k, ts[k]
             W, owners = tree.path(t, c, int(fi[k]), int(bi[k]))
             bad = self._check_segments(W)

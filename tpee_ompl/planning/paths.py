@@ -222,14 +222,13 @@ def motion_interior_states(
     Neither end is included (unlike :func:`motion_states`).  Not validated: it runs in planners' inner
     loops.
     """
-    d = np.sqrt(((B - A) ** 2).sum(-1)) if lengths is None else lengths
-    nd = np.maximum(1, np.ceil(d / step)).astype(int)
-    cnt = (nd - 1) // stride
-    total = int(cnt.sum())
-    idx = np.repeat(np.arange(len(A)), cnt)
-    j = (np.arange(total) - np.repeat(np.cumsum(cnt) - cnt, cnt) + 1) * stride
-    frac = j / nd[idx]
-    return A[idx] + frac[:, None] * (B[idx] - A[idx]), idx, j
+    D = B - A
+    d = np.sqrt((D * D).sum(-1)) if lengths is None else lengths
+    nd = np.maximum(1, np.ceil(d / step)).astype(int).tolist()
+    js = [np.arange(stride, n, stride) for n in nd]  # a few motions per call: one small arange each
+    idx = np.repeat(np.arange(len(A)), [len(x) for x in js])
+    j = np.concatenate(js) if js else np.zeros(0, dtype=int)
+    return A[idx] + (j / np.array(nd)[idx])[:, None] * D[idx], idx, j
 
 
 def polyline_motion_states(path: np.ndarray, step: float) -> np.ndarray:
