@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import time
+
 from ompl import base as ob
 from ompl import geometric as og
 
@@ -16,6 +18,19 @@ def length_after(ss: og.SimpleSetup, planner: ob.Planner, seconds: float) -> flo
     ss.setPlanner(planner)
     ss.solve(seconds)
     return ss.getSolutionPath().length() if ss.haveExactSolutionPath() else float("nan")
+
+
+def first_path_time(ss: og.SimpleSetup, planner: ob.Planner, limit: float) -> float | None:
+    """Seconds ``ss.solve`` takes ``planner`` (from a cleared setup) to its first exact path, stopped by
+    ``exactSolnPlannerTerminationCondition`` or after ``limit`` s; None when it found none."""
+    ss.clear()
+    ss.setPlanner(planner)
+    ptc = ob.plannerOrTerminationCondition(ob.exactSolnPlannerTerminationCondition(ss.getProblemDefinition()),
+                                           ob.timedPlannerTerminationCondition(limit))
+    t = time.perf_counter()
+    ss.solve(ptc)
+    dt = time.perf_counter() - t
+    return dt if ss.haveExactSolutionPath() else None
 
 
 def wearer_library_queries(queries: str, max_queries: int) -> tuple[WearerArm, PathLibrary, list[dict]]:

@@ -26,6 +26,7 @@ import statistics
 import time
 
 import numpy as np
+from _common import first_path_time
 from ompl import base as ob
 from ompl import geometric as og
 from ompl import util as ou
@@ -52,17 +53,6 @@ def get_argument_parser() -> argparse.ArgumentParser:
     p.add_argument("--split", action="store_true",
                    help="time the collision calls (pinocchio.computeCollisions*) apart from the rest of each run")
     return p
-
-
-def _first(ss: og.SimpleSetup, planner: ob.Planner, limit: float) -> float | None:
-    ss.clear()
-    ss.setPlanner(planner)
-    ptc = ob.plannerOrTerminationCondition(ob.exactSolnPlannerTerminationCondition(ss.getProblemDefinition()),
-                                           ob.timedPlannerTerminationCondition(limit))
-    t = time.perf_counter()
-    ss.solve(ptc)
-    dt = time.perf_counter() - t
-    return dt if ss.haveExactSolutionPath() else None
 
 
 def _p95(v: list[float]) -> float:
@@ -107,7 +97,7 @@ def home(args: argparse.Namespace) -> None:
                     planner = (og.RRTConnect(si) if who == "R"
                                else tpee_dimension_rrt(si, q.from_sector, q.to_sector, seed=k))
                     c0, n0 = robot.collision_checks, timer.spent if timer else 0.0
-                    times.append(_first(ss, planner, args.limit))
+                    times.append(first_path_time(ss, planner, args.limit))
                     checks.append(robot.collision_checks - c0)
                     if timer and times[-1] is not None:
                         native[who].append(timer.spent - n0)

@@ -25,6 +25,7 @@ import statistics
 import time
 
 import numpy as np
+from _common import first_path_time
 from ompl import base as ob
 from ompl import geometric as og
 from ompl import util as ou
@@ -142,17 +143,6 @@ def problems():
 
 
 # ----------------------------------------------------------------- runs
-def _first_path(ss, planner, limit):
-    ss.clear()
-    ss.setPlanner(planner)
-    ptc = ob.plannerOrTerminationCondition(ob.exactSolnPlannerTerminationCondition(ss.getProblemDefinition()),
-                                           ob.timedPlannerTerminationCondition(limit))
-    t = time.perf_counter()
-    ss.solve(ptc)
-    el = time.perf_counter() - t
-    return el if ss.haveExactSolutionPath() else None
-
-
 def _length_at(ss, planner, seconds, simplify=False):
     ss.clear()
     ss.setPlanner(planner)
@@ -194,18 +184,18 @@ def main() -> None:
         si = ss.getSpaceInformation()
         rc_first, rc_len, rcs_len = [], [], []
         for seed in range(args.seeds):
-            rc_first.append(_first_path(ss, og.RRTConnect(si), 1.0))
+            rc_first.append(first_path_time(ss, og.RRTConnect(si), 1.0))
             rc_len.append(_length_at(ss, og.RRTConnect(si), args.time))
             rcs_len.append(_length_at(ss, og.RRTConnect(si), args.time, simplify=True))
         for groups in groupings:
             d_first, d_len, l_first, l_len, d_samples = [], [], [], [], []
             for seed in range(args.seeds):
                 planner = DimensionRRT(si, groups=groups, seed=seed)
-                d_first.append(_first_path(ss, planner, args.limit))
+                d_first.append(first_path_time(ss, planner, args.limit))
                 d_samples.append(planner.last_run_stats()["samples"])
                 d_len.append(_length_at(ss, DimensionRRT(si, groups=groups, seed=seed), args.time))
                 if args.layered:
-                    l_first.append(_first_path(ss, DimensionRRT(si, groups=groups, seed=seed, connect=False), args.limit))
+                    l_first.append(first_path_time(ss, DimensionRRT(si, groups=groups, seed=seed, connect=False), args.limit))
                     l_len.append(_length_at(ss, DimensionRRT(si, groups=groups, seed=seed, connect=False), args.time))
             solved_d = sum(x is not None for x in d_first)
             solved_r = sum(x is not None for x in rc_first)
@@ -213,7 +203,7 @@ def main() -> None:
             extra = f"  {_med(l_first) / tr:6.2f} {_med(l_len):7.3f}" if args.layered else ""
             us = 1e6 * sum(x for x in d_first if x is not None) / max(1, sum(
                 n for x, n in zip(d_first, d_samples) if x is not None))
-            print(f"{name:12s} {str(groups):34s} {solved_d:>4d}/{solved_r:<4d}  {1e3 * td:8.1f} {1e3 * tr:8.1f}"
+            print(f"{name:12s} {groups!s:34s} {solved_d:>4d}/{solved_r:<4d}  {1e3 * td:8.1f} {1e3 * tr:8.1f}"
                   f" {td / tr:6.2f} {_med(d_samples):7.0f} {us:6.1f} {_med(d_len):7.3f} {_med(rc_len):7.3f}"
                   f" {_med(rcs_len):7.3f}{extra}", flush=True)
         del ss

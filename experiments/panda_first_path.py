@@ -16,10 +16,10 @@ from __future__ import annotations
 import argparse
 import statistics
 
+from _common import first_path_time
 from ompl import geometric as og
 from ompl import util as ou
 
-from experiments.first_path import _first  # one home for the first-path timing (run with PYTHONPATH=.)
 from tpee_ompl.bench.problems import get_problem
 from tpee_ompl.model.robots import PANDA_GROUPS
 from tpee_ompl.planning.dimension_rrt import DimensionRRT
@@ -43,9 +43,9 @@ def main(argv: list[str] | None = None) -> None:
         si = ss.getSpaceInformation()
         for seed in range(args.seeds):
             c0 = checker.collision_checks
-            rc = _first(ss, og.RRTConnect(si), args.limit)
+            rc = first_path_time(ss, og.RRTConnect(si), args.limit)
             c1 = checker.collision_checks
-            dr = _first(ss, DimensionRRT(si, groups=PANDA_GROUPS, seed=seed), args.limit)
+            dr = first_path_time(ss, DimensionRRT(si, groups=PANDA_GROUPS, seed=seed), args.limit)
             rows.append((rc, c1 - c0, dr, checker.collision_checks - c1))
     both = [r for r in rows if r[0] is not None and r[2] is not None]
     med = statistics.median
