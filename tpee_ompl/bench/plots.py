@@ -164,25 +164,19 @@ def _progress_within(db_path, runs: list[dict], planner: str, best: dict, within
         con.close()
     if not rows:
         return None, None
-    series = defaultdict(list)
-    for rid, t, c in rows:
-        if t is not None:
-            series[rid].append((float(t), math.inf if c is None else float(c)))
+    series = _series(rows)
     per_query = defaultdict(int)
     for r in mine.values():
         per_query[r["query_id"]] += 1
-    times = [t for pts in series.values() for t, c in pts if t > 0 and math.isfinite(c)]
-    t_end = max([bmax] + [t for pts in series.values() for t, _ in pts])  # runs overshoot their budget a little
+    times = [t for ts, cs in series.values() for t, c in zip(ts, cs) if t > 0 and math.isfinite(c)]
+    t_end = max([bmax] + [float(ts[-1]) for ts, _ in series.values()])  # runs overshoot their budget a little
     grid = np.geomspace(min(times, default=bmax / 100), t_end, 120)
     share = np.zeros_like(grid)
-    for rid, pts in series.items():
+    for rid, (ts, cs) in series.items():
         r = mine[rid]
         if not r["success"] or r["query_id"] not in best:
             continue
-        ts, cs = np.array([p[0] for p in pts]), np.array([p[1] for p in pts])
-        idx = np.searchsorted(ts, grid, side="right") - 1
-        cost = np.where(idx >= 0, cs[np.clip(idx, 0, None)], math.inf)
-        share += (cost <= within * best[r["query_id"]]) / per_query[r["query_id"]]
+        share += (_cost_at(ts, cs, grid) <= within * best[r["query_id"]]) / per_query[r["query_id"]]
     return grid, share / len({r["query_id"] for r in at})
 
 
@@ -205,19 +199,26 @@ def _progress_median(db_path, planner: str):
         con.close()
     if not rows:
         return None, None
-    series = defaultdict(list)
-    for rid, t, c in rows:
-        series[rid].append((t, math.inf if c is None else c))
     grid = np.linspace(0, float(bmax), 60)
-    vals = []
-    for pts in series.values():
-        ts = np.array([p[0] for p in pts])
-        cs = np.array([p[1] for p in pts])
-        idx = np.searchsorted(ts, grid, side="right") - 1
-        vals.append(np.where(idx >= 0, cs[np.clip(idx, 0, None)], math.inf))
-    med = np.median(np.array(vals), axis=0)
+    med = np.median(np.array([_cost_at(ts, cs, grid) for ts, cs in _series(rows).values()]), axis=0)
     med[~np.isfinite(med)] = np.nan
     return grid, med
+
+
+def _series(rows: list[tuple]) -> dict[int, tuple[np.ndarray, np.ndarray]]:
+    """Per run id, the times and best costs (inf before a first path) of its (runid, time, best_cost)
+    progress rows, in the rows' order (time order: the queries sort them)."""
+    series: dict[int, list[tuple[float, float]]] = defaultdict(list)
+    for rid, t, c in rows:
+        if t is not None:
+            series[rid].append((float(t), math.inf if c is None else float(c)))
+    return {rid: (np.array([t for t, _ in pts]), np.array([c for _, c in pts])) for rid, pts in series.items()}
+
+
+def _cost_at(ts: np.ndarray, cs: np.ndarray, grid: np.ndarray) -> np.ndarray:
+    """A run's best cost at each time of ``grid`` (its step function; inf before its first progress row)."""
+    idx = np.searchsorted(ts, grid, side="right") - 1
+    return np.where(idx >= 0, cs[np.clip(idx, 0, None)], math.inf)
 
 
 def _save(fig, path: Path) -> None:
