@@ -199,8 +199,11 @@ def _progress_median(db_path, planner: str):
         con.close()
     if not rows:
         return None, None
+    series = _series(rows)
+    if not series:
+        return None, None
     grid = np.linspace(0, float(bmax), 60)
-    med = np.median(np.array([_cost_at(ts, cs, grid) for ts, cs in _series(rows).values()]), axis=0)
+    med = np.median(np.array([_cost_at(ts, cs, grid) for ts, cs in series.values()]), axis=0)
     med[~np.isfinite(med)] = np.nan
     return grid, med
 
