@@ -88,6 +88,26 @@ def test_planners_that_know_their_budget_or_are_unverified_run_separately(name):
     assert ladder.names[w.getName()] == name
 
 
+def test_every_anytime_run_is_told_its_own_budget(tmp_path, robot, monkeypatch):
+    """The ladder's run its longest budget, a planner run separately at a shorter budget that budget (OMPL's
+    ``Benchmark`` alone would let each run on until its thread's next check, up to 0.1 s later)."""
+    told: list[tuple[str, float | None]] = []
+    init = RecordingPlanner.__init__
+
+    def recording_init(self, si, inner, *args, **kwargs):
+        init(self, si, inner, *args, **kwargs)
+        told.append((inner.getName(), self.deadline))
+
+    monkeypatch.setattr(RecordingPlanner, "__init__", recording_init)
+    cfg = CampaignConfig(name="deadlines", queries=str(write_query_file(tmp_path / "q.json", robot, n=1)),
+                         sample_caps=(), anytime_budgets=(0.02, 0.05), anytime_planners=("RRTConnect", "AORRTC"),
+                         workers=0, seed=3, out=str(tmp_path / "out"))
+    res = run_campaign(cfg, progress_bar=False, report=False)
+    assert res.database is not None and not res.failed_tasks
+    # RRTConnect runs separately at 0.02 s only when it was still running there (it usually stops sooner)
+    assert set(told) - {("RRTConnect", 0.02)} == {("AORRTC", 0.02), ("AORRTC", 0.05), ("RRTConnect", 0.05)}
+
+
 # --------------------------------------------------------------------------- RRT*: the path at a time checkpoint
 def _rrt_at_time(name: str, t: float) -> tuple[int, list]:
     """Fresh process: the planner's checkpoint at t s of a longer run (iterations, path)."""

@@ -11,6 +11,7 @@ from ompl import geometric as og
 
 from tests.helpers.planning_spaces import box_problem
 from tpee_ompl.bench.planners import RecordingPlanner
+from tpee_ompl.planning.dimension_rrt import DimensionRRT
 
 
 def _solve(planner_cls, seconds: float, cap: int | None = None) -> dict:
@@ -70,6 +71,39 @@ def test_a_runs_checks_are_counted_as_its_solve_returns_not_after_ompls_simplifi
     bench.benchmark(ot.Request(maxTime=1.0, maxMem=4096.0, runCount=1, displayProgress=False,
                                saveConsoleOutput=False, simplify=True))
     assert before[0] < w.last["checks_end"] < after[0]  # OMPL's simplification checks states after the run
+
+
+def _run_past_benchmarks_deadline(make_inner, deadline: float) -> tuple[RecordingPlanner, list[bool]]:
+    """Solve under a condition that stands for ``ot.Benchmark``'s thread (it looks at its deadline only every 0.1 s):
+    it never fires, but for a 60 s safety stop, which it records when reached."""
+    si, checker = box_problem()
+    pdef = ob.ProblemDefinition(si)
+    start, goal = si.allocState(), si.allocState()
+    start[0], start[1], goal[0], goal[1] = -0.9, 0.0, 0.9, 0.0
+    pdef.setStartAndGoalStates(start, goal, 1e-9)
+    pdef.setOptimizationObjective(ob.PathLengthOptimizationObjective(si))
+    w = RecordingPlanner(si, make_inner(si), deadline=deadline)
+    w.setProblemDefinition(pdef)
+    w.setup()
+    safety: list[bool] = []
+    t0 = time.perf_counter()
+
+    def benchmark_thread() -> bool:
+        if time.perf_counter() - t0 > 60.0:
+            safety.append(True)
+        return bool(safety)
+
+    w.solve(ob.PlannerTerminationCondition(benchmark_thread))
+    w.keep = (si, checker, pdef, start, goal)
+    return w, safety
+
+
+@pytest.mark.parametrize("make_inner", [og.RRTstar, og.AORRTC, lambda si: DimensionRRT(si, groups=[[0, 1]], seed=1)],
+                         ids=["RRTstar", "AORRTC", "DimensionRRT"])
+def test_the_run_deadline_stops_the_inner_planner_when_the_benchmarks_own_condition_does_not(make_inner):
+    w, safety = _run_past_benchmarks_deadline(make_inner, 0.05)
+    assert not safety and w.last["error"] is None  # stopped by the wrapper's own timed condition
+    assert w.last["best_cost"] is not None and math.isfinite(w.last["best_cost"])  # it ran: found a path first
 
 
 @pytest.mark.parametrize(("variant", "setting", "value", "default"), [

@@ -2,8 +2,9 @@
 
 OMPL's planners and dimension-RRT do not know their time budget: they evaluate the termination condition
 once per iteration and do the same work until it is true.  So the state of a run at the moment its clock
-passes b is the state a run with budget b has at its deadline (up to the termination-check granularity:
-``Benchmark`` checks its deadline in a thread every 0.1 s, so a separate run stops between b and b + 0.1 s).
+passes b is the state a run with budget b has at its deadline.  (``Benchmark`` checks its own deadline in a
+thread only every 0.1 s, so every run is also told its budget by its :class:`RecordingPlanner`: a separate
+run at b and the ladder's run at its longest budget stop at their budget, not up to 0.1 s later.)
 The anytime ladder (0.1, 0.5, 1, 2 s) of one query and validator is run once, at the longest budget, each
 planner inside :class:`TimeCheckpointPlanner`, which reads at each shorter budget b what the planner would
 return if stopped there (:data:`ANYTIME_READ`):
@@ -93,8 +94,8 @@ class TimeCheckpointPlanner(CheckpointPlanner):
     """
 
     def __init__(self, si, inner, checkpoints: list[float], context: tuple[str, PlannerContext], mode: str,
-                 checker=None, read=None, renew=None):
-        RecordingPlanner.__init__(self, si, inner, max_iterations=None, read=read, renew=renew)
+                 checker=None, read=None, renew=None, deadline: float | None = None):
+        RecordingPlanner.__init__(self, si, inner, max_iterations=None, read=read, renew=renew, deadline=deadline)
         self.checkpoints = sorted({float(c) for c in checkpoints})
         self.context = context
         self.mode = mode
@@ -158,11 +159,12 @@ class AnytimeLadder:
         if mode == "posted" and not hasattr(inner, "set_intermediate_solution_callback"):
             mode = None
         if mode is None:
-            w = RecordingPlanner(si, inner, max_iterations=None, read=read, checker=checker, renew=renew)
+            w = RecordingPlanner(si, inner, max_iterations=None, read=read, checker=checker, renew=renew,
+                                 deadline=self.budget)
             self.separate.add(w.getName())
         else:
             w = TimeCheckpointPlanner(si, inner, self.checkpoints, (pname, ctx), mode, checker=checker, read=read,
-                                      renew=renew)
+                                      renew=renew, deadline=self.budget)
         self.wrappers[w.getName()] = w
         self.names[w.getName()] = pname
         return w

@@ -259,8 +259,8 @@ def _run_experiment(cfg: dict, task: dict, spec: dict, ladder=None, only: list[s
         inner = factory(si, ctx)
         read = None if layout.is_plain else layout.read
         renew = functools.partial(factory, si, ctx) if pname in SINGLE_USE_PLANNERS else None
-        w = (RecordingPlanner(si, inner, max_iterations=cap, read=read, checker=checker, renew=renew) if ladder is None
-             else ladder.wrap(si, inner, cap, pname, ctx, checker=checker, read=read, renew=renew))
+        w = (RecordingPlanner(si, inner, max_iterations=cap, read=read, checker=checker, renew=renew, deadline=budget)
+             if ladder is None else ladder.wrap(si, inner, cap, pname, ctx, checker=checker, read=read, renew=renew))
         wrappers[w.getName()] = w
         bench.addPlanner(w)
 
