@@ -93,6 +93,31 @@ def test_smoke_campaign_fills_the_database(query_file, tmp_path):
     assert meta["seed"] == 3 and "ompl" in meta["versions"]
 
 
+def test_ompls_columns_the_wrapper_cannot_fill_say_what_the_run_did_or_null(query_file, tmp_path):
+    """``valid segment fraction``: the run's own share of valid motions (OMPL's counters read 0 under the
+    batched validator, a Python ``checkMotion``); graph sizes NULL for a planner without an OMPL graph;
+    ``best_cost`` NULL for a run without an exact path (not its approximate path's length)."""
+    cfg = CampaignConfig(name="columns", queries=str(query_file), sample_caps=(3, 400), anytime_budgets=(),
+                         iteration_planners=("DimensionRRT", "RRTstar"), checkers=("batched",), workers=0, seed=3,
+                         out=str(tmp_path))
+    res = run_campaign(cfg, progress_bar=False, report=False)
+    con = sqlite3.connect(res.database)
+    rows = con.execute(
+        "SELECT p.name, e.sample_cap, r.solved, r.valid_segment_fraction, r.graph_states, r.best_cost, r.raw_length "
+        "FROM runs r JOIN plannerConfigs p ON r.plannerid = p.id JOIN experiments e ON r.experimentid = e.id").fetchall()
+    con.close()
+    assert len(rows) == 2 * 2 * 2
+    for name, cap, solved, fraction, graph, best, raw in rows:
+        if cap == 400:  # both check motions through the validator, most of them valid
+            assert 0.0 < fraction <= 1.0, (name, fraction)
+        assert (graph is None) == (name == "geometric_DimensionRRT"), (name, graph)
+        if not solved:
+            assert best is None, (name, cap, raw)
+        else:
+            assert best == pytest.approx(raw, rel=1e-9) or best <= raw
+    assert any(not r[2] and r[6] is not None for r in rows)  # an approximate path was there, without a best cost
+
+
 @pytest.mark.slow
 def test_aorrtc_runs_again_in_one_experiment_with_a_fresh_planner_per_run(query_file, tmp_path):
     """ompl 2.0.1's AORRTC segfaults when solved again after ``clear()`` (``--runs 2``): each run after the

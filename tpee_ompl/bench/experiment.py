@@ -201,10 +201,10 @@ def _path_properties(si, rec: dict, start: np.ndarray, goal: np.ndarray, first: 
         return {}
     l4, l12, l34 = group_lengths(W, first, layout) if len(W) >= 2 else (0.0, 0.0, 0.0)
     ok = path_passes_motion_checks(si, W if layout.is_plain else layout.to_path(si, W))
-    best = rec["best_cost"]
-    if best is None or not math.isfinite(float(best)):
-        best = l4
     ends = bool(np.all(np.abs(layout.delta(W[0], start)) <= 1e-6) and np.all(np.abs(layout.delta(W[-1], goal)) <= 1e-6))
+    best = rec["best_cost"]
+    if best is None or not math.isfinite(float(best)):  # a planner without bestCost(): its path's length, when
+        best = l4 if ends else None  # it reaches the goal (an approximate path's length is no best cost)
     return {"reaches_goal INTEGER": int(ends), "best_cost REAL": best, "length_dof12 REAL": l12,
             "length_dof34 REAL": l34, "raw_length REAL": l4, "path_valid_dense INTEGER": int(ok)}
 
@@ -288,9 +288,11 @@ def _run_experiment(cfg: dict, task: dict, spec: dict, ladder=None, only: list[s
             "reaches_goal INTEGER": 0,
             "planner_error INTEGER": int(rec["error"] is not None),
         }
-        if rec.get("graph_states") is not None:  # OMPL's own columns, which it cannot fill through the wrapper
-            props["graph states INTEGER"] = rec["graph_states"]
-            props["graph motions INTEGER"] = rec["graph_motions"]
+        # OMPL's own columns, which it cannot fill through the wrapper: NULL where unknown (a Python planner's graph),
+        # and the valid share of the run's motions (OMPL's counters stay at 0 under a Python motion validator)
+        props["graph states INTEGER"] = rec.get("graph_states")
+        props["graph motions INTEGER"] = rec.get("graph_motions")
+        props["valid segment fraction REAL"] = rec.get("valid_fraction")
         props.update(_path_properties(si, rec, start, goal, problem.groups[0], layout))
         return {"props": props, "progress": rec["progress"]}
 

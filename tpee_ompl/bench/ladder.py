@@ -37,6 +37,7 @@ from ompl import geometric as og
 from ompl import tools as ot
 
 from ..planning.grouped_space import RealVectorLayout
+from ..planning.setup import motion_counts, valid_motion_fraction
 from .planners import PlannerContext, RecordingPlanner, planner_factory
 from .results import format_value
 
@@ -181,7 +182,7 @@ class CheckpointPlanner(RecordingPlanner):
         si = self.getSpaceInformation()
         dim = si.getStateDimension()
         snap = {"time": now, "iterations": n, "checks": self._checks(), "pending": False,
-                "valid_fraction": si.getMotionValidator().getValidMotionFraction()}
+                "valid_fraction": valid_motion_fraction(self._run["motions0"], motion_counts(si.getMotionValidator()))}
         if self.python:
             progress = self.inner.last_run_stats()["progress"]
             found = progress[-1][1] if progress else math.inf
@@ -202,7 +203,8 @@ class CheckpointPlanner(RecordingPlanner):
 
     def solve(self, ptc):  # noqa: D102 (OMPL override)
         self.start_checks.append(self._checks())
-        self._run = {"t0": time.perf_counter(), "calls": 0, "todo": set(self.checkpoints), "snaps": {}}
+        self._run = {"t0": time.perf_counter(), "calls": 0, "todo": set(self.checkpoints), "snaps": {},
+                     "motions0": motion_counts(self.getSpaceInformation().getMotionValidator())}
         if self.python:
             self.inner.set_intermediate_solution_callback(self._on_solution)
             if callable(getattr(self.inner, "set_sample_checkpoints", None)):
@@ -353,6 +355,7 @@ class Ladder:
         if snap.get("graph_states") is not None:
             out["graph states INTEGER"] = snap["graph_states"]
             out["graph motions INTEGER"] = snap["graph_motions"]
+        out["valid segment fraction REAL"] = snap["valid_fraction"]
         rec = {"waypoints": snap["waypoints"], "best_cost": snap["best_cost"]}
         out.update(path_properties(si, rec, start, goal))
         if snap["waypoints"] is None and math.isfinite(float(snap["best_cost"])):

@@ -29,6 +29,7 @@ from ompl import geometric as og
 from ompl import util as ou
 
 from ..planning.paths import path_to_array
+from ..planning.setup import motion_counts, valid_motion_fraction
 from .config import KNOWN_PLANNERS
 
 __all__ = [
@@ -206,7 +207,10 @@ class RecordingPlanner(ob.Planner):
     After each ``solve``, :attr:`last` holds the run's record: ``waypoints`` (raw path, (K, n), or
     None), ``iterations``, ``samples``, ``best_cost``, ``first_solution_time``, ``progress``
     (list of (time, best cost, iterations)), ``checks_end`` (the checker's counter as ``solve``
-    returned, or None) and ``error`` (None, or the exception's repr).  A native planner's
+    returned, or None), ``valid_fraction`` (the share of the motions checked during ``solve`` that were
+    valid, :func:`~tpee_ompl.planning.setup.motion_counts`: OMPL's own column reads 0 for a Python motion
+    validator), ``graph_states`` / ``graph_motions`` (None for a Python planner, which keeps no OMPL graph)
+    and ``error`` (None, or the exception's repr).  A native planner's
     ``first_solution_time`` is the first termination check that saw an exact solution (a finite
     ``bestCost()``, or one in the problem definition for planners without it, e.g. AORRTC), else the run's
     end when it returned one (RRTConnect stops at its first path).
@@ -284,6 +288,8 @@ class RecordingPlanner(ob.Planner):
 
         if self.deadline is not None:
             ptc = ob.plannerOrTerminationCondition(ptc, ob.timedPlannerTerminationCondition(self.deadline))
+        mv = self.getSpaceInformation().getMotionValidator()
+        motions0 = motion_counts(mv)
         error = self._setup_error
         self._ran = True
         try:
@@ -306,6 +312,7 @@ class RecordingPlanner(ob.Planner):
         if state["first"] is None and error is None and pdef.hasExactSolution():
             state["first"] = elapsed  # found as the planner returned (RRTConnect stops at its first path)
         self.last = {"waypoints": waypoints, "error": error, "checks_end": checks_end,
+                     "valid_fraction": valid_motion_fraction(motions0, motion_counts(mv)),
                      **self._run_stats(elapsed, progress, has_cost, state["first"]), **self._graph_size()}
         return status
 

@@ -38,6 +38,8 @@ __all__ = [
     "make_space",
     "make_simple_setup",
     "motion_check_step",
+    "motion_counts",
+    "valid_motion_fraction",
     "MOTION_VALIDATORS",
 ]
 
@@ -96,6 +98,9 @@ class BatchedMotionValidator(ob.MotionValidator):
         self._space = si.getStateSpace()
         self._n = robot.nq
         self.motions_checked = 0
+        self.motions_valid = 0
+        """Motions checked / found valid (OMPL's own counters stay at 0 under a Python ``checkMotion``:
+        :func:`motion_counts` reads these)."""
         self.screen_levels = tuple(check_number("screen_levels (motion-check steps)", h, low=0.5, high=1e3)
                                    for h in screen_levels)
         robot.ball_screen().prepare(h * self.step for h in self.screen_levels)  # not in the first plan's time
@@ -108,7 +113,9 @@ class BatchedMotionValidator(ob.MotionValidator):
         """True if every state along s1 -> s2 (excluding s1) is valid."""
         a, b = state_to_array(s1, self._n), state_to_array(s2, self._n)
         self.motions_checked += 1
-        return bool(self.all_valid([unchecked_motion_states(a, b, self.effective_step())])[0])
+        ok = bool(self.all_valid([unchecked_motion_states(a, b, self.effective_step())])[0])
+        self.motions_valid += ok
+        return ok
 
     def check_motions(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
         """Validity of many motions A[k] -> B[k] (each excluding its start), batched together."""
@@ -116,10 +123,13 @@ class BatchedMotionValidator(ob.MotionValidator):
         S, counts = batched_motion_states(A, B, self.effective_step())
         self.motions_checked += len(counts)
         if len(counts) < 2 or not self.screen_levels:
-            return self.all_valid(np.split(S, np.cumsum(counts)[:-1]) if len(counts) else [])
-        spacing = np.sqrt(((B - A) ** 2).sum(-1)) / counts  # the states are evenly spaced along each motion
-        return screened_lines_valid(self.robot, self.robot.ball_screen(), S, counts, spacing, self.step,
-                                    self.screen_levels)
+            ok = self.all_valid(np.split(S, np.cumsum(counts)[:-1]) if len(counts) else [])
+        else:
+            spacing = np.sqrt(((B - A) ** 2).sum(-1)) / counts  # the states are evenly spaced along each motion
+            ok = screened_lines_valid(self.robot, self.robot.ball_screen(), S, counts, spacing, self.step,
+                                      self.screen_levels)
+        self.motions_valid += int(np.count_nonzero(ok))
+        return ok
 
     def all_valid(self, chunks: list[np.ndarray]) -> np.ndarray:
         """Per chunk of evenly spaced states along a line (a motion's dense states), True iff all are valid."""
@@ -130,6 +140,22 @@ class BatchedMotionValidator(ob.MotionValidator):
         ok = self.robot.are_valid(np.concatenate(chunks))
         bounds = np.cumsum([0] + [len(c) for c in chunks])
         return np.array([ok[bounds[k] : bounds[k + 1]].all() for k in range(len(chunks))], dtype=bool)
+
+
+def motion_counts(mv: ob.MotionValidator) -> tuple[int, int]:
+    """(valid, checked) motions a validator has counted so far: the project's validators count their own
+    (a Python ``checkMotion`` leaves OMPL's counters at 0, so ``getValidMotionFraction()`` says 0), OMPL's
+    validators theirs."""
+    if isinstance(mv, BatchedMotionValidator):
+        return mv.motions_valid, mv.motions_checked
+    return int(mv.getValidMotionCount()), int(mv.getCheckedMotionCount())
+
+
+def valid_motion_fraction(before: tuple[int, int], after: tuple[int, int]) -> float:
+    """The share of valid motions among those checked between two :func:`motion_counts` (0 when none was
+    valid, as OMPL's ``getValidMotionFraction``)."""
+    valid, checked = after[0] - before[0], after[1] - before[1]
+    return valid / checked if valid else 0.0
 
 
 def make_space(robot: RobotChecker) -> ob.RealVectorStateSpace:
