@@ -81,6 +81,18 @@ def test_target_jumping_between_sectors_switches_to_each_posture(robot, planner)
     assert [posture_sector(t) for _, t, _ in stream] == switched_to
 
 
+def test_a_cross_sector_motion_arrives_aimed_at_its_target_in_the_new_sector(robot, planner):
+    tracker = Tracker(robot, planner, initial_sector=3)
+    target = sector_origin() + 6.0 * _direction(-60.0, -10.0)  # out of sector 3's reach: a posture change to 4
+    result = tracker.run([(0.0, sector_origin() + 6.0 * _direction(180.0, 0.0)), (1.0, target, True)])
+    _assert_safe_and_aimed(robot, result)
+    crossing = [e for e in result.events if e.kind == "cross-sector" and e.time == 1.0]
+    assert [e.sector for e in crossing] == [4]
+    # the motion's last row is the arrival: aimed at the target, in sector 4 (its other rows aim nowhere)
+    assert result.sectors[-1] == 4 and np.allclose(result.targets[-1], target)
+    assert aim_errors(robot, result.configurations[-1], target)[2] < 1e-6
+
+
 def test_bad_targets_give_events_and_the_arm_holds_still(robot, planner):
     tracker = Tracker(robot, planner, initial_sector=3)
     good = sector_origin() + 6.0 * _direction(45.0, 5.0)

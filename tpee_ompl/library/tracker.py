@@ -14,7 +14,6 @@ Output: a time-stamped joint trajectory plus events (aim, cross-sector, blind-ar
 
 from __future__ import annotations
 
-import itertools
 import logging
 import math
 import os
@@ -184,9 +183,10 @@ class Tracker:
             raise ValueError(f"planner path {self.sector}->{k} collides (checked every {self.options.check_step} rad)")
         self.events.append(TrackEvent(t, "cross-sector", k, f"{self.sector}->{k}: {why}, {len(waypoints)} waypoints"))
         clock = t
-        for a, b in itertools.pairwise(waypoints):
+        for i in range(1, len(waypoints)):
+            a, b = waypoints[i - 1], waypoints[i]
             clock += float(np.max(np.abs(b - a))) / self.options.joint_speed
-            last = b is waypoints[-1]
+            last = i == len(waypoints) - 1  # the arrival: aimed at the target, in sector k
             self._record(clock, b, target if last else None, k if last else 0)
         self.sector, self.q = k, goal.copy()
         return clock
