@@ -9,6 +9,7 @@ import pytest
 
 from tpee_ompl.cli._common import CliError
 from tpee_ompl.cli.library import DEFAULT_LIBRARY, build_parser
+from tpee_ompl.cli.main import main
 from tpee_ompl.library import PathLibrary
 
 
@@ -81,6 +82,17 @@ def test_every_subcommand_help_shows_an_example_and_the_default_file(sub: str, c
         build_parser().parse_args(["library", sub, "--help"])
     out = capsys.readouterr().out
     assert "example:" in out and f"tpee-ompl library {sub}" in out and str(DEFAULT_LIBRARY) in out
+
+
+def test_the_query_examples_of_the_help_run(capsys) -> None:
+    with pytest.raises(SystemExit):
+        build_parser().parse_args(["library", "query", "--help"])
+    examples = [line.split()[1:] for line in capsys.readouterr().out.splitlines()
+                if line.strip().startswith("tpee-ompl library query")]
+    assert len(examples) >= 2
+    for argv in examples:
+        assert main(argv) == 0, argv
+        capsys.readouterr()
 
 
 def test_build_never_replaces_a_library_without_force(robot, small_file: str, tmp_path) -> None:

@@ -23,6 +23,24 @@ def test_plan_with_rrtconnect_prints_a_valid_path_as_json(capsys):
     assert out["collision_checks"] > 0
 
 
+def test_a_path_printed_with_four_decimals_can_be_planned_again(capsys):
+    assert main(_args("--planner", "dimension-rrt", "--samples", "300")) == 0
+    rows = [line.split() for line in capsys.readouterr().out.splitlines() if line.startswith("  ")]
+    start, goal = rows[0], rows[-1]  # DOF1/DOF2 5e-5 rad off the postures: taken as them
+    assert main(["plan", "--from", "1", "--to", "4", "--start", *start, "--goal", *goal, "--planner", "dimension-rrt",
+                 "--samples", "300", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["exact"] and np.allclose(out["path"][0][:2], START[:2], atol=1e-6)
+
+
+def test_a_goal_off_its_sectors_posture_is_a_usage_error_naming_it(capsys):
+    # the goal of sector 4 given as sector 1's posture: before, a 2-waypoint motion labelled "1 -> 4"
+    argv = ["plan", "--from", "1", "--to", "4", "--start", *map(str, START), "--goal", *map(str, START)]
+    assert main(argv + ["--planner", "rrtconnect"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "--goal" in err and "sector 4's posture" in err
+
+
 def test_plan_prints_validity_and_length_in_text(capsys):
     assert main(_args("--planner", "rrtconnect", "--time", "2")) == 0
     out = capsys.readouterr().out

@@ -41,12 +41,17 @@ __all__ = [
     "index",
     "load_robot",
     "numpy_seed",
+    "on_postures",
     "positive_float",
     "positive_int",
     "seed",
     "seconds",
     "sector",
 ]
+
+POSTURE_SNAP = 1e-3
+"""Radians. A ``--start``/``--goal`` whose DOF1/DOF2 lie this close to its sector's Table 1 posture is taken as at
+it (the values ``plan`` prints, 4 decimals, are 5e-5 rad off; the planners want the posture to 1e-6)."""
 
 MAX_COUNT = 10**7
 """Largest count an argument may ask for (samples, frames, steps): more is refused as a usage error,
@@ -214,6 +219,26 @@ def check_output(path: str | Path, option: str, force: bool, suffixes: tuple[str
 
 
 # ---------------------------------------------------------------------------------------- the model
+def on_postures(start: Any, goal: Any, from_sector: int, to_sector: int) -> tuple[Any, Any, str | None]:
+    """``start`` and ``goal`` (arrays of DOF1..DOF4) with DOF1/DOF2 set to their sectors' Table 1 postures when
+    within :data:`POSTURE_SNAP` of them, and the usage error to raise once the other checks of ``--start``/``--goal``
+    passed (None when both are at their postures): a cross-sector motion starts and ends at the postures."""
+    import numpy as np
+
+    from ..model.sectors import posture_preset
+
+    out, error = [], None
+    for name, q, k in (("--start", start, from_sector), ("--goal", goal, to_sector)):
+        q, preset = np.array(q, dtype=float), posture_preset(k)
+        if np.max(np.abs(q[:2] - preset)) <= POSTURE_SNAP:
+            q[:2] = preset
+        elif error is None:
+            error = (f"{name}: DOF1/DOF2 ({q[0]:.4f}, {q[1]:.4f}) are not sector {k}'s posture ({preset[0]:.6f}, "
+                     f"{preset[1]:.6f}): a cross-sector motion starts and ends at the sectors' Table 1 postures")
+        out.append(q)
+    return out[0], out[1], error
+
+
 def add_model_args(p: argparse.ArgumentParser) -> None:
     """``--urdf`` / ``--srdf``: another wearer + arm model than the packaged one."""
     p.add_argument("--urdf", default=None, help="URDF file (default: the packaged wearer + arm)")

@@ -32,6 +32,7 @@ from ._common import (
     finite,
     index,
     numpy_seed,
+    on_postures,
     sector,
 )
 
@@ -50,7 +51,7 @@ _BUILD_EXAMPLE = """example:
 """
 _QUERY_EXAMPLE = """example:
   tpee-ompl library query --query-set planning_necessary --index 0
-  tpee-ompl library query --from 1 --to 3 --start -2.2 1.1 0.3 0.2 --goal 0.4 1.3 -0.5 0.1 --json
+  tpee-ompl library query --from 1 --to 3 --start -0.8727 2.7925 3.0947 -0.2065 --goal -0.8727 0.3491 0.4239 -0.6484 --json
 """
 _STATS_EXAMPLE = """example:
   tpee-ompl library stats                       # the packaged default library
@@ -143,9 +144,12 @@ def run_query(args: argparse.Namespace) -> int:
             raise CliError(f"give --query-set NAME --index K, or all of --from --to --start --goal (missing {' '.join(missing)})")
         if args.from_sector == args.to_sector:
             raise CliError(f"--from and --to are both sector {args.from_sector}: a query joins two sectors")
-        start, goal, i, j = np.array(args.start), np.array(args.goal), args.from_sector, args.to_sector
+        i, j = args.from_sector, args.to_sector
+        start, goal, off_posture = on_postures(args.start, args.goal, i, j)
         with argument("--start/--goal"):
             _check_endpoints(default_robot(), start, goal)
+        if off_posture:
+            raise CliError(off_posture)
     lib = _load(Path(args.library), fallback=not args.no_fallback)
     res = lib.query(start, goal, i, j)
     if args.json:

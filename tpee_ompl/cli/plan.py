@@ -26,6 +26,7 @@ from ._common import (
     finite,
     index,
     load_robot,
+    on_postures,
     positive_float,
     positive_int,
     seconds,
@@ -116,8 +117,11 @@ def plan_motion(args: argparse.Namespace) -> tuple[dict, WearerArm]:
     robot = load_robot(args)
     start, goal, qid = _start_and_goal(args, robot)
     if qid is None:
+        start, goal, off_posture = on_postures(start, goal, args.from_sector, args.to_sector)
         with argument("--start/--goal"):
             ss = make_simple_setup(robot, start, goal)
+        if off_posture:
+            raise CliError(off_posture)
     else:
         ss = make_simple_setup(robot, start, goal)
     si = ss.getSpaceInformation()
