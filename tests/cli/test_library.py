@@ -76,6 +76,13 @@ def test_bad_sector_pair_is_a_usage_error(capsys) -> None:
     assert "two different numbers" in capsys.readouterr().err
 
 
+def test_build_writes_nowhere_unless_told_where(capsys) -> None:
+    """No default file: the packaged library lives inside the installed package."""
+    with pytest.raises(SystemExit) as exc:
+        build_parser().parse_args(["library", "build", "--pairs", "1-2"])
+    assert exc.value.code == 2 and "--library" in capsys.readouterr().err
+
+
 @pytest.mark.parametrize("sub", ["build", "query", "stats"])
 def test_every_subcommand_help_shows_an_example_and_the_default_file(sub: str, capsys) -> None:
     with pytest.raises(SystemExit):

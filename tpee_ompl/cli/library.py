@@ -71,7 +71,7 @@ def _pair(text: str) -> tuple[int, int]:
 def _check_library_file(path: Path) -> Path:
     """``--library`` names an existing file (a usage error otherwise, with the fix)."""
     return check_input_file(path, "--library", "path library",
-                            hint=": build it with 'make library' or 'tpee-ompl library build'")
+                            hint=": build one with 'tpee-ompl library build --library FILE' ('make library' in a source checkout)")
 
 
 def _load(path: Path, fallback: bool = True, max_samples: int = _BUILD_DEFAULTS.max_samples) -> PathLibrary:
@@ -198,7 +198,10 @@ def register(subparsers: argparse._SubParsersAction, formatter_class: type = arg
 
     b = sub.add_parser("build", help="build a library (dimension-RRT demonstrations)", epilog=_BUILD_EXAMPLE,
                        formatter_class=formatter_class)
-    common(b)
+    # no default: the packaged library lives inside the installed package, which a build must not write into
+    # unasked (``make library`` names it on purpose); queries and stats read it by default
+    b.add_argument("--library", type=Path, required=True, metavar="FILE",
+                   help=f"the library file (.npz) to write (the packaged one, read by default elsewhere: {DEFAULT_LIBRARY})")
     d = _BUILD_DEFAULTS
     b.add_argument("--per-pair", type=int, default=d.per_pair,
                    help=f"demonstrations per ordered sector pair (default {d.per_pair})")
