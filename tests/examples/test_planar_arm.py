@@ -51,3 +51,13 @@ def test_second_solve_without_clear_still_finds_the_start() -> None:
     ss.setPlanner(planner)
     assert ss.solve(10.0) == ob.PlannerStatus.EXACT_SOLUTION
     assert ob.Planner.solve(planner, 10.0) == ob.PlannerStatus.EXACT_SOLUTION
+
+
+def test_the_example_runs_as_a_module_and_reports_both_planners() -> None:
+    import subprocess
+    import sys
+
+    out = subprocess.run([sys.executable, "-m", "tpee_ompl.examples.planar_arm"], capture_output=True, text=True,
+                         timeout=120, check=True).stdout.splitlines()
+    assert [line.split()[0] for line in out] == ["DimensionRRT", "RRTConnect"]
+    assert all("Exact solution" in line and "valid True" in line for line in out)

@@ -11,7 +11,7 @@ import numpy as np
 from ompl import base as ob
 from ompl import geometric as og
 
-__all__ = ["PlanarArm", "make_planar_arm_setup"]
+__all__ = ["PlanarArm", "main", "make_planar_arm_setup"]
 
 
 class PlanarArm(ob.StateValidityChecker):
@@ -84,3 +84,25 @@ def make_planar_arm_setup(
     ss._planar_arm = checker  # type: ignore[attr-defined]  # keep the Python checker alive
     si.setup()
     return ss
+
+
+def main() -> None:
+    """``python -m tpee_ompl.examples.planar_arm``: dimension-RRT (improving for 1 s) and RRTConnect (stopping at its
+    first path) on the default query, each in a fresh setup."""
+    from ompl import util as ou
+
+    from ..planning.dimension_rrt import DimensionRRT
+
+    ou.setLogLevel(ou.LOG_WARN)
+    for name, make in (("DimensionRRT [[0, 1], [2, 3]]", lambda si: DimensionRRT(si, groups=[[0, 1], [2, 3]], seed=1)),
+                       ("RRTConnect", og.RRTConnect)):
+        ss = make_planar_arm_setup()
+        ss.setPlanner(make(ss.getSpaceInformation()))
+        status = ss.solve(1.0)
+        path = ss.getSolutionPath()
+        print(f"{name:30s} {status}: length {path.length():.3f} rad, {path.getStateCount()} states, "
+              f"valid {path.check()}, {ss.getStateValidityChecker().collision_checks} configurations checked")
+
+
+if __name__ == "__main__":
+    main()
