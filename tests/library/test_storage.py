@@ -34,6 +34,14 @@ def test_truncated_library_file_is_refused(robot: WearerArm, library: PathLibrar
         PathLibrary.load(f, robot)
 
 
+def test_a_file_that_is_no_archive_is_refused_without_numpys_pickle_advice(robot: WearerArm, tmp_path) -> None:
+    f = tmp_path / "notes.npz"
+    f.write_text("not a library\n")
+    with pytest.raises(LibraryFileError, match="not an .npz archive") as exc:
+        PathLibrary.load(f, robot)
+    assert "pickle" not in str(exc.value)
+
+
 def test_library_from_another_model_or_version_is_refused(robot: WearerArm, library: PathLibrary, tmp_path, monkeypatch) -> None:
     import tpee_ompl.library.storage as storage
 

@@ -171,7 +171,9 @@ def read_library(path: str | Path, robot: WearerArm) -> tuple[dict[tuple[int, in
     except FileNotFoundError:
         raise
     except (zipfile.BadZipFile, EOFError, OSError, ValueError, KeyError) as exc:
-        raise LibraryFileError(f"path library {path} is unreadable (truncated or not a library file): {exc}") from exc
+        # numpy's message for a file that is no .npz at all advises loading it with pickle: not for a user to follow
+        why = "not an .npz archive" if "allow_pickle" in str(exc) else str(exc)
+        raise LibraryFileError(f"path library {path} is unreadable (truncated or not a library file): {why}") from exc
     try:
         meta = json.loads(str(arrays["meta"]))
     except (KeyError, json.JSONDecodeError, RecursionError) as exc:
