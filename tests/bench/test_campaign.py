@@ -118,6 +118,18 @@ def test_ompls_columns_the_wrapper_cannot_fill_say_what_the_run_did_or_null(quer
     assert any(not r[2] and r[6] is not None for r in rows)  # an approximate path was there, without a best cost
 
 
+def test_a_cap_read_at_a_checkpoint_has_the_settings_of_a_run_capped_there(query_file, tmp_path):
+    """One configuration per planner and cap: the 3-sample row, read during the 400-sample run, says 3 samples."""
+    cfg = CampaignConfig(name="configs", queries=str(query_file), sample_caps=(3, 400), anytime_budgets=(),
+                         iteration_planners=("DimensionRRT",), checkers=("batched",), workers=0, seed=3,
+                         out=str(tmp_path))
+    con = sqlite3.connect(run_campaign(cfg, progress_bar=False, report=False).database)
+    settings = [s for (s,) in con.execute("SELECT settings FROM plannerConfigs ORDER BY id")]
+    con.close()
+    for cap, text in zip((3, 400), settings):
+        assert f"iteration_cap = {cap}" in text and f"planner.max_samples = {cap}" in text, text
+
+
 @pytest.mark.slow
 def test_aorrtc_runs_again_in_one_experiment_with_a_fresh_planner_per_run(query_file, tmp_path):
     """ompl 2.0.1's AORRTC segfaults when solved again after ``clear()`` (``--runs 2``): each run after the

@@ -267,6 +267,8 @@ class Ladder:
                                                              si, pdef, simplify, start, goal, path_properties)
                 total += seconds
                 pl.common["iteration_cap"] = str(n)
+                if "planner.max_samples" in pl.common.to_dict():  # our planners' own cap: the row's, as a run capped at n
+                    pl.common["planner.max_samples"] = str(n)
             ed.totalDuration = total
             out.append((log_text(bench), extras, None))
         return out
