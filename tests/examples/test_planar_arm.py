@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from ompl import base as ob
 
 from tpee_ompl.planning.dimension_rrt import DimensionRRT
@@ -53,6 +54,7 @@ def test_second_solve_without_clear_still_finds_the_start() -> None:
     assert ob.Planner.solve(planner, 10.0) == ob.PlannerStatus.EXACT_SOLUTION
 
 
+@pytest.mark.slow  # a subprocess and a 1 s solve
 def test_the_example_runs_as_a_module_and_reports_both_planners() -> None:
     import subprocess
     import sys

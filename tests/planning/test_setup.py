@@ -181,3 +181,22 @@ def test_batched_check_motions_gives_each_motion_check_motions_verdict(robot, rn
             set_state(a, A[k]), set_state(b, B[k])
             assert got[k] == mv.checkMotion(a, b)
     assert mv.check_motions(np.zeros((0, robot.nq)), np.zeros((0, robot.nq))).shape == (0,)  # no motion, no verdict
+
+
+def test_motion_counts_are_the_validators_own_and_a_fraction_needs_a_counted_motion(robot: WearerArm) -> None:
+    from tpee_ompl.planning.setup import motion_counts, valid_motion_fraction
+
+    start, goal = np.r_[posture_preset(1), 0.0, 0.0], np.r_[posture_preset(4), 0.0, 0.0]
+    for validator in ("batched", "discrete"):
+        ss = make_simple_setup(robot, start, goal, motion_validator=validator)
+        si = ss.getSpaceInformation()
+        mv = si.getMotionValidator()
+        before = motion_counts(mv)
+        a, b = si.allocState(), si.allocState()
+        for k in range(4):
+            a[k], b[k] = float(start[k]), float(goal[k])
+        ok = [si.checkMotion(a, b), si.checkMotion(a, a)]
+        valid, checked = (x - y for x, y in zip(motion_counts(mv), before))
+        assert (valid, checked) == (sum(ok), 2), validator  # OMPL's own counters stay at 0 for the batched one
+        assert valid_motion_fraction(before, motion_counts(mv)) == sum(ok) / 2
+    assert valid_motion_fraction((3, 5), (3, 5)) is None and valid_motion_fraction(None, (1, 1)) is None

@@ -26,6 +26,7 @@ package's columns (collision checks, iterations, lengths, dense validity) as the
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import logging
 import math
@@ -75,7 +76,10 @@ def group_ladders(specs: list[dict], enabled: bool, planners: tuple[str, ...] | 
 
 
 def _ompl_text(v) -> str:
-    """A value as OMPL's ``Benchmark`` writes it (``ompl::toString``: C++ stream defaults, 6 significant digits)."""
+    """A value as OMPL's ``Benchmark`` writes it (``ompl::toString``: C++ stream defaults, 6 significant digits);
+    '' (NULL in the database) for None."""
+    if v is None:
+        return ""
     if isinstance(v, (bool, np.bool_, int, np.integer)):
         return str(int(v))
     return f"{float(v):.6g}"
@@ -203,8 +207,9 @@ class CheckpointPlanner(RecordingPlanner):
 
     def solve(self, ptc):  # noqa: D102 (OMPL override)
         self.start_checks.append(self._checks())
-        self._run = {"t0": time.perf_counter(), "calls": 0, "todo": set(self.checkpoints), "snaps": {},
-                     "motions0": motion_counts(self.getSpaceInformation().getMotionValidator())}
+        self._run = {"t0": time.perf_counter(), "calls": 0, "todo": set(self.checkpoints), "snaps": {}, "motions0": None}
+        with contextlib.suppress(Exception):  # nothing may escape to OMPL (it would abort the benchmark)
+            self._run["motions0"] = motion_counts(self.getSpaceInformation().getMotionValidator())
         if self.python:
             self.inner.set_intermediate_solution_callback(self._on_solution)
             if callable(getattr(self.inner, "set_sample_checkpoints", None)):
@@ -286,9 +291,10 @@ class Ladder:
                     pdef.clearSolutionPaths()
                     p.setProblemDefinition(pdef)
                     p.setup()
-                    c0, t0 = w._checks(), time.perf_counter()
+                    c0, t0, m0 = w._checks(), time.perf_counter(), motion_counts(si.getMotionValidator())
                     p.solve(ob.timedPlannerTerminationCondition(max_time))
                     elapsed = time.perf_counter() - t0
+                    snap["valid_fraction"] = valid_motion_fraction(m0, motion_counts(si.getMotionValidator()))
                     stats = p.last_run_stats()
                     W = None
                     if pdef.hasExactSolution():

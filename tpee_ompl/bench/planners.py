@@ -207,9 +207,9 @@ class RecordingPlanner(ob.Planner):
     After each ``solve``, :attr:`last` holds the run's record: ``waypoints`` (raw path, (K, n), or
     None), ``iterations``, ``samples``, ``best_cost``, ``first_solution_time``, ``progress``
     (list of (time, best cost, iterations)), ``checks_end`` (the checker's counter as ``solve``
-    returned, or None), ``valid_fraction`` (the share of the motions checked during ``solve`` that were
-    valid, :func:`~tpee_ompl.planning.setup.motion_counts`: OMPL's own column reads 0 for a Python motion
-    validator), ``graph_states`` / ``graph_motions`` (None for a Python planner, which keeps no OMPL graph)
+    returned, or None), ``valid_fraction`` (the share of the motions the validator checked during ``solve``
+    that were valid, :func:`~tpee_ompl.planning.setup.motion_counts`, None when it counted none: OMPL's own
+    column reads 0 for a Python motion validator), ``graph_states`` / ``graph_motions`` (None for a Python planner, which keeps no OMPL graph)
     and ``error`` (None, or the exception's repr).  A native planner's
     ``first_solution_time`` is the first termination check that saw an exact solution (a finite
     ``bestCost()``, or one in the problem definition for planners without it, e.g. AORRTC), else the run's
@@ -286,13 +286,13 @@ class RecordingPlanner(ob.Planner):
                 state["next"] = now + self.progress_period
             return cap is not None and it is not None and it >= cap
 
-        if self.deadline is not None:
-            ptc = ob.plannerOrTerminationCondition(ptc, ob.timedPlannerTerminationCondition(self.deadline))
-        mv = self.getSpaceInformation().getMotionValidator()
-        motions0 = motion_counts(mv)
         error = self._setup_error
         self._ran = True
+        mv, motions0 = self.getSpaceInformation().getMotionValidator(), None
         try:
+            if self.deadline is not None:
+                ptc = ob.plannerOrTerminationCondition(ptc, ob.timedPlannerTerminationCondition(self.deadline))
+            motions0 = motion_counts(mv)
             if error is not None:
                 raise RuntimeError(f"setup failed: {error}")
             if self._native:
@@ -311,8 +311,10 @@ class RecordingPlanner(ob.Planner):
             waypoints = path_to_array(pdef.getSolutionPath(), self._dim, read=self._read)
         if state["first"] is None and error is None and pdef.hasExactSolution():
             state["first"] = elapsed  # found as the planner returned (RRTConnect stops at its first path)
-        self.last = {"waypoints": waypoints, "error": error, "checks_end": checks_end,
-                     "valid_fraction": valid_motion_fraction(motions0, motion_counts(mv)),
+        fraction = None
+        with contextlib.suppress(Exception):  # nothing may escape to OMPL (it would abort the benchmark)
+            fraction = valid_motion_fraction(motions0, motion_counts(mv))
+        self.last = {"waypoints": waypoints, "error": error, "checks_end": checks_end, "valid_fraction": fraction,
                      **self._run_stats(elapsed, progress, has_cost, state["first"]), **self._graph_size()}
         return status
 

@@ -165,6 +165,8 @@ def _progress_within(db_path, runs: list[dict], planner: str, best: dict, within
     if not rows:
         return None, None
     series = _series(rows)
+    if not series:
+        return None, None
     per_query = defaultdict(int)
     for r in mine.values():
         per_query[r["query_id"]] += 1

@@ -222,20 +222,22 @@ def check_output(path: str | Path, option: str, force: bool, suffixes: tuple[str
 def on_postures(start: Any, goal: Any, from_sector: int, to_sector: int) -> tuple[Any, Any, str | None]:
     """``start`` and ``goal`` (arrays of DOF1..DOF4) with DOF1/DOF2 set to their sectors' Table 1 postures when
     within :data:`POSTURE_SNAP` of them, and the usage error to raise once the other checks of ``--start``/``--goal``
-    passed (None when both are at their postures): a cross-sector motion starts and ends at the postures."""
+    passed (None when both are at their postures; naming each that is not): a cross-sector motion starts and
+    ends at the postures."""
     import numpy as np
 
     from ..model.sectors import posture_preset
 
-    out, error = [], None
+    out, off = [], []
     for name, q, k in (("--start", start, from_sector), ("--goal", goal, to_sector)):
         q, preset = np.array(q, dtype=float), posture_preset(k)
         if np.max(np.abs(q[:2] - preset)) <= POSTURE_SNAP:
             q[:2] = preset
-        elif error is None:
-            error = (f"{name}: DOF1/DOF2 ({q[0]:.4f}, {q[1]:.4f}) are not sector {k}'s posture ({preset[0]:.6f}, "
-                     f"{preset[1]:.6f}): a cross-sector motion starts and ends at the sectors' Table 1 postures")
+        else:
+            off.append(f"{name}: DOF1/DOF2 ({q[0]:.4f}, {q[1]:.4f}) are not sector {k}'s posture "
+                       f"({preset[0]:.6f}, {preset[1]:.6f})")
         out.append(q)
+    error = "; ".join(off) + ": a cross-sector motion starts and ends at the sectors' Table 1 postures" if off else None
     return out[0], out[1], error
 
 

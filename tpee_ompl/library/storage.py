@@ -165,15 +165,15 @@ def read_library(path: str | Path, robot: WearerArm) -> tuple[dict[tuple[int, in
         or array is malformed (the message names it).
     """
     path = Path(path)
+    if path.is_file() and not zipfile.is_zipfile(path):  # numpy's own message would advise loading it with pickle
+        raise LibraryFileError(f"path library {path} is unreadable (truncated or not a library file): not an .npz archive")
     try:
         with np.load(path, allow_pickle=False) as z:
             arrays = {k: z[k] for k in z.files}
     except FileNotFoundError:
         raise
     except (zipfile.BadZipFile, EOFError, OSError, ValueError, KeyError) as exc:
-        # numpy's message for a file that is no .npz at all advises loading it with pickle: not for a user to follow
-        why = "not an .npz archive" if "allow_pickle" in str(exc) else str(exc)
-        raise LibraryFileError(f"path library {path} is unreadable (truncated or not a library file): {why}") from exc
+        raise LibraryFileError(f"path library {path} is unreadable (truncated or not a library file): {exc}") from exc
     try:
         meta = json.loads(str(arrays["meta"]))
     except (KeyError, json.JSONDecodeError, RecursionError) as exc:

@@ -365,7 +365,7 @@ class Search:
         tried = -1
         joined: set[int] = set()  # holding: the trees c joined already
         if len(both):
-            k = int(both[0])  # the step with the shortest motions
+            k = int(both[0])  # the only step with both trees' nodes, else the one with the shortest motions:
             if len(both) > 1:
                 A, B = base[ts_a[both] - 1].copy(), base[ts_a[both] + 1].copy()
                 A[:, d], B[:, d] = tree.fwd.values[fi[both]], tree.bwd.values[bi[both]]

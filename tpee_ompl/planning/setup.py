@@ -151,11 +151,13 @@ def motion_counts(mv: ob.MotionValidator) -> tuple[int, int]:
     return int(mv.getValidMotionCount()), int(mv.getCheckedMotionCount())
 
 
-def valid_motion_fraction(before: tuple[int, int], after: tuple[int, int]) -> float:
-    """The share of valid motions among those checked between two :func:`motion_counts` (0 when none was
-    valid, as OMPL's ``getValidMotionFraction``)."""
+def valid_motion_fraction(before: tuple[int, int] | None, after: tuple[int, int] | None) -> float | None:
+    """The share of valid motions among those checked between two :func:`motion_counts`; None when no motion
+    was counted (nothing checked, or a Python validator without counters of its own) or a count is missing."""
+    if before is None or after is None:
+        return None
     valid, checked = after[0] - before[0], after[1] - before[1]
-    return valid / checked if valid else 0.0
+    return valid / checked if checked > 0 else None
 
 
 def make_space(robot: RobotChecker) -> ob.RealVectorStateSpace:
