@@ -14,20 +14,26 @@ from tpee_ompl.bench.planners import RecordingPlanner
 from tpee_ompl.planning.dimension_rrt import DimensionRRT
 
 
-def _solve(planner_cls, seconds: float, cap: int | None = None) -> dict:
+def _wrapped_box_planner(make_inner, **wrapper_options) -> tuple[RecordingPlanner, ob.ProblemDefinition, tuple]:
+    """``make_inner(si)`` in a set-up :class:`RecordingPlanner` on the box problem, from (-0.9, 0) to (0.9, 0),
+    path length objective; with the objects to keep alive."""
     si, checker = box_problem()
     pdef = ob.ProblemDefinition(si)
     start, goal = si.allocState(), si.allocState()
     start[0], start[1], goal[0], goal[1] = -0.9, 0.0, 0.9, 0.0
     pdef.setStartAndGoalStates(start, goal, 1e-9)
     pdef.setOptimizationObjective(ob.PathLengthOptimizationObjective(si))
-    w = RecordingPlanner(si, planner_cls(si), max_iterations=cap)
+    w = RecordingPlanner(si, make_inner(si), **wrapper_options)
     w.setProblemDefinition(pdef)
     w.setup()
+    return w, pdef, (si, checker, start, goal)
+
+
+def _solve(planner_cls, seconds: float, cap: int | None = None) -> dict:
+    w, pdef, keep = _wrapped_box_planner(planner_cls, max_iterations=cap)
     t0 = time.perf_counter()
     status = w.solve(ob.timedPlannerTerminationCondition(seconds))
-    return dict(w.last, status=str(status), exact=pdef.hasExactSolution(), elapsed=time.perf_counter() - t0,
-                keep=(si, checker, start, goal))
+    return dict(w.last, status=str(status), exact=pdef.hasExactSolution(), elapsed=time.perf_counter() - t0, keep=keep)
 
 
 @pytest.mark.parametrize("planner_cls", [og.RRTstar, og.AORRTC])
@@ -78,15 +84,7 @@ def _run_past_benchmarks_deadline(make_inner, deadline: float) -> tuple[Recordin
     it never fires, but for a 5 s safety stop, which it records when reached.  The solve starts 0.3 s after the
     wrapper was built and set up, so a deadline counted from there would stop it at once.  Returns the
     wrapper, the safety record and the solve's seconds."""
-    si, checker = box_problem()
-    pdef = ob.ProblemDefinition(si)
-    start, goal = si.allocState(), si.allocState()
-    start[0], start[1], goal[0], goal[1] = -0.9, 0.0, 0.9, 0.0
-    pdef.setStartAndGoalStates(start, goal, 1e-9)
-    pdef.setOptimizationObjective(ob.PathLengthOptimizationObjective(si))
-    w = RecordingPlanner(si, make_inner(si), deadline=deadline)
-    w.setProblemDefinition(pdef)
-    w.setup()
+    w, pdef, keep = _wrapped_box_planner(make_inner, deadline=deadline)
     time.sleep(0.3)
     safety: list[bool] = []
     t0 = time.perf_counter()
@@ -98,7 +96,7 @@ def _run_past_benchmarks_deadline(make_inner, deadline: float) -> tuple[Recordin
 
     w.solve(ob.PlannerTerminationCondition(benchmark_thread))
     elapsed = time.perf_counter() - t0
-    w.keep = (si, checker, pdef, start, goal)
+    w.keep = (pdef, keep)
     return w, safety, elapsed
 
 
