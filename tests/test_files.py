@@ -24,6 +24,14 @@ def test_failed_write_keeps_the_old_file_and_leaves_no_temporary(tmp_path):
     assert target.read_bytes() == b"old" and [p.name for p in tmp_path.iterdir()] == ["lib.npz"]
 
 
+def test_a_failed_write_names_the_output_not_its_temporary_file(tmp_path):
+    target = tmp_path / "scene.png"
+    with pytest.raises(FileNotFoundError) as exc, atomic_path(target) as tmp:
+        raise FileNotFoundError(2, "No such file or directory", str(tmp))  # as a writer that cannot open it
+    assert exc.value.filename == str(target) and ".part" not in str(exc.value)
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_existing_file_is_not_replaced_without_force(tmp_path):
     target = tmp_path / "r.json"
     target.write_text("keep")
