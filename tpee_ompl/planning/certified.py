@@ -221,17 +221,13 @@ class CertifiedMotionValidator(BatchedMotionValidator):
         """True if the motion s1 -> s2 is certified, or its uncertified part passes the dense check."""
         a, b = state_to_array(s1, self._n), state_to_array(s2, self._n)
         self.motions_checked += 1
-        ok = self._decide([self.certify(a, b)])[0]
-        self.motions_valid += ok
-        return ok
+        return self._tally(self._decide([self.certify(a, b)])[0])
 
     def check_motions(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
         """Validity of many motions A[k] -> B[k]; their uncertified parts go to one batched call."""
         A, B = np.atleast_2d(np.asarray(A, dtype=float)), np.atleast_2d(np.asarray(B, dtype=float))
         self.motions_checked += len(A)
-        ok = np.array(self._decide([self.certify(a, b) for a, b in zip(A, B)]), dtype=bool)
-        self.motions_valid += int(np.count_nonzero(ok))
-        return ok
+        return self._tally(np.array(self._decide([self.certify(a, b) for a, b in zip(A, B)]), dtype=bool))
 
     def _decide(self, verdicts: list[bool | np.ndarray]) -> list[bool]:
         dense = [v for v in verdicts if isinstance(v, np.ndarray) and len(v)]

@@ -113,9 +113,7 @@ class BatchedMotionValidator(ob.MotionValidator):
         """True if every state along s1 -> s2 (excluding s1) is valid."""
         a, b = state_to_array(s1, self._n), state_to_array(s2, self._n)
         self.motions_checked += 1
-        ok = bool(self.all_valid([unchecked_motion_states(a, b, self.effective_step())])[0])
-        self.motions_valid += ok
-        return ok
+        return self._tally(bool(self.all_valid([unchecked_motion_states(a, b, self.effective_step())])[0]))
 
     def check_motions(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
         """Validity of many motions A[k] -> B[k] (each excluding its start), batched together."""
@@ -128,6 +126,10 @@ class BatchedMotionValidator(ob.MotionValidator):
             spacing = np.sqrt(((B - A) ** 2).sum(-1)) / counts  # the states are evenly spaced along each motion
             ok = screened_lines_valid(self.robot, self.robot.ball_screen(), S, counts, spacing, self.step,
                                       self.screen_levels)
+        return self._tally(ok)
+
+    def _tally(self, ok):
+        """Count the valid verdicts among ``ok`` (one bool or an array of them) into ``motions_valid``; return ``ok``."""
         self.motions_valid += int(np.count_nonzero(ok))
         return ok
 
