@@ -17,29 +17,22 @@ from .connect_trees import RANGE_FRACTION, ConnectTrees
 from .grouped_space import GroupedSpace
 from .layered_trees import LayeredTrees, spread_waypoints
 from .search_checker import Checker, segment_key
+from .search_draws import GROUP_BLOCK, SampleDraws
 from .waypoint_shortcuts import respread_candidate, shortcut_waypoints
 
 __all__ = ["Search"]
 
-_UNIFORM_FRACTION = 0.1  # share of samples drawn uniformly over the bounds once the region has narrowed
-_NARROWING_UNIT = 100  # the narrowing factor applies per this many samples
-_GROUP_BLOCK = 100  # with several planned groups, each gets this many consecutive samples in turn
 
 
-class Search:
+class Search(SampleDraws):
     """The dimension-RRT iteration on a waypoint array; OMPL-free apart from the checker.  ``local``: narrowed
-    samples around one waypoint at a time (the released search; :meth:`_group_draws`)."""
+    samples around one waypoint at a time (the released search; :meth:`SampleDraws._group_draws`)."""
 
     def __init__(self, grouped: GroupedSpace, checker: Checker, rng: np.random.Generator, start: np.ndarray,
                  goal: np.ndarray, narrow_after: int, narrowing: float, range_: dict[int, np.ndarray],
                  initial: np.ndarray | None = None, connect: bool = True, turns: np.ndarray | None = None,
                  shortcuts: bool = False, local: bool = False) -> None:
-        self.g = grouped
         self.checker = checker
-        self.rng = rng
-        self.narrow_after = narrow_after
-        self.narrowing = narrowing
-        self.range_ = range_
         self.dist = grouped.layout.distance
         W = grouped.initial_waypoints(start, goal)
         if initial is not None:
@@ -57,11 +50,7 @@ class Search:
             # in full at once: the initial path is often valid, and then screening a coarse subset first only costs
             self.E[self.E] = checker.check_motions(W[:-1][self.E], W[1:][self.E])
         self.L = self.dist(W[:-1], W[1:])
-        self.samples = 0
-        self.group_samples = {gi: 0 for gi in grouped.planned}
-        self.narrow_start: dict[int, int | None] = {gi: None for gi in grouped.planned}
-        self._dims = {gi: grouped.group_dims(gi) for gi in grouped.planned}
-        self._bounds = {gi: grouped.group_bounds(gi) for gi in grouped.planned}
+        self._init_draws(grouped, rng, narrow_after, narrowing, range_, local)
         self._tree: LayeredTrees | None = None
         self._connect: ConnectTrees | None = None
         self._use_connect = connect
@@ -77,15 +66,7 @@ class Search:
         self._fbounds = (grouped.layout.lower[self._fdims], grouped.layout.upper[self._fdims])
         self._hold = not grouped.prescribed
         self.delta = grouped.layout.delta
-        self._uniform = np.empty((0, 0))
-        self._ui = 0
-        self._drawn: tuple | None = None
-        self._scales = np.zeros(0)
-        self._cut: int | None = None  # the offset from which every group's padding is its range_
-        self._floor = min((float(np.min(range_[gi] / (hi - lo))) for gi, (lo, hi) in self._bounds.items()),
-                          default=0.0) * (1 - 1e-12)
         self._shortcuts = shortcuts
-        self._local = local
         self._shortcut_due = self.valid  # the valid path changed since the last sweep (or is new)
         if turns is not None and not self.valid:  # a connect path found with fewer steps (h raised)
             self._use_connect = False
@@ -103,78 +84,6 @@ class Search:
     @property
     def cost(self) -> float:
         return float(self.L.sum())
-
-    def _refill(self, k: int) -> None:
-        """A fresh buffer of 1024 samples' randomness (one uniform picking narrowed or uniform, then k values)."""
-        if self._ui >= len(self._uniform) or self._uniform.shape[1] != k + 1:
-            self._uniform = self.rng.random((1024, k + 1))
-            self._ui = 0
-
-    def _next_random(self, k: int) -> np.ndarray:  # one sample's 1 + k uniforms (see :meth:`_refill`)
-        self._refill(k)
-        self._ui += 1
-        return self._uniform[self._ui - 1]
-
-    def current_group(self) -> int:
-        planned = self.g.planned
-        return planned[(self.samples // _GROUP_BLOCK) % len(planned)]
-
-    def draw(self, gi: int | None) -> np.ndarray:
-        """One sample: for group gi (narrowed or uniform), or with gi None for the feasibility phase's
-        joint planned DOFs (uniform over their bounds); see the module docstring."""
-        if gi is None:
-            lo, hi = self._fbounds
-            return lo + self._next_random(len(self._fdims))[1:] * (hi - lo)
-        drawn, self._drawn = self._drawn, None
-        if drawn is not None and drawn[:2] == (self._ui, gi):  # drawn already by :meth:`_pass_rejected`
-            self._ui += 1
-            c, n0 = drawn[2], drawn[3]
-        else:
-            C, n0 = self._group_draws(gi, self._next_random(len(self._dims[gi]))[None, :])
-            c = C[0]
-        if n0 is not None and self.narrow_start[gi] is None:
-            self.narrow_start[gi] = n0
-        return c
-
-    def _group_draws(self, gi: int, U: np.ndarray) -> tuple[np.ndarray, int | None]:
-        """The next len(U) samples of group gi from the random rows U (m, k + 1), as :meth:`draw` draws them
-        one by one (W unchanged), and the narrowing start they imply (None: not narrowing yet).  With
-        ``local`` a narrowed sample's box is padded around one intermediate waypoint (picked by U[:, 0])
-        instead of around the whole path."""
-        lo, hi = self._bounds[gi]
-        span = hi - lo
-        C = lo + U[:, 1:] * span
-        g0 = self.group_samples[gi]
-        n0 = self.narrow_start[gi]
-        if n0 is None and g0 + len(U) - 1 >= self.narrow_after:
-            n0 = max(g0, self.narrow_after)
-        if n0 is not None:
-            narrow = np.flatnonzero((U[:, 0] >= _UNIFORM_FRACTION) & (g0 + np.arange(len(U)) >= n0))
-            if len(narrow):
-                if self._cut is not None and g0 - n0 >= self._cut:  # every padding is range_ from here on
-                    pad = self.range_[gi]
-                else:
-                    pad = np.maximum(self.range_[gi], span * self._scale(g0 - n0 + narrow)[:, None])
-                vals = self.W[:, self._dims[gi]]
-                if self._local:
-                    m = len(vals) - 2
-                    t = 1 + np.minimum((U[narrow, 0] - _UNIFORM_FRACTION) / (1 - _UNIFORM_FRACTION) * m, m - 1).astype(int)
-                    vlo = vhi = vals[t]
-                else:
-                    vlo, vhi = vals.min(axis=0), vals.max(axis=0)
-                nlo, nhi = np.maximum(lo, vlo - pad), np.minimum(hi, vhi + pad)
-                C[narrow] = nlo + U[narrow, 1:] * (nhi - nlo)
-        return C, n0
-
-    def _scale(self, k: np.ndarray) -> np.ndarray:
-        """``narrowing ** (k / 100)`` for ascending offsets k >= 0, memoised (``np.power`` is not bit-identical) up to
-        the offset where every padding has reached its ``range_`` (later offsets get that one's: the same paddings)."""
-        while self._cut is None and int(k[-1]) >= (have := len(self._scales)):
-            more = range(have, max(2 * have, 128))
-            self._scales = np.concatenate((self._scales, [self.narrowing ** (i / _NARROWING_UNIT) for i in more]))
-            below = np.flatnonzero(self._scales <= self._floor)
-            self._cut = int(below[0]) if len(below) else None
-        return self._scales[k if self._cut is None else np.minimum(k, self._cut)]
 
     def iterate(self, limit: int = 1, stop: Callable[[], bool] | None = None) -> int:
         """Draw one sample and try it at every intermediate step (up to ``limit`` samples; see below).
@@ -244,32 +153,6 @@ class Search:
         moved = (S[1:-1] != W[1:-1]).any(axis=1)
         return bool(self.checker.states(S[1:-1][moved]).all()) and not self._check_segments(S)
 
-    def _pass_rejected(self, limit: int) -> None:
-        """Advance past the next samples (at most ``limit``, within the group's block and the random buffer)
-        that :meth:`_improve` would reject on cost alone: :meth:`draw` and its cost test, vectorised."""
-        gi = self.current_group()
-        d = self._dims[gi]
-        self._refill(len(d))
-        n = min(limit, _GROUP_BLOCK - self.samples % _GROUP_BLOCK, len(self._uniform) - self._ui)
-        if n <= 0:
-            return
-        g0 = self.group_samples[gi]
-        C, n0 = self._group_draws(gi, self._uniform[self._ui : self._ui + n])
-        W, L = self.W, self.L
-        X = np.broadcast_to(W[1:-1], (n,) + W[1:-1].shape).copy()
-        X[:, :, d] = C[:, None, :]
-        shorter = (self.dist(W[:-2], X) + self.dist(X, W[2:]) < L[:-1] + L[1:] - 1e-12).any(axis=1)
-        j = int(np.argmax(shorter)) if shorter.any() else n
-        # the first sample not rejected, as :meth:`draw` would draw it next (W does not change in between)
-        self._drawn = (self._ui + j, gi, C[j], n0 if n0 is not None and g0 + j >= n0 else None) if j < n else None
-        if j == 0:
-            return
-        self._ui += j
-        self.samples += j
-        self.group_samples[gi] = g0 + j
-        if self.narrow_start[gi] is None and n0 is not None and g0 + j - 1 >= n0:
-            self.narrow_start[gi] = n0
-
     def _layered(self, W: np.ndarray, V: np.ndarray, E: np.ndarray) -> LayeredTrees:
         return LayeredTrees(W, V, E, self._fdims, self._hold, functools.partial(self.delta, dims=self._fdims))
 
@@ -287,7 +170,7 @@ class Search:
         self._ui += used
         planned = self.g.planned
         for s in range(self.samples, self.samples + used):
-            self.group_samples[planned[(s // _GROUP_BLOCK) % len(planned)]] += 1
+            self.group_samples[planned[(s // GROUP_BLOCK) % len(planned)]] += 1
         self.samples += used
         if P is None:
             return 0
