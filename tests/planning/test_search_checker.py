@@ -74,3 +74,20 @@ def test_candidate_motions_that_pass_are_remembered_as_passing_check_motion(chec
         for a, b, ok in ((A[k], C[k], left[k]), (C[k], B[k], right[k])):
             assert ok == checker.check_motion(a, b)  # si.checkMotion's verdict (remembered when it passes)
     assert remembered == checker.passed  # exactly the passing motions
+
+
+def test_one_strict_candidate_is_valid_exactly_when_it_and_both_its_motions_pass(checker, robot, rng) -> None:
+    """The improvement phase's case: the candidate, its motions' screen (every 4th state, up to the first
+    failure), then the validator in full; the verdict is ``si.isValid`` and ``si.checkMotion``'s."""
+    good, bad = valid_and_colliding(robot, rng, 60)
+    A, B = good[:30], good[30:]
+    C = np.vstack([good[rng.permutation(60)[:25]], bad[:5]])
+    one = np.ones(1, dtype=bool)
+    verdicts = []
+    for k in range(30):
+        vc, left, right = checker.candidates(C[k : k + 1], A[k : k + 1], B[k : k + 1], one, one, one)
+        want = bool(robot.are_valid(C[k : k + 1])[0]) and checker.check_motion(A[k], C[k]) and \
+            checker.check_motion(C[k], B[k])
+        assert bool(vc[0] and left[0] and right[0]) == want
+        verdicts.append(want)
+    assert any(verdicts) and not all(verdicts)

@@ -1,0 +1,110 @@
+"""Speed changes that keep every path: the same capped runs with a switch in each setting, same samples, same paths.
+
+    PYTHONPATH=. .venv/bin/python experiments/speed_switches.py look-ahead                    # ~1 min
+    PYTHONPATH=. .venv/bin/python experiments/speed_switches.py look-ahead --samples 20000 --reps 1
+    PYTHONPATH=. .venv/bin/python experiments/speed_switches.py candidate-stride --values 16 8 4 2
+    PYTHONPATH=. .venv/bin/python experiments/speed_switches.py candidate-stride --planner paper --samples 2500
+
+Switches (scratch settings of the installed code; the first value is the reference):
+
+* ``look-ahead`` (``on``, ``off``): on a valid path the search passes over the samples that are shorter at
+  no step with one vectorised cost test (``SampleDraws._pass_rejected``); ``on`` runs it ahead over up
+  to ``AHEAD`` samples and keeps it while the path stays the same (the package); ``off`` drops the kept
+  test before every call, so each call tests its own window of at most 63 samples (before 2026-11-26).
+* ``candidate-stride`` (default values ``4 16``): the improvement phase screens one candidate's two
+  motions at every N-th interior state, longest stretch first, up to the first failure, before the
+  validator checks them in full (``search_checker._CANDIDATE_STRIDE``; 16 before 2026-11-26).
+
+Each run is capped at ``--samples``, so every setting draws the same samples; the paths must be the same
+(checked and printed).  Settings alternate per query.  Prints the total time, the collision checks and
+the ratio to the first value.  ``--planner library``: ``LibraryDimensionRRT`` (Table 3's rows released
+after ``RELEASE_AFTER``); ``paper``: ``tpee_dimension_rrt`` (rows kept, Table 4's planner).
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from collections.abc import Callable
+
+import numpy as np
+from _common import wearer_library_queries
+from ompl import util as ou
+
+from tpee_ompl import make_simple_setup
+from tpee_ompl.library.planner import LibraryDimensionRRT
+from tpee_ompl.planning import search_checker, search_draws
+from tpee_ompl.planning.tpee import tpee_dimension_rrt
+
+_KEPT = search_draws.SampleDraws._pass_rejected
+
+
+def _per_call(self, limit: int) -> None:
+    """``_pass_rejected`` without the look-ahead: the kept test dropped, a window of ``limit`` samples."""
+    self._ahead = None
+    saved, search_draws.AHEAD = search_draws.AHEAD, max(1, limit)
+    try:
+        _KEPT(self, limit)
+    finally:
+        search_draws.AHEAD = saved
+
+
+def _look_ahead(value: str) -> None:
+    search_draws.SampleDraws._pass_rejected = _KEPT if value == "on" else _per_call
+
+
+def _candidate_stride(value: str) -> None:
+    search_checker._CANDIDATE_STRIDE = int(value)
+
+
+SWITCHES: dict[str, tuple[Callable[[str], None], list[str]]] = {
+    "look-ahead": (_look_ahead, ["on", "off"]),
+    "candidate-stride": (_candidate_stride, ["4", "16"]),
+}
+
+
+def main(argv: list[str] | None = None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("switch", choices=sorted(SWITCHES))
+    ap.add_argument("--values", nargs="+", help="settings to compare, the reference first (default: see above)")
+    ap.add_argument("--queries", default="planning_necessary")
+    ap.add_argument("--max-queries", type=int, default=24)
+    ap.add_argument("--samples", type=int, default=5000, help="sample cap per run")
+    ap.add_argument("--planner", choices=("library", "paper"), default="library")
+    ap.add_argument("--reps", type=int, default=2)
+    args = ap.parse_args(argv)
+    apply, default = SWITCHES[args.switch]
+    values = args.values or default
+    ou.setLogLevel(ou.LOG_NONE)
+    robot, lib, rows = wearer_library_queries(args.queries, args.max_queries)
+    setups = [make_simple_setup(robot, np.array(q["start"]), np.array(q["goal"])) for q in rows]
+    total = dict.fromkeys(values, 0.0)
+    checks = dict.fromkeys(values, 0)
+    lengths: dict[str, list[float]] = {v: [] for v in values}
+    for rep in range(args.reps):
+        for k, (q, ss) in enumerate(zip(rows, setups)):
+            for value in (values if (k + rep) % 2 else values[::-1]):
+                apply(value)
+                si = ss.getSpaceInformation()
+                if args.planner == "library":
+                    planner = LibraryDimensionRRT(si, lib, q["from_sector"], q["to_sector"], seed=k,
+                                                  max_samples=args.samples)
+                else:
+                    planner = tpee_dimension_rrt(si, q["from_sector"], q["to_sector"], seed=k, max_samples=args.samples)
+                ss.clear()
+                ss.setPlanner(planner)
+                c0, t0 = robot.collision_checks, time.perf_counter()
+                ss.solve(60.0)
+                total[value] += time.perf_counter() - t0
+                checks[value] += robot.collision_checks - c0
+                lengths[value].append(planner.last_run_stats()["best_cost"])
+    apply(default[0])
+    ref = values[0]
+    print(f"{args.switch}, {args.planner}, {len(rows)} queries x {args.reps}, {args.samples} samples per run:")
+    for v in values:
+        same = "same paths" if lengths[v] == lengths[ref] else "PATHS DIFFER"
+        print(f"  {v:>4}: {total[v]:6.2f} s  ratio {total[v] / total[ref]:.3f}  checks {checks[v]}  {same}")
+
+
+if __name__ == "__main__":
+    main()
