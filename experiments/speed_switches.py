@@ -10,13 +10,15 @@ Switches (scratch settings of the installed code; the first value is the referen
 * ``look-ahead`` (``on``, ``off``): on a valid path the search passes over the samples that are shorter at
   no step with one vectorised cost test (``SampleDraws._pass_rejected``); ``on`` runs it ahead over up
   to ``AHEAD`` samples and keeps it while the path stays the same (the package); ``off`` drops the kept
-  test before every call, so each call tests its own window of at most 63 samples (before 2026-11-26).
+  test before every call, so each call tests its own window of at most 63 samples (before 2026-11-26;
+  exactly so with one planned group, as in both planners here: with several, the window still runs to
+  the end of the group's block).
 * ``candidate-stride`` (default values ``4 16``): the improvement phase screens one candidate's two
   motions at every N-th interior state, longest stretch first, up to the first failure, before the
   validator checks them in full (``search_checker._CANDIDATE_STRIDE``; 16 before 2026-11-26).
 
 Each run is capped at ``--samples``, so every setting draws the same samples; the paths must be the same
-(checked and printed).  Settings alternate per query.  Prints the total time, the collision checks and
+(their states' bytes compared, and printed).  Settings alternate per query.  Prints the total time, the collision checks and
 the ratio to the first value.  ``--planner library``: ``LibraryDimensionRRT`` (Table 3's rows released
 after ``RELEASE_AFTER``); ``paper``: ``tpee_dimension_rrt`` (rows kept, Table 4's planner).
 """
@@ -24,6 +26,7 @@ after ``RELEASE_AFTER``); ``paper``: ``tpee_dimension_rrt`` (rows kept, Table 4'
 from __future__ import annotations
 
 import argparse
+import hashlib
 import time
 from collections.abc import Callable
 
@@ -34,6 +37,7 @@ from ompl import util as ou
 from tpee_ompl import make_simple_setup
 from tpee_ompl.library.planner import LibraryDimensionRRT
 from tpee_ompl.planning import search_checker, search_draws
+from tpee_ompl.planning.paths import path_to_array
 from tpee_ompl.planning.tpee import tpee_dimension_rrt
 
 _KEPT = search_draws.SampleDraws._pass_rejected
@@ -80,7 +84,7 @@ def main(argv: list[str] | None = None) -> None:
     setups = [make_simple_setup(robot, np.array(q["start"]), np.array(q["goal"])) for q in rows]
     total = dict.fromkeys(values, 0.0)
     checks = dict.fromkeys(values, 0)
-    lengths: dict[str, list[float]] = {v: [] for v in values}
+    paths: dict[str, list[str]] = {v: [] for v in values}
     for rep in range(args.reps):
         for k, (q, ss) in enumerate(zip(rows, setups)):
             for value in (values if (k + rep) % 2 else values[::-1]):
@@ -97,12 +101,13 @@ def main(argv: list[str] | None = None) -> None:
                 ss.solve(60.0)
                 total[value] += time.perf_counter() - t0
                 checks[value] += robot.collision_checks - c0
-                lengths[value].append(planner.last_run_stats()["best_cost"])
+                W = path_to_array(ss.getSolutionPath(), robot.nq) if ss.haveExactSolutionPath() else None
+                paths[value].append(hashlib.sha256(b"" if W is None else W.tobytes()).hexdigest())
     apply(default[0])
     ref = values[0]
     print(f"{args.switch}, {args.planner}, {len(rows)} queries x {args.reps}, {args.samples} samples per run:")
     for v in values:
-        same = "same paths" if lengths[v] == lengths[ref] else "PATHS DIFFER"
+        same = "same paths" if paths[v] == paths[ref] else "PATHS DIFFER"
         print(f"  {v:>4}: {total[v]:6.2f} s  ratio {total[v] / total[ref]:.3f}  checks {checks[v]}  {same}")
 
 

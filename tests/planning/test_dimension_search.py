@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 from helpers.planning_spaces import box_problem
@@ -132,12 +134,14 @@ def test_iterate_in_blocks_matches_one_sample_per_call(limit: int, batch: bool, 
     assert many.narrow_start == one.narrow_start and many.group_samples == one.group_samples
 
 
+@pytest.mark.parametrize("shortcuts", [False, True])
 @pytest.mark.parametrize("ahead", [1, 3, 50, 256])
 @pytest.mark.parametrize("local", [False, True])
 def test_cost_test_run_ahead_passes_over_the_same_samples_as_one_sample_per_call(
-        ahead: int, local: bool, monkeypatch: pytest.MonkeyPatch) -> None:
+        ahead: int, local: bool, shortcuts: bool, monkeypatch: pytest.MonkeyPatch) -> None:
     """One planned group: the cost test runs ahead over ``AHEAD`` samples and is kept while the path stays;
-    whatever that window, the path changes after the same samples as when they are drawn one per call."""
+    whatever that window, and with calls of 1 to 200 samples mixed (across blocks and buffers), the path
+    changes after the same samples as when they are drawn one per call."""
     monkeypatch.setattr(search_draws, "AHEAD", ahead)
     si, _ = box_problem(lo=(-0.2, -1.0), hi=(0.2, 0.6))
     grouped = GroupedSpace(si, [[0, 1]], 7)
@@ -145,18 +149,19 @@ def test_cost_test_run_ahead_passes_over_the_same_samples_as_one_sample_per_call
 
     def search() -> Search:
         return Search(grouped, Checker(si, grouped.layout, True), np.random.default_rng(3), start, goal,
-                      narrow_after=50, narrowing=0.5, range_={0: np.full(2, 0.02)}, local=local)
+                      narrow_after=50, narrowing=0.5, range_={0: np.full(2, 0.02)}, local=local, shortcuts=shortcuts)
 
     one, many = search(), search()
     trace_one, trace_many = [], []
     while one.samples < 3000:
         one.iterate()
         trace_one.append((one.samples, one.W.tobytes()))
+    limits = itertools.cycle([1, 1, 1, 64, 7, 1, 200, 2, 64])
     while many.samples < 3000:
-        many.iterate(min(64, 3000 - many.samples))
+        many.iterate(min(next(limits), 3000 - many.samples))
         trace_many.append((many.samples, many.W.tobytes()))
-    changes = sum(a[1] != b[1] for a, b in zip(trace_one, trace_one[1:]))
-    assert many.valid and changes >= 5  # the look-ahead was computed again after each change of the path
+    changes = sum(a[1] != b[1] for a, b in itertools.pairwise(trace_one))
+    assert many.valid and changes >= 5  # the path changed, so the test run ahead was stale several times
     np.testing.assert_array_equal(many.W, one.W)
     seen = dict(trace_one)
     assert all(seen[n] == w for n, w in trace_many)

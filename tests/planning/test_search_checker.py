@@ -78,16 +78,25 @@ def test_candidate_motions_that_pass_are_remembered_as_passing_check_motion(chec
 
 def test_one_strict_candidate_is_valid_exactly_when_it_and_both_its_motions_pass(checker, robot, rng) -> None:
     """The improvement phase's case: the candidate, its motions' screen (every 4th state, up to the first
-    failure), then the validator in full; the verdict is ``si.isValid`` and ``si.checkMotion``'s."""
-    good, bad = valid_and_colliding(robot, rng, 60)
-    A, B = good[:30], good[30:]
-    C = np.vstack([good[rng.permutation(60)[:25]], bad[:5]])
+    failure), then the validator in full; the verdict is ``si.isValid`` and ``si.checkMotion``'s, and a
+    candidate whose motion collides stops before checking all of its motions' states."""
+    good, bad = valid_and_colliding(robot, rng, 600)
+    # near obstacles: around the midpoints of motions that collide
+    blocked = [k for k in range(300) if not checker.check_motion(good[k], good[300 + k])][:30]
+    m = len(blocked)
+    A, B = good[blocked + list(range(5))], good[[300 + k for k in blocked] + list(range(300, 305))]
+    C = np.vstack([0.5 * (A[:m] + B[:m]) + 0.1 * rng.standard_normal((m, robot.nq)), bad[:5]])
     one = np.ones(1, dtype=bool)
-    verdicts = []
-    for k in range(30):
+    outcomes = set()
+    for k in range(m + 5):
+        before = checker.counter()
         vc, left, right = checker.candidates(C[k : k + 1], A[k : k + 1], B[k : k + 1], one, one, one)
-        want = bool(robot.are_valid(C[k : k + 1])[0]) and checker.check_motion(A[k], C[k]) and \
-            checker.check_motion(C[k], B[k])
-        assert bool(vc[0] and left[0] and right[0]) == want
-        verdicts.append(want)
-    assert any(verdicts) and not all(verdicts)
+        checks = checker.counter() - before
+        c_ok = bool(robot.are_valid(C[k : k + 1])[0])
+        motions_ok = c_ok and checker.check_motion(A[k], C[k]) and checker.check_motion(C[k], B[k])
+        assert bool(vc[0] and left[0] and right[0]) == motions_ok
+        dense = sum(len(checker.interior(p[None], q[None])[0]) + 1 for p, q in ((A[k], C[k]), (C[k], B[k])))
+        if c_ok and not motions_ok:
+            assert checks < dense  # stopped at a failure of the screen
+        outcomes.add((c_ok, motions_ok))
+    assert outcomes == {(False, False), (True, False), (True, True)}

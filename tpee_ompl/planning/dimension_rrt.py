@@ -67,11 +67,12 @@ without a prescribed group: a waypoint on its neighbours' segment never moves ag
 
 Batching: a sample's candidate waypoints and their motions go through the checker's batched
 ``are_valid(Q)`` when it has one (candidates plus every 16th interior motion state, then the rest for
-the survivors; a lone candidate first, then that screen in bisection order up to the first failure),
-else ``si.isValid`` / ``si.checkMotion``; motion states are those OMPL's discrete validator checks,
-and a motion that passed ``si.checkMotion`` is not checked again when posted.  Up to
-64 samples the cost test rejects are passed over in one vectorised step (the same paths as one at a
-time); the termination condition is asked between batches and at :meth:`DimensionRRT.set_sample_checkpoints`.
+the survivors; a lone candidate first, then every 4th state of its motions in bisection order up to the
+first failure), else ``si.isValid`` / ``si.checkMotion``; motion states are those OMPL's discrete
+validator checks, and a motion that passed ``si.checkMotion`` is not checked again when posted.  Up to
+64 samples the cost test rejects are passed over per call, by a vectorised test run ahead and kept while
+the path stays (:mod:`tpee_ompl.planning.search_draws`; the same paths as one at a time); the
+termination condition is asked between calls and at :meth:`DimensionRRT.set_sample_checkpoints`.
 
 Stopping like an OMPL planner: each improved path is added to the problem definition as it is found
 (so ``ob.exactSolnPlannerTerminationCondition(pdef)`` stops at the first), after every segment not

@@ -160,10 +160,11 @@ class Checker:
         return -1 if i < 0 else int(idx[i])
 
     def _screen(self, A: np.ndarray, B: np.ndarray, bisect: bool, starts: bool = False,
-                stride: int = _COARSE_STRIDE) -> tuple[np.ndarray, np.ndarray]:
-        """The states :meth:`first_failing_motion` checks (every ``stride``-th), in its order, and the motion of each."""
+                stride: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """The states of a screen (every ``stride``-th interior state, default :data:`_COARSE_STRIDE`) in
+        :meth:`first_failing_motion`'s order, and the motion of each."""
         K = len(A)
-        S, idx, j = self.interior(A, B, stride)  # in motion order, then step order
+        S, idx, j = self.interior(A, B, stride or _COARSE_STRIDE)  # in motion order, then step order
         if bisect and len(idx):
             j = _longest_stretch_key(_screen_levels(idx, K), self.layout.distance(A, B)[idx])
         if starts:  # each motion's start before its interior states

@@ -11,6 +11,9 @@ the path stays the same (the same samples, in the same calls, as drawing them on
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import NamedTuple
+
 import numpy as np
 
 from .grouped_space import GroupedSpace
@@ -23,7 +26,18 @@ GROUP_BLOCK = 100
 """With several planned groups, each gets this many consecutive samples in turn."""
 AHEAD = 256
 """Most samples whose cost test runs ahead at once (one planned group): at 5,000 / 20,000 samples per
-run the library pipeline took 0.80 / 0.68 of the time it took with the test run per call (64 samples)."""
+run the library pipeline took 0.76 / 0.68 of the time it took with the test run per call (at most 63
+samples, ``limit - 1``; ``experiments/speed_switches.py look-ahead``)."""
+
+
+class _Ahead(NamedTuple):
+    """The cost test run ahead (:meth:`SampleDraws._ahead_test`)."""
+
+    key: tuple
+    start: int  # the buffer row of C[0]
+    C: np.ndarray  # the samples
+    n0: int | None  # their narrowing start
+    hits: np.ndarray  # indices into C of the samples shorter at some step
 
 
 class SampleDraws:
@@ -32,6 +46,9 @@ class SampleDraws:
 
     W: np.ndarray
     L: np.ndarray
+    dist: Callable[[np.ndarray, np.ndarray], np.ndarray]
+    _fdims: np.ndarray
+    _fbounds: tuple[np.ndarray, np.ndarray]
 
     def _init_draws(self, grouped: GroupedSpace, rng: np.random.Generator, narrow_after: int, narrowing: float,
                     range_: dict[int, np.ndarray], local: bool) -> None:
@@ -49,7 +66,7 @@ class SampleDraws:
         self._uniform = np.empty((0, 0))
         self._ui = 0
         self._buffers = 0  # buffers drawn so far (identifies the current one)
-        self._ahead: tuple | None = None  # the cost test run ahead (:meth:`_ahead_test`)
+        self._ahead: _Ahead | None = None
         self._drawn: tuple | None = None
         self._scales = np.zeros(0)
         self._cut: int | None = None  # the offset from which every group's padding is its range_
@@ -69,6 +86,7 @@ class SampleDraws:
         return self._uniform[self._ui - 1]
 
     def current_group(self) -> int:
+        """The planned group the next sample is for (each gets :data:`GROUP_BLOCK` samples in turn)."""
         planned = self.g.planned
         return planned[(self.samples // GROUP_BLOCK) % len(planned)]
 
@@ -146,7 +164,7 @@ class SampleDraws:
             m = min(n, len(C) - o)
             i = int(np.searchsorted(hits, o))
             j = int(hits[i]) - o if i < len(hits) and hits[i] - o < m else m
-            if j < m:  # the first sample not rejected, as :meth:`draw` would draw it next (W does not change in between)
+            if j < m:  # the first sample not rejected, as :meth:`draw` would draw it next (W unchanged in between)
                 self._drawn = (self._ui + j, gi, C[o + j], n0 if n0 is not None and g0 + j >= n0 else None)
             self._ui += j
             self.samples += j
@@ -157,18 +175,18 @@ class SampleDraws:
                 return
             n -= m
 
-    def _ahead_test(self, gi: int, block: int) -> tuple:
-        """(key, first buffer row, the samples C, their narrowing start, indices of those shorter at some step) of
-        :meth:`_pass_rejected`'s cost test from the current buffer row on, computed again when W changed."""
-        key = (self._buffers, gi, self._ui - self.group_samples[gi], self.W.tobytes())
+    def _ahead_test(self, gi: int, block: int) -> _Ahead:
+        """:meth:`_pass_rejected`'s cost test from the current buffer row on (at least that row), computed
+        again when the path (W, L), the buffer or the group changed."""
+        key = (self._buffers, gi, self._ui - self.group_samples[gi], self.W.tobytes(), self.L.tobytes())
         ahead = self._ahead
-        if ahead is not None and ahead[0] == key and ahead[1] <= self._ui < ahead[1] + len(ahead[2]):
+        if ahead is not None and ahead.key == key and ahead.start <= self._ui < ahead.start + len(ahead.C):
             return ahead
         W, L, d = self.W, self.L, self._dims[gi]
-        end = min(len(self._uniform), self._ui + AHEAD if len(self.g.planned) == 1 else block)
+        end = min(len(self._uniform), self._ui + max(1, AHEAD) if len(self.g.planned) == 1 else block)
         C, n0 = self._group_draws(gi, self._uniform[self._ui : end])
         X = np.broadcast_to(W[1:-1], (len(C),) + W[1:-1].shape).copy()
         X[:, :, d] = C[:, None, :]
         shorter = (self.dist(W[:-2], X) + self.dist(X, W[2:]) < L[:-1] + L[1:] - 1e-12).any(axis=1)
-        self._ahead = (key, self._ui, C, n0, np.flatnonzero(shorter))
+        self._ahead = _Ahead(key, self._ui, C, n0, np.flatnonzero(shorter))
         return self._ahead
