@@ -23,7 +23,6 @@ from .waypoint_shortcuts import respread_candidate, shortcut_waypoints
 __all__ = ["Search"]
 
 
-
 class Search(SampleDraws):
     """The dimension-RRT iteration on a waypoint array; OMPL-free apart from the checker.  ``local``: narrowed
     samples around one waypoint at a time (the released search; :meth:`SampleDraws._group_draws`)."""
