@@ -4,6 +4,7 @@
     PYTHONPATH=. .venv/bin/python experiments/speed_switches.py look-ahead --samples 20000 --reps 1
     PYTHONPATH=. .venv/bin/python experiments/speed_switches.py candidate-stride --values 16 8 4 2
     PYTHONPATH=. .venv/bin/python experiments/speed_switches.py candidate-stride --planner paper --samples 2500
+    PYTHONPATH=. .venv/bin/python experiments/speed_switches.py hit-states --samples 20000 --reps 1
 
 Switches (scratch settings of the installed code; the first value is the reference):
 
@@ -16,6 +17,9 @@ Switches (scratch settings of the installed code; the first value is the referen
 * ``candidate-stride`` (default values ``4 16``): the improvement phase screens one candidate's two
   motions at every N-th interior state, longest stretch first, up to the first failure, before the
   validator checks them in full (``search_checker._CANDIDATE_STRIDE``; 16 before 2026-11-26).
+* ``hit-states`` (``on``, ``off``): with a group of every DOF (the released search) the look-ahead checks the
+  states of the samples its cost test lets through in one call (``SampleDraws._hit_states``, the package);
+  ``off``: each is checked when its turn comes, one call per sample (before 2026-11-26).
 
 Each run is capped at ``--samples``, so every setting draws the same samples; the paths must be the same
 (their states' bytes compared, and printed).  Settings alternate per query.  Prints the total time, the collision checks and
@@ -61,9 +65,17 @@ def _candidate_stride(value: str) -> None:
     search_checker._CANDIDATE_STRIDE = int(value)
 
 
+_HIT_STATES = search_draws.SampleDraws._hit_states
+
+
+def _hit_states(value: str) -> None:
+    search_draws.SampleDraws._hit_states = _HIT_STATES if value == "on" else (lambda self, S, last: {})
+
+
 SWITCHES: dict[str, tuple[Callable[[str], None], list[str]]] = {
     "look-ahead": (_look_ahead, ["on", "off"]),
     "candidate-stride": (_candidate_stride, ["4", "16"]),
+    "hit-states": (_hit_states, ["on", "off"]),
 }
 
 

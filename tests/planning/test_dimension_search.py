@@ -168,6 +168,43 @@ def test_cost_test_run_ahead_passes_over_the_same_samples_as_one_sample_per_call
     assert many.narrow_start == one.narrow_start and many.group_samples == one.group_samples
 
 
+@pytest.mark.parametrize("local", [False, True])
+def test_hits_checked_together_give_the_paths_of_hits_checked_one_by_one(local: bool, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A group of every DOF: the look-ahead checks the states of the samples its cost test lets through in one
+    call, and the candidates come with that validity; the path after every call is the one each sample checked
+    on its own gives."""
+    si, _ = box_problem(lo=(-0.2, -1.0), hi=(0.2, 0.6))
+    grouped = GroupedSpace(si, [[0, 1]], 7)
+    start, goal = np.array([-0.8, 0.0]), np.array([0.8, 0.0])
+    given = []
+    candidates = Checker.candidates
+
+    def recorded(self, C, A, B, left, right, strict, valid=None):
+        given.append(valid is not None)
+        return candidates(self, C, A, B, left, right, strict, valid)
+
+    monkeypatch.setattr(Checker, "candidates", recorded)
+
+    def trace() -> list[tuple[int, bytes]]:
+        search = Search(grouped, Checker(si, grouped.layout, True), np.random.default_rng(5), start, goal,
+                        narrow_after=50, narrowing=0.5, range_={0: np.full(2, 0.02)}, local=local, shortcuts=True)
+        out, limits = [], itertools.cycle([1, 64, 7, 200, 2])
+        while search.samples < 3000:
+            search.iterate(min(next(limits), 3000 - search.samples))
+            out.append((search.samples, search.W.tobytes()))
+        assert search.valid
+        return out
+
+    together = trace()
+    assert sum(given) > 20
+    with monkeypatch.context() as m:
+        m.setattr(search_draws.SampleDraws, "_hit_states", lambda self, S, last: {})
+        given.clear()
+        alone = trace()
+        assert not any(given)
+    assert together == alone and len({w for _, w in together}) > 5  # the path changed several times
+
+
 @pytest.mark.parametrize("local", [True, False])
 def test_released_search_draws_its_narrowed_samples_around_one_waypoint_at_a_time(local: bool) -> None:
     """``local`` (the released search): once narrowed, a sample lies within ``range_`` of one intermediate

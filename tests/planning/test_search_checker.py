@@ -100,3 +100,25 @@ def test_one_strict_candidate_is_valid_exactly_when_it_and_both_its_motions_pass
             assert checks < dense  # stopped at a failure of the screen
         outcomes.add((c_ok, motions_ok))
     assert outcomes == {(False, False), (True, False), (True, True)}
+
+
+@pytest.mark.parametrize("m", [1, 3])
+def test_candidates_given_their_validity_are_not_checked_again_and_get_the_same_verdicts(checker, robot, rng, m) -> None:
+    """``valid`` (the look-ahead checked the states already): an invalid candidate costs no check, a valid one
+    only its motions', and every verdict is the one the candidates checked here get."""
+    good, bad = valid_and_colliding(robot, rng, 400)
+    yes = np.ones(m, dtype=bool)
+    for k in range(0, 60, m):
+        A, B = good[k : k + m], good[200 + k : 200 + k + m]
+        C = 0.5 * (A + B) + 0.05 * rng.standard_normal((m, robot.nq))
+        if k % 4 == 0:
+            C[0] = bad[k]
+        own = checker.candidates(C, A, B, yes, yes, yes)
+        valid = robot.are_valid(C)
+        before = checker.counter()
+        given = checker.candidates(C, A, B, yes, yes, yes, valid)
+        checks = checker.counter() - before
+        for a, b in zip(own, given):
+            np.testing.assert_array_equal(a, b)
+        if m == 1 and not given[0][0]:
+            assert checks == 0

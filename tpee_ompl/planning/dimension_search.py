@@ -367,7 +367,8 @@ class Search(SampleDraws):
             return 0
         ts = np.flatnonzero(shorter)
         yes = np.ones(len(ts), dtype=bool)
-        vc, left, right = self.checker.candidates(C[ts], A[ts], B[ts], yes, yes, yes)
+        C = C[ts]
+        vc, left, right = self.checker.candidates(C, A[ts], B[ts], yes, yes, yes, self.hit_validity(C))
         ok = vc & left & right
         accepted = 0
         last = -2
@@ -375,7 +376,7 @@ class Search(SampleDraws):
             t = int(ts[k]) + 1
             if t == last + 1:
                 continue
-            W[t] = C[t - 1]
+            W[t] = C[k]
             L[t - 1], L[t] = dl[t - 1], dr[t - 1]
             accepted += 1
             last = t

@@ -263,13 +263,15 @@ class Checker:
         return ok
 
     def candidates(
-        self, C: np.ndarray, A: np.ndarray, B: np.ndarray, left_known: np.ndarray, right_known: np.ndarray, strict: np.ndarray
+        self, C: np.ndarray, A: np.ndarray, B: np.ndarray, left_known: np.ndarray, right_known: np.ndarray,
+        strict: np.ndarray, valid: np.ndarray | None = None,
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Evaluate candidate waypoints C (m, n) between neighbours A and B (m, n).
 
         ``left_known[k]`` / ``right_known[k]`` false means that neighbour is invalid, so that motion is
         invalid without a check.  For ``strict[k]`` candidates only all-valid matters, so the motions are
-        not finished once one fails.  Returns validity of C, of A->C and of C->B (ends incl.).
+        not finished once one fails.  ``valid``: the validity of C when it was checked already (not
+        checked again).  Returns validity of C, of A->C and of C->B (ends incl.).
         """
         m = len(C)
         if m == 1 and self._first_invalid is not None and self._check_motions is not None \
@@ -278,14 +280,14 @@ class Checker:
             # even built when it collides), then its motions' screen in bisection order, stopping at the
             # first failure; the motions in full if none
             no = np.zeros(1, dtype=bool)
-            if self.first_invalid(C) >= 0:
+            if (self.first_invalid(C) >= 0) if valid is None else not valid[0]:
                 return no, no, no
             A2, B2 = np.concatenate((A, C)), np.concatenate((C, B))
             if self.first_invalid(self._screen(A2, B2, bisect=True, stride=_CANDIDATE_STRIDE)[0]) >= 0:
                 return ~no, no, no
             ok = self.check_motions(A2, B2)
             return np.ones(1, dtype=bool), ok[:1], ok[1:]
-        vc = self.states(C) if not self.batched else None
+        vc = self.states(C) if not self.batched and valid is None else valid
         if self.batched:
             # pass 1: candidate states + every 16th interior state of motions whose other end is valid
             # (only those built when the validator checks the motions itself in pass 2)
@@ -293,8 +295,11 @@ class Checker:
             SL, iL, jL = self.interior(A, C, stride)
             SR, iR, jR = self.interior(C, B, stride)
             cL, cR = (jL % _COARSE_STRIDE == 0) & left_known[iL], (jR % _COARSE_STRIDE == 0) & right_known[iR]
-            ok = self.states(np.concatenate([C, SL[cL], SR[cR]]))
-            vc = ok[:m]
+            if valid is None:
+                ok = self.states(np.concatenate([C, SL[cL], SR[cR]]))
+                vc = ok[:m]
+            else:
+                ok = np.concatenate((valid, self.states(np.concatenate([SL[cL], SR[cR]]))))
             nl = int(cL.sum())
             badL = np.bincount(iL[cL][~ok[m : m + nl]], minlength=m) > 0
             badR = np.bincount(iR[cR][~ok[m + nl :]], minlength=m) > 0
