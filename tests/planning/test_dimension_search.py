@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import itertools
+from collections.abc import Iterator
 
 import numpy as np
 import pytest
@@ -171,8 +172,11 @@ def test_cost_test_run_ahead_passes_over_the_same_samples_as_one_sample_per_call
 @pytest.mark.parametrize("local", [False, True])
 def test_hits_checked_together_give_the_paths_of_hits_checked_one_by_one(local: bool, monkeypatch: pytest.MonkeyPatch) -> None:
     """A group of every DOF: the look-ahead checks the states of the samples its cost test lets through in one
-    call, and the candidates come with that validity; the path after every call is the one each sample checked
-    on its own gives."""
+    call; the candidates come with that validity, and the samples whose state collides are passed over with
+    the ones the cost test rejects.  The path after every call is the one each sample drawn and checked on its
+    own, one per call, gives after as many samples, with the hits' check and without it (the sweep due on a
+    new path runs after the same sample: with seed 5 and ``local=False`` a call used to pass over samples
+    tested against the path before that sweep)."""
     si, _ = box_problem(lo=(-0.2, -1.0), hi=(0.2, 0.6))
     grouped = GroupedSpace(si, [[0, 1]], 7)
     start, goal = np.array([-0.8, 0.0]), np.array([0.8, 0.0])
@@ -185,24 +189,30 @@ def test_hits_checked_together_give_the_paths_of_hits_checked_one_by_one(local: 
 
     monkeypatch.setattr(Checker, "candidates", recorded)
 
-    def trace() -> list[tuple[int, bytes]]:
+    def trace(limits: Iterator[int]) -> tuple[list[tuple[int, bytes]], int]:
         search = Search(grouped, Checker(si, grouped.layout, True), np.random.default_rng(5), start, goal,
                         narrow_after=50, narrowing=0.5, range_={0: np.full(2, 0.02)}, local=local, shortcuts=True)
-        out, limits = [], itertools.cycle([1, 64, 7, 200, 2])
+        out, calls = [], 0
         while search.samples < 3000:
             search.iterate(min(next(limits), 3000 - search.samples))
             out.append((search.samples, search.W.tobytes()))
+            calls += 1
         assert search.valid
-        return out
+        return out, calls
 
-    together = trace()
+    together, calls = trace(itertools.cycle([1, 64, 7, 200, 2]))
     assert sum(given) > 20
     with monkeypatch.context() as m:
         m.setattr(search_draws.SampleDraws, "_hit_states", lambda self, S, last: {})
         given.clear()
-        alone = trace()
+        mixed, mixed_calls = trace(itertools.cycle([1, 64, 7, 200, 2]))
+        alone, _ = trace(itertools.repeat(1))
         assert not any(given)
-    assert together == alone and len({w for _, w in together}) > 5  # the path changed several times
+    seen = dict(alone)
+    assert all(seen[n] == w for n, w in mixed), "mixed"
+    assert all(seen[n] == w for n, w in together), "together"
+    assert together[-1] == alone[-1] and len({w for _, w in alone}) > 5  # the path changed several times
+    assert calls < mixed_calls  # the colliding samples were passed over
 
 
 @pytest.mark.parametrize("local", [True, False])

@@ -101,7 +101,8 @@ class Search(SampleDraws):
         if self._spread_pending:
             self._spread()
         valid = self.valid
-        if limit > 1 and valid:
+        if limit > 1 and valid and not (self._shortcuts and self._shortcut_due):
+            # (a sweep due runs after the next sample: the samples after it are tested against the swept path)
             self._pass_rejected(limit - 1)
         gi = self.current_group()
         if not valid and self._tree is None and self._connect is None:

@@ -40,6 +40,7 @@ class _Ahead(NamedTuple):
     n0: int | None  # their narrowing start
     hits: np.ndarray  # indices into C of the samples shorter at some step
     valid: dict[bytes, bool]  # validity of the hits' candidate states (their bytes), checked together
+    live: np.ndarray  # the hits not known to be invalid states
 
 
 class SampleDraws:
@@ -152,7 +153,9 @@ class SampleDraws:
 
     def _pass_rejected(self, limit: int) -> None:
         """Advance past the next samples (at most ``limit``, within the group's block and the random buffer)
-        that :meth:`_improve` would reject on cost alone: :meth:`draw` and its cost test, vectorised.
+        that :meth:`_improve` would reject on cost alone: :meth:`draw` and its cost test, vectorised; with a
+        group of every DOF also those whose state the look-ahead found invalid (:meth:`_hit_states`).  Not
+        called while a shortcut sweep is due (:meth:`Search.iterate`): it runs after the next sample.
 
         The test runs ahead over up to :data:`AHEAD` samples (one planned group; with several, to the end
         of the group's block) and is kept while W stays the same: most samples are passed over, so later
@@ -162,7 +165,9 @@ class SampleDraws:
         block = self._ui + GROUP_BLOCK - self.samples % GROUP_BLOCK  # the group's block ends there
         n = min(limit, min(block, len(self._uniform)) - self._ui)
         while n > 0:
-            _, u0, C, n0, hits, _ = self._ahead_test(gi, block)
+            ahead = self._ahead_test(gi, block)
+            u0, C, n0 = ahead.start, ahead.C, ahead.n0
+            hits = ahead.live  # a hit whose state collides is rejected too
             g0, o = self.group_samples[gi], self._ui - u0
             m = min(n, len(C) - o)
             i = int(np.searchsorted(hits, o))
@@ -193,18 +198,20 @@ class SampleDraws:
         shorter = self.dist(W[:-2], X) + self.dist(X, W[2:]) < L[:-1] + L[1:] - 1e-12
         hits = np.flatnonzero(shorter.any(axis=1))
         valid = self._hit_states(C[hits], ahead) if len(d) == W.shape[1] else {}
-        self._ahead = _Ahead(key, self._ui, C, n0, hits, valid)
+        live = hits[[valid[c.tobytes()] for c in C[hits]]] if valid else hits
+        self._ahead = _Ahead(key, self._ui, C, n0, hits, valid, live)
         return self._ahead
 
     def _hit_states(self, S: np.ndarray, last: _Ahead | None) -> dict[bytes, bool]:
         """Validity of the hits' samples S by their bytes, in one batched call, for a group of every DOF (a
         sample is then the candidate state at every step, whatever W is): :meth:`_improve` would check
         each hit on its own, one call per sample.  With a batched checker only; the states known from the
-        last look-ahead are not checked again.  Library pipeline, 24 ``planning_necessary`` queries capped
-        at 5,000 / 20,000 samples: the same paths in 0.95 / 0.93 of the time, 2 % more checks (the hits
-        after a shorter path are checked but not all tried; ``experiments/speed_switches.py hit-states``).
-        With a group of some DOFs a shorter path changes the candidates of the later hits (tried on the
-        paper's planner: 1.02-1.06x the time), so not there."""
+        last look-ahead are not checked again.  :meth:`_pass_rejected` then passes over the hits whose state
+        collides as over those the cost test rejects.  Library pipeline, 24 ``planning_necessary`` queries
+        capped at 5,000 / 20,000 samples: the same paths in 0.89 / 0.81 of the time, 2 % more checks (the
+        hits after a shorter path are checked but not all tried; ``experiments/speed_switches.py
+        hit-states``).  With a group of some DOFs a shorter path changes the candidates of the later hits
+        (tried on the paper's planner: 1.02-1.06x the time), so not there."""
         if not len(S) or not self.checker.batched:
             return {}
         known = last.valid if last is not None else {}
