@@ -5,6 +5,7 @@
     PYTHONPATH=. .venv/bin/python experiments/speed_switches.py candidate-stride --values 16 8 4 2
     PYTHONPATH=. .venv/bin/python experiments/speed_switches.py candidate-stride --planner paper --samples 2500
     PYTHONPATH=. .venv/bin/python experiments/speed_switches.py hit-states --samples 20000 --reps 1
+    PYTHONPATH=. .venv/bin/python experiments/speed_switches.py candidate-order --samples 20000 --reps 1
 
 Switches (scratch settings of the installed code; the first value is the reference):
 
@@ -20,6 +21,9 @@ Switches (scratch settings of the installed code; the first value is the referen
 * ``hit-states`` (``on``, ``off``): with a group of every DOF (the released search) the look-ahead checks the
   states of the samples its cost test lets through in one call (``SampleDraws._hit_states``, the package);
   ``off``: each is checked when its turn comes, one call per sample (before 2026-11-26).
+* ``candidate-order`` (``nearest``, ``bisect``): the screen of one candidate's motions with the states
+  nearest the last colliding state found first (``Checker._candidate_screen``, the package), or always
+  longest stretch first (before 2026-11-26).
 
 Each run is capped at ``--samples``, so every setting draws the same samples; the paths must be the same
 (their states' bytes compared, and printed).  Settings alternate per query.  Prints the total time, the collision checks and
@@ -72,10 +76,23 @@ def _hit_states(value: str) -> None:
     search_draws.SampleDraws._hit_states = _HIT_STATES if value == "on" else (lambda self, S, last: {})
 
 
+_NEAREST = search_checker.Checker._candidate_screen
+
+
+def _bisect(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
+    """``_candidate_screen`` as before 2026-11-26: longest stretch first, whatever collided last."""
+    return self._screen(A, B, bisect=True, stride=search_checker._CANDIDATE_STRIDE)[0]
+
+
+def _candidate_order(value: str) -> None:
+    search_checker.Checker._candidate_screen = _NEAREST if value == "nearest" else _bisect
+
+
 SWITCHES: dict[str, tuple[Callable[[str], None], list[str]]] = {
     "look-ahead": (_look_ahead, ["on", "off"]),
     "candidate-stride": (_candidate_stride, ["4", "16"]),
     "hit-states": (_hit_states, ["on", "off"]),
+    "candidate-order": (_candidate_order, ["nearest", "bisect"]),
 }
 
 
@@ -120,7 +137,7 @@ def main(argv: list[str] | None = None) -> None:
     print(f"{args.switch}, {args.planner}, {len(rows)} queries x {args.reps}, {args.samples} samples per run:")
     for v in values:
         same = "same paths" if paths[v] == paths[ref] else "PATHS DIFFER"
-        print(f"  {v:>4}: {total[v]:6.2f} s  ratio {total[v] / total[ref]:.3f}  checks {checks[v]}  {same}")
+        print(f"  {v:>7}: {total[v]:6.2f} s  ratio {total[v] / total[ref]:.3f}  checks {checks[v]}  {same}")
 
 
 if __name__ == "__main__":

@@ -122,3 +122,29 @@ def test_candidates_given_their_validity_are_not_checked_again_and_get_the_same_
             np.testing.assert_array_equal(a, b)
         if m == 1 and not given[0][0]:
             assert checks == 0
+
+
+def test_a_candidate_screen_checks_first_where_the_last_screen_found_a_collision(robot, rng) -> None:
+    """The screen of a lone candidate's motions starts with the state nearest the last colliding state a
+    screen found: the same candidate again costs its own check and one state, with the same verdict."""
+    si = make_simple_setup(robot).getSpaceInformation()
+    checker = Checker(si, GroupedSpace(si, [[0, 1], [2, 3]], 7).layout, batch=True)
+    good, _ = valid_and_colliding(robot, rng, 600)
+    one = np.ones(1, dtype=bool)
+    found = 0
+    for k in range(300):
+        A, B = good[k : k + 1], good[300 + k : 301 + k]
+        C = 0.5 * (A + B) + 0.1 * rng.standard_normal((1, robot.nq))
+        if not robot.are_valid(C)[0] or checker.check_motion(A[0], C[0]) and checker.check_motion(C[0], B[0]):
+            continue
+        first = checker.candidates(C, A, B, one, one, one)
+        before = checker.counter()
+        again = checker.candidates(C, A, B, one, one, one)
+        if checker.counter() - before > 2:  # a thin obstacle between screened states: the full check found it
+            continue
+        assert checker.counter() - before == 2
+        for a, b in zip(first, again):
+            np.testing.assert_array_equal(a, b)
+        assert not (again[1][0] and again[2][0])
+        found += 1
+    assert found >= 5
