@@ -229,6 +229,41 @@ def test_stall_samples_stop_a_converged_run_before_its_cap(robot: WearerArm) -> 
         tpee_dimension_rrt(ss.getSpaceInformation(), 1, 2, stall_samples=0)
 
 
+def test_released_wearer_search_gives_one_path_whatever_the_call_sizes_and_speed_switches(
+        robot: WearerArm, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The released search on the wearer (one group of every DOF, the lone candidates' screens, the hits'
+    states checked ahead, sweeps): the same capped path with one sample per call, with sample checkpoints
+    every 37 samples, with the hits' check off and with the screen in bisection order."""
+    from tpee_ompl.planning import dimension_rrt, search_checker, search_draws
+
+    q = load_queries("planning_necessary")[1]
+    ss = make_simple_setup(robot, q.start, q.goal)
+
+    def path(checkpoints: bool = False) -> np.ndarray:
+        planner = tpee_dimension_rrt(ss.getSpaceInformation(), q.from_sector, q.to_sector, max_samples=2500,
+                                     seed=2, release_after=50)
+        if checkpoints:
+            planner.set_sample_checkpoints(range(37, 2500, 37))
+        ss.clear()
+        ss.setPlanner(planner)
+        assert ss.solve(60.0) == ob.PlannerStatus.EXACT_SOLUTION
+        assert planner.last_run_stats()["released_at"] is not None
+        return path_to_array(ss.getSolutionPath(), robot.nq)
+
+    ref = path()
+    np.testing.assert_array_equal(path(checkpoints=True), ref)
+    with monkeypatch.context() as m:
+        m.setattr(search_draws.SampleDraws, "_hit_states", lambda self, S, last: {})
+        np.testing.assert_array_equal(path(), ref)
+    with monkeypatch.context() as m:
+        m.setattr(search_checker.Checker, "_candidate_screen",
+                  lambda self, A, B: self._screen(A, B, bisect=True, stride=search_checker._CANDIDATE_STRIDE)[0])
+        np.testing.assert_array_equal(path(), ref)
+    with monkeypatch.context() as m:
+        m.setattr(dimension_rrt, "_PASS_BATCH", 1)
+        np.testing.assert_array_equal(path(), ref)
+
+
 def test_termination_condition_is_asked_at_each_sample_checkpoint_and_between_batches(robot: WearerArm) -> None:
     q = load_queries("planning_necessary")[1]
     ss = make_simple_setup(robot, q.start, q.goal)

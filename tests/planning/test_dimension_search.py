@@ -169,8 +169,10 @@ def test_cost_test_run_ahead_passes_over_the_same_samples_as_one_sample_per_call
     assert many.narrow_start == one.narrow_start and many.group_samples == one.group_samples
 
 
+@pytest.mark.parametrize("group", [[0, 1], [1, 0]])
 @pytest.mark.parametrize("local", [False, True])
-def test_hits_checked_together_give_the_paths_of_hits_checked_one_by_one(local: bool, monkeypatch: pytest.MonkeyPatch) -> None:
+def test_hits_checked_together_give_the_paths_of_hits_checked_one_by_one(
+        local: bool, group: list[int], monkeypatch: pytest.MonkeyPatch) -> None:
     """A group of every DOF: the look-ahead checks the states of the samples its cost test lets through in one
     call; the candidates come with that validity, and the samples whose state collides are passed over with
     the ones the cost test rejects.  The path after every call is the one each sample drawn and checked on its
@@ -178,7 +180,7 @@ def test_hits_checked_together_give_the_paths_of_hits_checked_one_by_one(local: 
     new path runs after the same sample: with seed 5 and ``local=False`` a call used to pass over samples
     tested against the path before that sweep)."""
     si, _ = box_problem(lo=(-0.2, -1.0), hi=(0.2, 0.6))
-    grouped = GroupedSpace(si, [[0, 1]], 7)
+    grouped = GroupedSpace(si, [group], 7)  # [1, 0]: the group's values are the state's in another order
     start, goal = np.array([-0.8, 0.0]), np.array([0.8, 0.0])
     given = []
     candidates = Checker.candidates

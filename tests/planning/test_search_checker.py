@@ -104,8 +104,8 @@ def test_one_strict_candidate_is_valid_exactly_when_it_and_both_its_motions_pass
 
 @pytest.mark.parametrize("m", [1, 3])
 def test_candidates_given_their_validity_are_not_checked_again_and_get_the_same_verdicts(checker, robot, rng, m) -> None:
-    """``valid`` (the look-ahead checked the states already): an invalid candidate costs no check, a valid one
-    only its motions', and every verdict is the one the candidates checked here get."""
+    """``valid`` (the look-ahead checked the states already): an invalid lone candidate costs no check, and
+    every verdict is the one the candidates checked here get."""
     good, bad = valid_and_colliding(robot, rng, 400)
     yes = np.ones(m, dtype=bool)
     for k in range(0, 60, m):

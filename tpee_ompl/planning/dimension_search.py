@@ -94,7 +94,9 @@ class Search(SampleDraws):
         0 otherwise).
 
         With ``limit > 1`` on a valid path, up to ``limit - 1`` samples that the cost test rejects at
-        every step are first passed over in one vectorised step; in the connect trees, up to ``limit``
+        every step (with a group of every DOF, also those whose state the look-ahead found colliding) are
+        first passed over in one vectorised step, unless a shortcut sweep is due (it runs after the next
+        sample, and the samples after it are tested against the swept path); in the connect trees, up to ``limit``
         samples go through in one call, until the trees meet or ``stop()`` (asked before each sample
         after the first): either way the same samples and result as single calls.
         """

@@ -185,8 +185,7 @@ class Checker:
         the verdicts are the same.  A converged path lies against an obstacle, and its shorter candidates
         poke into it where the last one did: on 959 screens of the released search, replayed, 4.0 states
         checked per screen against 8.4 in bisection order, 37 against 71 us (``experiments/speed_switches.py
-        candidate-order`` times it in runs).  The distance is Euclidean in the coordinates, SO2 entries
-        included: an order, not a metric."""
+        candidate-order`` times it in runs)."""
         if self._collision is None:
             return self._screen(A, B, bisect=True, stride=_CANDIDATE_STRIDE)[0]
         S = self.interior(A, B, _CANDIDATE_STRIDE)[0]
@@ -312,8 +311,8 @@ class Checker:
             return np.ones(1, dtype=bool), ok[:1], ok[1:]
         vc = self.states(C) if not self.batched and valid is None else valid
         if self.batched:
-            # pass 1: candidate states + every 16th interior state of motions whose other end is valid
-            # (only those built when the validator checks the motions itself in pass 2)
+            # pass 1: candidate states (unless ``valid`` gives them) + every 16th interior state of motions
+            # whose other end is valid (only those built when the validator checks the motions itself in pass 2)
             stride = 1 if self._check_motions is None else _COARSE_STRIDE
             SL, iL, jL = self.interior(A, C, stride)
             SR, iR, jR = self.interior(C, B, stride)

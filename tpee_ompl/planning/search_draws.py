@@ -6,7 +6,9 @@ samples of a group, 90 % are drawn from the bounding box of the current path's v
 (released: of one waypoint's), padded by ``max(range_, span * narrowing ** (m / 100))``, the rest
 uniformly over the bounds.  On a valid path most samples are shorter at no step; :meth:`SampleDraws._pass_rejected`
 passes over them with one vectorised cost test, run ahead over up to :data:`AHEAD` samples and kept while
-the path stays the same (the same samples, in the same calls, as drawing them one by one).
+the path stays the same, and with a group of every DOF also over the samples whose state the look-ahead
+found colliding (:meth:`SampleDraws._hit_states`): the same samples, and the same paths, as drawing them
+one by one.
 """
 
 from __future__ import annotations
@@ -38,9 +40,8 @@ class _Ahead(NamedTuple):
     start: int  # the buffer row of C[0]
     C: np.ndarray  # the samples
     n0: int | None  # their narrowing start
-    hits: np.ndarray  # indices into C of the samples shorter at some step
     valid: dict[bytes, bool]  # validity of the hits' candidate states (their bytes), checked together
-    live: np.ndarray  # the hits not known to be invalid states
+    live: np.ndarray  # indices into C of the samples shorter at some step whose state is not known to collide
 
 
 class SampleDraws:
@@ -166,8 +167,7 @@ class SampleDraws:
         n = min(limit, min(block, len(self._uniform)) - self._ui)
         while n > 0:
             ahead = self._ahead_test(gi, block)
-            u0, C, n0 = ahead.start, ahead.C, ahead.n0
-            hits = ahead.live  # a hit whose state collides is rejected too
+            u0, C, n0, hits = ahead.start, ahead.C, ahead.n0, ahead.live
             g0, o = self.group_samples[gi], self._ui - u0
             m = min(n, len(C) - o)
             i = int(np.searchsorted(hits, o))
@@ -197,20 +197,25 @@ class SampleDraws:
         X[:, :, d] = C[:, None, :]
         shorter = self.dist(W[:-2], X) + self.dist(X, W[2:]) < L[:-1] + L[1:] - 1e-12
         hits = np.flatnonzero(shorter.any(axis=1))
-        valid = self._hit_states(C[hits], ahead) if len(d) == W.shape[1] else {}
-        live = hits[[valid[c.tobytes()] for c in C[hits]]] if valid else hits
-        self._ahead = _Ahead(key, self._ui, C, n0, hits, valid, live)
+        valid: dict[bytes, bool] = {}
+        if len(d) == W.shape[1] and len(hits):  # the candidate at every step is the sample, in the DOFs' order
+            S = np.empty((len(hits), len(d)))
+            S[:, d] = C[hits]
+            valid = self._hit_states(S, ahead)
+            hits = hits[[valid[s.tobytes()] for s in S]] if valid else hits
+        self._ahead = _Ahead(key, self._ui, C, n0, valid, hits)
         return self._ahead
 
     def _hit_states(self, S: np.ndarray, last: _Ahead | None) -> dict[bytes, bool]:
-        """Validity of the hits' samples S by their bytes, in one batched call, for a group of every DOF (a
-        sample is then the candidate state at every step, whatever W is): :meth:`_improve` would check
+        """Validity of the hits' candidate states S by their bytes, in one batched call, for a group of every DOF
+        (a sample is then the candidate state at every step, whatever W is): :meth:`_improve` would check
         each hit on its own, one call per sample.  With a batched checker only; the states known from the
         last look-ahead are not checked again.  :meth:`_pass_rejected` then passes over the hits whose state
         collides as over those the cost test rejects.  Library pipeline, 24 ``planning_necessary`` queries
         capped at 5,000 / 20,000 samples: the same paths in 0.89 / 0.81 of the time, 2 % more checks (the
         hits after a shorter path are checked but not all tried; ``experiments/speed_switches.py
-        hit-states``).  With a group of some DOFs a shorter path changes the candidates of the later hits
+        hit-states``).  The check runs ahead of the samples drawn, so a run capped at N samples may count
+        checks of a few hits after the N-th.  With a group of some DOFs a shorter path changes the candidates of the later hits
         (tried on the paper's planner: 1.02-1.06x the time), so not there."""
         if not len(S) or not self.checker.batched:
             return {}
