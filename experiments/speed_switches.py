@@ -5,7 +5,7 @@
     PYTHONPATH=. .venv/bin/python experiments/speed_switches.py candidate-stride --values 16 8 4 2
     PYTHONPATH=. .venv/bin/python experiments/speed_switches.py candidate-stride --planner paper --samples 2500
     PYTHONPATH=. .venv/bin/python experiments/speed_switches.py hit-states --samples 20000 --reps 1
-    PYTHONPATH=. .venv/bin/python experiments/speed_switches.py candidate-order --samples 20000 --reps 1
+    PYTHONPATH=. .venv/bin/python experiments/speed_switches.py screen-order --samples 20000 --reps 1
 
 Switches (scratch settings of the installed code; the first value is the reference):
 
@@ -21,9 +21,11 @@ Switches (scratch settings of the installed code; the first value is the referen
 * ``hit-states`` (``on``, ``off``): with a group of every DOF (the released search) the look-ahead checks the
   states of the samples its cost test lets through in one call (``SampleDraws._hit_states``, the package);
   ``off``: each is checked when its turn comes, one call per sample (before 2026-11-26).
-* ``candidate-order`` (``nearest``, ``bisect``): the screen of one candidate's motions with the states
-  nearest the last colliding state found first (``Checker._candidate_screen``, the package), or always
-  longest stretch first (before 2026-11-26).
+* ``screen-order`` (``nearest``, ``bisect``): the screens in bisection order check the states nearest the
+  last colliding state a screen found first (``search_checker._NEAREST_FIRST``, the package), or always
+  longest stretch first (before 2026-11-26).  A lone candidate's verdict is the same either way; a
+  candidate path of the feasibility phase may report another failing motion, so with a search that has no
+  valid path at first the paths may differ (then ``PATHS DIFFER`` is expected).
 
 Each run is capped at ``--samples``, so every setting draws the same samples; the paths must be the same
 (their states' bytes compared, and printed).  Settings alternate per query.  Prints the total time, the collision checks and
@@ -76,23 +78,15 @@ def _hit_states(value: str) -> None:
     search_draws.SampleDraws._hit_states = _HIT_STATES if value == "on" else (lambda self, S, last: {})
 
 
-_NEAREST = search_checker.Checker._candidate_screen
-
-
-def _bisect(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
-    """``_candidate_screen`` as before 2026-11-26: longest stretch first, whatever collided last."""
-    return self._screen(A, B, bisect=True, stride=search_checker._CANDIDATE_STRIDE)[0]
-
-
-def _candidate_order(value: str) -> None:
-    search_checker.Checker._candidate_screen = _NEAREST if value == "nearest" else _bisect
+def _screen_order(value: str) -> None:
+    search_checker._NEAREST_FIRST = value == "nearest"
 
 
 SWITCHES: dict[str, tuple[Callable[[str], None], list[str]]] = {
     "look-ahead": (_look_ahead, ["on", "off"]),
     "candidate-stride": (_candidate_stride, ["4", "16"]),
     "hit-states": (_hit_states, ["on", "off"]),
-    "candidate-order": (_candidate_order, ["nearest", "bisect"]),
+    "screen-order": (_screen_order, ["nearest", "bisect"]),
 }
 
 

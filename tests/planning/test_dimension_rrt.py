@@ -229,12 +229,12 @@ def test_stall_samples_stop_a_converged_run_before_its_cap(robot: WearerArm) -> 
         tpee_dimension_rrt(ss.getSpaceInformation(), 1, 2, stall_samples=0)
 
 
-def test_released_wearer_search_gives_one_path_whatever_the_call_sizes_and_speed_switches(
+def test_released_wearer_search_gives_one_path_whatever_the_call_sizes_and_the_hits_check(
         robot: WearerArm, monkeypatch: pytest.MonkeyPatch) -> None:
     """The released search on the wearer (one group of every DOF, the lone candidates' screens, the hits'
     states checked ahead, sweeps): the same capped path with one sample per call, with sample checkpoints
-    every 37 samples, with the hits' check off and with the screen in bisection order."""
-    from tpee_ompl.planning import dimension_rrt, search_checker, search_draws
+    every 37 samples and with the hits' check off."""
+    from tpee_ompl.planning import dimension_rrt, search_draws
 
     q = load_queries("planning_necessary")[1]
     ss = make_simple_setup(robot, q.start, q.goal)
@@ -254,10 +254,6 @@ def test_released_wearer_search_gives_one_path_whatever_the_call_sizes_and_speed
     np.testing.assert_array_equal(path(checkpoints=True), ref)
     with monkeypatch.context() as m:
         m.setattr(search_draws.SampleDraws, "_hit_states", lambda self, S, last: {})
-        np.testing.assert_array_equal(path(), ref)
-    with monkeypatch.context() as m:
-        m.setattr(search_checker.Checker, "_candidate_screen",
-                  lambda self, A, B: self._screen(A, B, bisect=True, stride=search_checker._CANDIDATE_STRIDE)[0])
         np.testing.assert_array_equal(path(), ref)
     with monkeypatch.context() as m:
         m.setattr(dimension_rrt, "_PASS_BATCH", 1)

@@ -24,9 +24,12 @@ _COARSE_STRIDE = 16
 """First pass over a motion checks every 16th interior state (collisions span many states): 8 until
 2026-11-25; 16 took 5 % less time to a first path at home (320-340 checks either way) and 26 % less on
 the Panda shelf (7,719 -> 5,741 checks), with Table 4 unchanged; 32 was no better, 64 had a longer tail."""
+_NEAREST_FIRST = True
+"""Screens in bisection order check the states nearest the last collision a screen found first
+(:meth:`Checker._screen`); False: bisection order only (before 2026-11-26; a switch for experiments)."""
 _CANDIDATE_STRIDE = 4
 """The improvement phase's screen of one candidate's two motions checks every 4th interior state (nearest
-the last collision first, :meth:`Checker._candidate_screen`, up to the first failure) before the validator
+the last collision first, :meth:`Checker._screen`, up to the first failure) before the validator
 checks them in full: a shortening candidate pokes into an obstacle by little, and with every 16th state
 two thirds of the full checks failed.  Same
 verdicts; 16 -> 4 took 0.90 of the time for the library pipeline (5,000 samples per run, 25 % fewer
@@ -107,7 +110,7 @@ class Checker:
         self.passed: set[bytes] = set()
         """Keys (:func:`segment_key`) of the motions that passed ``si.checkMotion`` here."""
         self._collision: np.ndarray | None = None
-        """The last colliding state a single candidate's screen found (:meth:`_candidate_screen`)."""
+        """The last colliding state a screen found (:meth:`_screen` checks its nearest states first)."""
 
     def counter(self) -> int:
         """Configurations checked so far (the robot's counter when available, else our own count)."""
@@ -160,14 +163,30 @@ class Checker:
             return -1
         S, idx = self._screen(A, B, bisect, starts)
         i = self.first_invalid(S)
-        return -1 if i < 0 else int(idx[i])
+        if i < 0:
+            return -1
+        self._collision = S[i].copy()
+        return int(idx[i])
 
     def _screen(self, A: np.ndarray, B: np.ndarray, bisect: bool, starts: bool = False,
                 stride: int | None = None) -> tuple[np.ndarray, np.ndarray]:
         """The states of a screen (every ``stride``-th interior state, default :data:`_COARSE_STRIDE`) in
-        :meth:`first_failing_motion`'s order, and the motion of each."""
+        :meth:`first_failing_motion`'s order, and the motion of each.
+
+        ``bisect`` (without ``starts``) once a screen has found a colliding state: nearest that state first
+        instead.  Only the order of the checks depends on it, and the screen stops at the first failure:
+        candidates tend to poke into the obstacle where the last one did.  A lone candidate of the
+        improvement phase fails its screen with the same verdict (the screen fails when any of its states
+        collides); a candidate path may report another of its failing motions.  Measured: on 959 screens of
+        the released search, replayed, 4.0 states checked per screen against 8.4 in bisection order (37
+        against 71 us); on the 734 screens of 120 first paths at home, 6.0 against 9.2; in runs
+        ``experiments/speed_switches.py screen-order``."""
         K = len(A)
         S, idx, j = self.interior(A, B, stride or _COARSE_STRIDE)  # in motion order, then step order
+        if bisect and not starts and self._collision is not None and _NEAREST_FIRST:
+            D = S - self._collision
+            order = np.argsort(np.einsum("ij,ij->i", D, D), kind="stable")
+            return S[order], idx[order]
         if bisect and len(idx):
             j = _longest_stretch_key(_screen_levels(idx, K), self.layout.distance(A, B)[idx])
         if starts:  # each motion's start before its interior states
@@ -175,22 +194,6 @@ class Checker:
             j = np.concatenate((np.full(K, -np.inf), j))
         order = np.lexsort((idx, j)) if bisect else np.lexsort((j, idx))
         return S[order], idx[order]
-
-    def _candidate_screen(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
-        """Every :data:`_CANDIDATE_STRIDE`-th interior state of a candidate's two motions A[k] -> B[k], those
-        nearest the last colliding state a screen found first (before any: :meth:`first_failing_motion`'s
-        bisection order).
-
-        Only the order of the checks depends on it (the screen fails when any of its states collides), so
-        the verdicts are the same.  A converged path lies against an obstacle, and its shorter candidates
-        poke into it where the last one did: on 959 screens of the released search, replayed, 4.0 states
-        checked per screen against 8.4 in bisection order, 37 against 71 us (``experiments/speed_switches.py
-        candidate-order`` times it in runs)."""
-        if self._collision is None:
-            return self._screen(A, B, bisect=True, stride=_CANDIDATE_STRIDE)[0]
-        S = self.interior(A, B, _CANDIDATE_STRIDE)[0]
-        D = S - self._collision
-        return S[np.argsort(np.einsum("ij,ij->i", D, D), kind="stable")]
 
     def interior(self, A: np.ndarray, B: np.ndarray, stride: int = 1) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Interior states of motions A[k] -> B[k]: (states (M, n), motion index (M,), step index j >= 1;
@@ -296,13 +299,13 @@ class Checker:
         if m == 1 and self._first_invalid is not None and self._check_motions is not None \
                 and bool(strict[0] and left_known[0] and right_known[0]):
             # one strict candidate (the improvement phase's usual case): the candidate (the screen is not
-            # even built when it collides), then its motions' screen (:meth:`_candidate_screen`), stopping at
-            # the first failure; the motions in full if none
+            # even built when it collides), then its motions' screen (:meth:`_screen`), stopping at the first
+            # failure; the motions in full if none
             no = np.zeros(1, dtype=bool)
             if (self.first_invalid(C) >= 0) if valid is None else not valid[0]:
                 return no, no, no
             A2, B2 = np.concatenate((A, C)), np.concatenate((C, B))
-            S = self._candidate_screen(A2, B2)
+            S = self._screen(A2, B2, bisect=True, stride=_CANDIDATE_STRIDE)[0]
             i = self.first_invalid(S)
             if i >= 0:
                 self._collision = S[i].copy()
