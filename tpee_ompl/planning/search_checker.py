@@ -178,9 +178,9 @@ class Checker:
         candidates tend to poke into the obstacle where the last one did.  A lone candidate of the
         improvement phase fails its screen with the same verdict (the screen fails when any of its states
         collides); a candidate path may report another of its failing motions.  Measured: on 959 screens of
-        the released search, replayed, 4.0 states checked per screen against 8.4 in bisection order (37
-        against 71 us); on the 734 screens of 120 first paths at home, 6.0 against 9.2; in runs
-        ``experiments/speed_switches.py screen-order``."""
+        the library pipeline's improvement phase, replayed, 4.0 states checked per screen against 8.4 in
+        bisection order (37 against 71 us); on the 734 screens of 120 first paths at home, 6.0 against 9.2;
+        in runs ``experiments/speed_switches.py screen-order``."""
         K = len(A)
         S, idx, j = self.interior(A, B, stride or _COARSE_STRIDE)  # in motion order, then step order
         if bisect and not starts and self._collision is not None and _NEAREST_FIRST:
