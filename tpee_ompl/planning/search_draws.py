@@ -215,8 +215,8 @@ class SampleDraws:
         capped at 5,000 / 20,000 samples: the same paths in 0.89 / 0.81 of the time, 2 % more checks (the
         hits after a shorter path are checked but not all tried; ``experiments/speed_switches.py
         hit-states``).  The check runs ahead of the samples drawn, so a run capped at N samples may count
-        checks of a few hits after the N-th.  With a group of some DOFs a shorter path changes the candidates of the later hits
-        (tried on the paper's planner: 1.02-1.06x the time), so not there."""
+        checks of a few hits after the N-th.  With a group of some DOFs a shorter path changes the candidates
+        of the later hits (tried on the paper's planner: 1.02-1.06x the time), so not there."""
         if not len(S) or not self.checker.batched:
             return {}
         known = last.valid if last is not None else {}
