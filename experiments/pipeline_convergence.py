@@ -34,8 +34,10 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--seeds", type=int, default=1, help="runs per query and budget, each with its own seed")
     args = ap.parse_args(argv)
     ou.setLogLevel(ou.LOG_NONE)
+    if args.seeds < 1:
+        ap.error(f"--seeds must be at least 1, got {args.seeds}")
     if args.seeds > 1 or args.only:
-        _spread(args)
+        _spread(args, ap)
         return
     robot, lib, rows = wearer_library_queries(args.queries, args.max_queries)
     cost = {b: [] for b in args.budgets}
@@ -59,9 +61,11 @@ def main(argv: list[str] | None = None) -> None:
         print(f"{b:g} s, % above the shortest, per query:", np.round(100 * (np.array(cost[b]) / best - 1), 2).tolist())
 
 
-def _spread(args: argparse.Namespace) -> None:
-    """Every run of the chosen queries x seeds x budgets: cost and samples, then per query and budget the range."""
+def _spread(args: argparse.Namespace, ap: argparse.ArgumentParser) -> None:
+    """Every run of the chosen queries x seeds x budgets: per query and budget the cost range, then each run."""
     robot, lib, rows = wearer_library_queries(args.queries, args.max_queries)
+    if args.only and not all(0 <= k < len(rows) for k in args.only):
+        ap.error(f"--only takes positions 0..{len(rows) - 1} of the stratified set, got {args.only}")
     for k in args.only if args.only else range(len(rows)):
         q = rows[k]
         ss = make_simple_setup(robot, np.array(q["start"]), np.array(q["goal"]))
