@@ -6,6 +6,7 @@
     PYTHONPATH=. .venv/bin/python experiments/speed_switches.py candidate-stride --planner paper --samples 2500
     PYTHONPATH=. .venv/bin/python experiments/speed_switches.py hit-states --samples 20000 --reps 1
     PYTHONPATH=. .venv/bin/python experiments/speed_switches.py screen-order --samples 20000 --reps 1
+    PYTHONPATH=. .venv/bin/python experiments/speed_switches.py pair-checks --planner paper --samples 2500
 
 Switches (scratch settings of the installed code; the first value is the reference):
 
@@ -26,6 +27,10 @@ Switches (scratch settings of the installed code; the first value is the referen
   longest stretch first (before 2026-11-26).  A lone candidate's verdict is the same either way; a
   candidate path of the feasibility phase may report another failing motion, so with a search that has no
   valid path at first the paths may differ (then ``PATHS DIFFER`` is expected).
+* ``pair-checks`` (``on``, ``off``): ``RobotChecker.first_invalid`` (every screen that stops at its first
+  failure) checks its rows two at a time, one per thread (``robot_checker.FIRST_INVALID_PAIRS``, the
+  package), or one at a time on one thread (before 2026-11-26).  The same answers, so the same paths; the
+  checks count both rows of the last pair.
 
 Each run is capped at ``--samples``, so every setting draws the same samples; the paths must be the same
 (their states' bytes compared, and printed).  Settings alternate per query.  Prints the total time, the collision checks and
@@ -46,6 +51,7 @@ from ompl import util as ou
 
 from tpee_ompl import make_simple_setup
 from tpee_ompl.library.planner import LibraryDimensionRRT
+from tpee_ompl.model import robot_checker
 from tpee_ompl.planning import search_checker, search_draws
 from tpee_ompl.planning.paths import path_to_array
 from tpee_ompl.planning.tpee import tpee_dimension_rrt
@@ -82,11 +88,16 @@ def _screen_order(value: str) -> None:
     search_checker._NEAREST_FIRST = value == "nearest"
 
 
+def _pair_checks(value: str) -> None:
+    robot_checker.FIRST_INVALID_PAIRS = value == "on"
+
+
 SWITCHES: dict[str, tuple[Callable[[str], None], list[str]]] = {
     "look-ahead": (_look_ahead, ["on", "off"]),
     "candidate-stride": (_candidate_stride, ["4", "16"]),
     "hit-states": (_hit_states, ["on", "off"]),
     "screen-order": (_screen_order, ["nearest", "bisect"]),
+    "pair-checks": (_pair_checks, ["on", "off"]),
 }
 
 

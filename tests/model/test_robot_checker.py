@@ -10,6 +10,7 @@ import pytest
 from tests.helpers.panda import needs_panda
 from tests.helpers.wearer_configs import valid_and_colliding
 from tpee_ompl.model.obstacles import Obstacle, box
+from tpee_ompl.model import robot_checker
 from tpee_ompl.model.robot_checker import RobotChecker
 from tpee_ompl.model.wearer_arm import WearerArm
 
@@ -200,12 +201,16 @@ def test_pair_margins_follow_link_margins_for_static_pairs_only(tmp_path):
     assert margins[("a_0", "b_0")] == pytest.approx(c.security_margin)
 
 
-def test_first_invalid_stops_at_the_first_invalid_row_and_counts_only_the_rows_checked(robot, rng) -> None:
+@pytest.mark.parametrize("pairs", [True, False], ids=["two-rows-at-a-time", "one-row-at-a-time"])
+def test_first_invalid_stops_at_the_first_invalid_row_and_counts_only_the_rows_checked(robot, rng, pairs,
+                                                                                       monkeypatch) -> None:
+    monkeypatch.setattr(robot_checker, "FIRST_INVALID_PAIRS", pairs)
     good, bad = valid_and_colliding(robot, rng, 4)
     Q = np.vstack([good[:2], bad[:1], good[2:], bad[1:]])  # first invalid row: 2
     c0 = robot.collision_checks
     assert robot.first_invalid(Q) == 2
-    assert robot.collision_checks - c0 == 3  # rows 0, 1, 2; the rest never checked
+    # rows 0, 1, 2 (and row 3, checked with row 2 by the other thread); the rest never checked
+    assert robot.collision_checks - c0 == (4 if pairs and robot.n_threads > 1 else 3)
     c0 = robot.collision_checks
     assert robot.first_invalid(good) == -1 and robot.collision_checks - c0 == len(good)
     outside = good.copy()
@@ -217,6 +222,24 @@ def test_first_invalid_stops_at_the_first_invalid_row_and_counts_only_the_rows_c
         M = np.vstack([good, bad])[rng.permutation(2 * len(good))[:5]]
         ok = robot.are_valid(M)
         assert robot.first_invalid(M) == (-1 if ok.all() else int(ok.argmin()))
+
+
+def test_first_invalid_two_rows_at_a_time_gives_the_row_of_one_row_at_a_time_and_at_most_one_check_more(
+        robot, rng, monkeypatch) -> None:
+    two = WearerArm(n_threads=2)  # pairs need two threads, whatever the machine
+    good, bad = valid_and_colliding(two, rng, 12)
+    pool = np.vstack([good, bad])
+    for n in [1, 2, 3, 4, 5, 8, 13, 24]:
+        for _ in range(6):
+            Q = pool[rng.choice(len(pool), n)]
+            found, checks = [], []
+            for pairs in (True, False):
+                monkeypatch.setattr(robot_checker, "FIRST_INVALID_PAIRS", pairs)
+                c0 = two.collision_checks
+                found.append(two.first_invalid(Q))
+                checks.append(two.collision_checks - c0)
+            assert found[0] == found[1]
+            assert checks[1] <= checks[0] <= checks[1] + 1
 
 
 def test_first_invalid_of_an_empty_batch_finds_none_and_checks_nothing(robot) -> None:

@@ -30,6 +30,10 @@ log = logging.getLogger(__name__)
 DEFAULT_SECURITY_MARGIN = 0.02
 """Metres. A configuration is valid only if every checked pair is at least this far apart."""
 MAX_SECURITY_MARGIN = 1.0
+FIRST_INVALID_PAIRS = True
+"""``first_invalid`` checks its rows two at a time, one per thread, when the checker has two threads (the same
+answer and an exact count; False: one row at a time on one thread, before 2026-11-26; a switch for
+``experiments/speed_switches.py pair-checks``)."""
 """Metres. Largest accepted security margin."""
 
 
@@ -460,9 +464,13 @@ class RobotChecker:
     def first_invalid(self, Q: np.ndarray) -> int:
         """Index of the first invalid row of Q (N, nq), or -1: :meth:`are_valid` in row order, stopping there.
 
-        One thread, so the rows are checked in order and the count is exact: a caller that puts the
-        states most likely to fail first (a motion's midpoint before its quarter points) finds a
-        failure without checking the rest.  Only the rows checked for collision are counted."""
+        The rows are checked in order, two at a time (one per thread) when the checker has two threads,
+        and the checks stop after the pair that holds the first invalid row: a caller that puts the states
+        most likely to fail first (a motion's midpoint before its quarter points) finds a failure without
+        checking the rest.  The count is exact (both rows of the last pair, only rows checked for collision).
+        Pairs rather than one call for all rows: Pinocchio's stop-at-first-collision splits a batch between
+        its threads in halves, so the second thread would start with the rows least likely to fail and the
+        rows checked could not be counted."""
         Q = as_config_batch(Q, self.nq)
         if len(Q) == 0:
             return -1
@@ -470,6 +478,16 @@ class RobotChecker:
         end = int(outside[0]) if len(outside) else len(Q)
         if end == 0:
             return 0
+        if self.n_threads > 1 and end > 1 and FIRST_INVALID_PAIRS:
+            Qt = np.ascontiguousarray(Q[:end].T)
+            first = end
+            for a in range(0, end, 2):
+                pair = pin.computeCollisionsInParallel(2, self.pool, Qt[:, a : a + 2], True, False)
+                self.collision_checks += len(pair)
+                if pair[0] or (len(pair) > 1 and pair[1]):
+                    first = a if pair[0] else a + 1
+                    break
+            return first if first < len(Q) else -1
         collides = np.asarray(pin.computeCollisionsInParallel(1, self.pool, np.ascontiguousarray(Q[:end].T), True, True),
                               dtype=bool)
         first = int(np.argmax(collides)) if collides.any() else end
