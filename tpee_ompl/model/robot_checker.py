@@ -14,12 +14,12 @@ import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
-import coal
 import numpy as np
 import pinocchio as pin
 
 from ..validation import as_float_array, check_bool, check_int, check_number
 from .clearance_balls import BallScreen, separated_pairs
+from .lever_arms import joint_lever_arms, pair_lever_arms
 from .obstacles import Obstacle
 from .urdf_loading import LoadedModel, ModelFiles, bounding_radius, is_prismatic, load_urdf_model
 
@@ -51,18 +51,6 @@ def as_config_batch(Q: np.ndarray, nq: int) -> np.ndarray:
         k = int(np.flatnonzero(bad)[0])
         raise ValueError(f"configurations contain NaN or inf: row {k} is {Q[k]}")
     return Q
-
-
-def _symmetric_about(go: pin.GeometryObject, point: np.ndarray, axis: np.ndarray, tol: float = 1e-9) -> bool:
-    """True if the geometry (placed in its joint's frame) is mapped onto itself by every rotation about
-    the line through ``point`` along unit ``axis``: a sphere centred on it, a capsule or cylinder along it."""
-    offset = go.placement.translation - point
-    on_axis = np.linalg.norm(np.cross(offset, axis)) <= tol
-    if isinstance(go.geometry, coal.Sphere):
-        return bool(on_axis)
-    if isinstance(go.geometry, (coal.Capsule, coal.Cylinder)):
-        return bool(on_axis and np.linalg.norm(np.cross(go.placement.rotation[:, 2], axis)) <= tol)
-    return False
 
 
 class RobotChecker:
@@ -271,25 +259,8 @@ class RobotChecker:
         The model is fixed after loading, so this is computed once.
         """
         if self._lever_arms is None:
-            self._lever_arms = self._compute_lever_arms()
+            self._lever_arms = joint_lever_arms(self.model, self.gmodel, self._extra_frames)
         return self._lever_arms.copy()
-
-    def _chain_lengths(self, j: int, k: int) -> list[float] | None:
-        """Longest offsets from joint j's origin down to joint k's (root to leaf order), or None if k is
-        not in j's subtree.  A prismatic joint on the way adds its largest travel."""
-        chain = []
-        while k > j:
-            chain.append(k)
-            k = self.model.parents[k]
-        if k != j:
-            return None
-        out = []
-        for m in reversed(chain):
-            out.append(np.linalg.norm(self.model.jointPlacements[m].translation))
-            jm = self.model.joints[m]
-            if is_prismatic(jm):
-                out.append(max(abs(self.lower_limit(m)), abs(self.upper_limit(m))))
-        return out
 
     def lower_limit(self, jid: int) -> float:
         """Lower limit of joint ``jid`` (Pinocchio joint index, 1-based)."""
@@ -298,29 +269,6 @@ class RobotChecker:
     def upper_limit(self, jid: int) -> float:
         """Upper limit of joint ``jid`` (Pinocchio joint index, 1-based)."""
         return float(self.model.upperPositionLimit[self.model.joints[jid].idx_q])
-
-    def _compute_lever_arms(self) -> np.ndarray:
-        n = self.model.njoints - 1
-        reach = np.zeros(n)
-        for j in range(1, n + 1):
-            if is_prismatic(self.model.joints[j]):
-                reach[j - 1] = 1.0
-                continue
-            best = 0.0
-            for go in self.gmodel.geometryObjects:
-                chain = self._chain_lengths(j, go.parentJoint)
-                if chain is None:
-                    continue
-                dist = sum(chain)
-                dist += np.linalg.norm(go.placement.translation) + bounding_radius(go.geometry)
-                best = max(best, dist)
-            for fid in self._extra_frames:
-                f = self.model.frames[fid]
-                chain = self._chain_lengths(j, f.parentJoint)
-                if chain is not None:
-                    best = max(best, sum(chain) + np.linalg.norm(f.placement.translation))
-            reach[j - 1] = best
-        return reach
 
     def pair_lever_arms(self) -> np.ndarray:
         """Per checked pair, how fast each joint can change the pair's distance: shape (P, nq), P =
@@ -333,53 +281,8 @@ class RobotChecker:
         zeros is a pair whose distance cannot change.  Computed once (the model is fixed after loading).
         """
         if self._pair_lever_arms is None:
-            self._pair_lever_arms = self._compute_pair_lever_arms()
+            self._pair_lever_arms = pair_lever_arms(self.model, self.gmodel)
         return self._pair_lever_arms.copy()
-
-    def _ancestors(self, j: int) -> list[int]:
-        """Joints from ``j`` up to (not including) the universe."""
-        out = []
-        while j > 0:
-            out.append(j)
-            j = self.model.parents[j]
-        return out
-
-    def _geometry_lever(self, k: int, go: pin.GeometryObject) -> float:
-        """Bound on how far a unit step of joint k (an ancestor of go's joint) moves any point of go."""
-        if is_prismatic(self.model.joints[k]):
-            return 1.0
-        chain = self._chain_lengths(k, go.parentJoint)
-        return float(sum(chain) + np.linalg.norm(go.placement.translation) + bounding_radius(go.geometry))
-
-    def _compute_pair_lever_arms(self) -> np.ndarray:
-        out = np.zeros((len(self.gmodel.collisionPairs), self.nq))
-        for p, cp in enumerate(self.gmodel.collisionPairs):
-            ga, gb = self.gmodel.geometryObjects[cp.first], self.gmodel.geometryObjects[cp.second]
-            up_a, up_b = set(self._ancestors(ga.parentJoint)), set(self._ancestors(gb.parentJoint))
-            for go, other, path in ((ga, gb, up_a - up_b), (gb, ga, up_b - up_a)):
-                for k in path:
-                    if not self._distance_ignores_joint(k, go, other):
-                        out[p, self.model.joints[k].idx_q] = self._geometry_lever(k, go)
-        return out
-
-    def _distance_ignores_joint(self, k: int, go: pin.GeometryObject, other: pin.GeometryObject) -> bool:
-        """True if turning revolute joint k (on go's side) cannot change go's distance to ``other``:
-        go hangs on k and is symmetric about k's axis, or k hangs on other's joint and other is
-        symmetric about k's axis (a rotation that maps the shape onto itself)."""
-        if is_prismatic(self.model.joints[k]):
-            return False
-        jdata = self.model.joints[k].createData()
-        self.model.joints[k].calc(jdata, pin.neutral(self.model))
-        motion = np.asarray(jdata.S).reshape(6, -1)[:, 0]
-        if np.linalg.norm(motion[:3]) > 1e-12:
-            return False  # not a pure rotation about an axis through the joint origin
-        axis = motion[3:] / np.linalg.norm(motion[3:])
-        if go.parentJoint == k and _symmetric_about(go, np.zeros(3), axis):
-            return True
-        if self.model.parents[k] == other.parentJoint:
-            jp = self.model.jointPlacements[k]
-            return _symmetric_about(other, jp.translation, jp.rotation @ axis)
-        return False
 
     def pair_margins(self) -> np.ndarray:
         """Per checked pair (``gmodel.collisionPairs`` order), its security margin in metres (shape (P,)):
