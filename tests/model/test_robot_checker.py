@@ -9,8 +9,8 @@ import pytest
 
 from tests.helpers.panda import needs_panda
 from tests.helpers.wearer_configs import valid_and_colliding
-from tpee_ompl.model.obstacles import Obstacle, box
 from tpee_ompl.model import robot_checker
+from tpee_ompl.model.obstacles import Obstacle, box
 from tpee_ompl.model.robot_checker import RobotChecker
 from tpee_ompl.model.wearer_arm import WearerArm
 
@@ -225,7 +225,7 @@ def test_first_invalid_stops_at_the_first_invalid_row_and_counts_only_the_rows_c
 
 
 def test_first_invalid_two_rows_at_a_time_gives_the_row_of_one_row_at_a_time_and_at_most_one_check_more(
-        robot, rng, monkeypatch) -> None:
+        rng, monkeypatch) -> None:
     two = WearerArm(n_threads=2)  # pairs need two threads, whatever the machine
     good, bad = valid_and_colliding(two, rng, 12)
     pool = np.vstack([good, bad])
