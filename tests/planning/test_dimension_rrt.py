@@ -279,3 +279,19 @@ def test_termination_condition_is_asked_at_each_sample_checkpoint_and_between_ba
     assert same.last_run_stats()["best_cost"] == cost  # the stops change nothing
     with pytest.raises(ValueError, match="sample checkpoint"):
         planner.set_sample_checkpoints([0])
+
+
+@pytest.mark.parametrize("connect", [True, False], ids=["connect-trees", "layered-trees"])
+def test_the_first_path_does_not_depend_on_how_the_planned_dofs_are_grouped(connect: bool) -> None:
+    """The feasibility phase varies every planned DOF at once; its samples take the DOFs in index order, so
+    the same seed finds the same first path whether the groups are [[0, 1], [2, 3]], [[0, 2], [1, 3]] or one."""
+    paths = []
+    for groups in ([[0, 1], [2, 3]], [[0, 2], [1, 3]], [[3, 1], [2, 0]], [[0, 1, 2, 3]]):
+        ss = make_planar_arm_setup()
+        planner = DimensionRRT(ss.getSpaceInformation(), groups=groups, seed=4, connect=connect, max_samples=3000)
+        ss.setPlanner(planner)
+        assert ss.solve(ob.exactSolnPlannerTerminationCondition(ss.getProblemDefinition()))
+        paths.append(path_to_array(ss.getSolutionPath(), 4))
+        assert planner.last_run_stats()["solutions_posted"] == 1
+    for W in paths[1:]:
+        np.testing.assert_array_equal(W, paths[0])

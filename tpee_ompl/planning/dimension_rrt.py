@@ -13,7 +13,8 @@ steps are never both replaced by one sample (the motion between them was not che
 
 Feasibility phase (before the first valid path; the paper leaves it open): a forward tree from the
 start and a backward tree from the goal whose depth-t nodes are waypoints of step t.  The trees vary
-ALL planned groups jointly and are built once, so progress in one group is never lost when the
+ALL planned groups jointly (their DOFs in index order: the grouping does not change the first path) and are
+built once, so progress in one group is never lost when the
 improvement phase's group turns over (a per-group feasibility phase stalled on a 6-joint arm split
 in three groups).  They are seeded with the valid prefix and suffix of the initial path.  Every node
 is a valid waypoint; motions are checked lazily, as in LazyRRT: the step whose motions from the
