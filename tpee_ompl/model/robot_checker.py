@@ -262,14 +262,6 @@ class RobotChecker:
             self._lever_arms = joint_lever_arms(self.model, self.gmodel, self._extra_frames)
         return self._lever_arms.copy()
 
-    def lower_limit(self, jid: int) -> float:
-        """Lower limit of joint ``jid`` (Pinocchio joint index, 1-based)."""
-        return float(self.model.lowerPositionLimit[self.model.joints[jid].idx_q])
-
-    def upper_limit(self, jid: int) -> float:
-        """Upper limit of joint ``jid`` (Pinocchio joint index, 1-based)."""
-        return float(self.model.upperPositionLimit[self.model.joints[jid].idx_q])
-
     def pair_lever_arms(self) -> np.ndarray:
         """Per checked pair, how fast each joint can change the pair's distance: shape (P, nq), P =
         ``len(gmodel.collisionPairs)`` in that order; metres per radian (revolute) or per metre (prismatic).
@@ -381,20 +373,19 @@ class RobotChecker:
         end = int(outside[0]) if len(outside) else len(Q)
         if end == 0:
             return 0
+        Qt = np.asfortranarray(Q[:end].T)  # (nq, end), each configuration a contiguous column
+        first = end
         if self.n_threads > 1 and end > 1 and FIRST_INVALID_PAIRS:
-            Qt = np.ascontiguousarray(Q[:end].T)
-            first = end
             for a in range(0, end, 2):
                 pair = pin.computeCollisionsInParallel(2, self.pool, Qt[:, a : a + 2], True, False)
                 self.collision_checks += len(pair)
-                if pair[0] or (len(pair) > 1 and pair[1]):
+                if any(pair):
                     first = a if pair[0] else a + 1
                     break
-            return first if first < len(Q) else -1
-        collides = np.asarray(pin.computeCollisionsInParallel(1, self.pool, np.ascontiguousarray(Q[:end].T), True, True),
-                              dtype=bool)
-        first = int(np.argmax(collides)) if collides.any() else end
-        self.collision_checks += min(first + 1, end)
+        else:
+            collides = np.asarray(pin.computeCollisionsInParallel(1, self.pool, Qt, True, True), dtype=bool)
+            first = int(np.argmax(collides)) if collides.any() else end
+            self.collision_checks += min(first + 1, end)
         return first if first < len(Q) else -1
 
     def collision_free(self, Q: np.ndarray, pool: pin.GeometryPool | None = None) -> np.ndarray:
