@@ -222,3 +222,40 @@ def test_a_batched_checker_answering_the_wrong_shape_is_named_in_the_error(caplo
         status = _run(ss, seed=0, max_samples=50)[1]
     assert status == ob.PlannerStatus.CRASH
     assert "are_valid returned shape" in caplog.text
+
+
+def _wall_setup(bound: float) -> og.SimpleSetup:
+    """3-D box with a wall at x = 0 whose only way round lies at |y| or |z| > 1.2."""
+    space = ob.RealVectorStateSpace(3)
+    space.setBounds(-bound, bound)
+    ss = og.SimpleSetup(space)
+    ss.setStateValidityChecker(lambda s: not (abs(s[0]) < 0.1 and abs(s[1]) < 1.2 and abs(s[2]) < 1.2))
+    si = ss.getSpaceInformation()
+    start, goal = si.allocState(), si.allocState()
+    set_state(start, [-0.5, 0.0, 0.0])
+    set_state(goal, [0.5, 0.0, 0.0])
+    ss.setStartAndGoalStates(start, goal)
+    return ss
+
+
+def test_a_planner_built_before_the_bounds_widened_plans_in_the_new_bounds() -> None:
+    ss = _wall_setup(1.0)  # no way round inside [-1, 1]^3
+    planner = DimensionRRT(ss.getSpaceInformation(), seed=0, max_samples=CAP)
+    ss.getStateSpace().setBounds(-2.0, 2.0)  # as OMPL's planners, it plans in the bounds of solve time
+    ss.setPlanner(planner)
+    assert ss.solve(ob.timedPlannerTerminationCondition(60.0)) == ob.PlannerStatus.EXACT_SOLUTION
+    assert path_passes_motion_checks(ss.getSpaceInformation(), ss.getSolutionPath())
+    assert np.max(np.abs(planner.grouped.layout.upper)) == 2.0
+
+
+def test_bounds_that_leave_the_initial_waypoints_outside_abort_with_a_reason(caplog) -> None:
+    ss = _wall_setup(2.0)
+    W = np.linspace([-0.5, 0.0, 0.0], [0.5, 0.0, 0.0], 7)
+    W[1:-1, 1] = 1.5  # round the wall
+    planner = DimensionRRT(ss.getSpaceInformation(), seed=0, max_samples=CAP, initial_waypoints=W)
+    ss.getStateSpace().setBounds(-1.0, 1.0)
+    ss.setPlanner(planner)
+    with caplog.at_level(logging.ERROR):
+        status = ss.solve(ob.timedPlannerTerminationCondition(5.0))
+    assert status == ob.PlannerStatus.ABORT and not ss.haveSolutionPath()
+    assert "bounds changed" in caplog.text and "initial_waypoints lie outside" in caplog.text

@@ -91,7 +91,9 @@ Goal regions: a goal that is not one state (``GoalStates``, e.g. several IK solu
 search's shorter paths go to the same problem definition, and a goal whose start-goal distance is no
 shorter than the best path found stops.  A goal off a prescribed row is skipped.
 
-Spaces: bounded RealVector, SO2 (the short way round, like ``SO2StateSpace``) and compounds of them.
+Spaces: bounded RealVector, SO2 (the short way round, like ``SO2StateSpace``) and compounds of them;
+the bounds are read again at each solve (as OMPL's samplers read them).  No approximate solutions: a
+solve without an exact path ends with TIMEOUT and adds nothing to the problem definition.
 Here: the planner; its settings (:class:`DimensionRRTOptions`) are in :mod:`tpee_ompl.planning.dimension_rrt_options`,
 the search in :mod:`tpee_ompl.planning.dimension_search`, the goal states in :mod:`tpee_ompl.planning.goal_runs`.
 """
@@ -112,7 +114,7 @@ from ..validation import check_int
 from .dimension_rrt_options import RELEASE_AFTER, DimensionRRTOptions, resolve_options, shortcuts_on
 from .dimension_search import Search
 from .goal_runs import GOAL_TURN, GoalRun, goal_states
-from .grouped_space import GroupedSpace
+from .grouped_space import GroupedSpace, RealVectorLayout
 from .planner_base import PythonPlanner, planner_status
 from .search_checker import Checker
 from .solution_posting import SolutionPoster
@@ -176,15 +178,7 @@ class DimensionRRT(PythonPlanner):
         if not isinstance(si, ob.SpaceInformation):
             raise ValueError(f"si must be an ompl.base.SpaceInformation, got {type(si).__name__}")
         grouped = GroupedSpace(si, opts.groups, opts.h, prescribed)
-        layout = grouped.layout
-        span = layout.upper - layout.lower
-        if opts.range_ is None:
-            rng_full = 0.02 * span
-        else:
-            arr = np.asarray(opts.range_, dtype=float)
-            if arr.ndim > 1 or (arr.ndim == 1 and len(arr) != layout.n):
-                raise ValueError(f"range_ must be a positive number or array of {layout.n}, got {opts.range_!r}")
-            rng_full = np.broadcast_to(arr, (layout.n,)).copy()
+        rng_full = self._full_range(opts, grouped)
         initial = self._check_initial(grouped, initial_waypoints)
         super().__init__(si, opts.name)
         self.options = opts
@@ -205,6 +199,35 @@ class DimensionRRT(PythonPlanner):
         self._callback_failed = False
         self._sample_checkpoints: tuple[int, ...] = ()
         self._samples_drawn = 0
+
+    @staticmethod
+    def _full_range(opts: DimensionRRTOptions, grouped: GroupedSpace) -> np.ndarray:
+        """``range_`` per DOF: as given, or 2 % of each bound width."""
+        layout = grouped.layout
+        if opts.range_ is None:
+            return 0.02 * (layout.upper - layout.lower)
+        arr = np.asarray(opts.range_, dtype=float)
+        if arr.ndim > 1 or (arr.ndim == 1 and len(arr) != layout.n):
+            raise ValueError(f"range_ must be a positive number or array of {layout.n}, got {opts.range_!r}")
+        return np.broadcast_to(arr, (layout.n,)).copy()
+
+    def _follow_bounds(self) -> ob.PlannerStatus | None:
+        """Take the space's bounds as they are now, as OMPL's planners do (their samplers read them at each
+        solve): when they changed since this planner was built, the groups, ``range_`` and the initial
+        waypoints are set up again for them.  None when the planner can go on, else ABORT (the reason logged)."""
+        space = self.getSpaceInformation().getStateSpace()
+        old = self.grouped
+        try:
+            layout = RealVectorLayout(space)
+            if np.array_equal(layout.lower, old.layout.lower) and np.array_equal(layout.upper, old.layout.upper):
+                return None
+            grouped = GroupedSpace(space, old.groups, old.h, old.prescribed)
+            initial = self._check_initial(grouped, self._initial)
+        except ValueError as e:
+            log.error("%s: the space's bounds changed and %s", self.getName(), e)
+            return planner_status(ob.PlannerStatus.ABORT)
+        self.grouped, self.range_, self._initial = grouped, self._full_range(self.options, grouped), initial
+        return None
 
     def _ranges(self, grouped: GroupedSpace) -> dict[int, np.ndarray]:
         """Group index -> the smallest narrowed padding of its DOFs (``range_``), for ``grouped``'s groups."""
@@ -325,6 +348,9 @@ class DimensionRRT(PythonPlanner):
 
     def _solve(self, ptc: ob.PlannerTerminationCondition) -> ob.PlannerStatus:
         t0 = time.perf_counter()
+        moved = self._follow_bounds()
+        if moved is not None:
+            return moved
         si, pdef = self.getSpaceInformation(), self.getProblemDefinition()
         layout, grouped = self.grouped.layout, self.grouped
         start = self._start()
