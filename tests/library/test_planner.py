@@ -93,15 +93,26 @@ def test_a_free_straight_motion_is_taken_when_the_library_has_nothing(robot, lib
     assert path_passes_motion_checks(ss.getSpaceInformation(), ss.getSolutionPath())
 
 
-def test_sector_pair_is_inferred_from_the_presets_or_refused(robot, library):
+def test_sector_pair_is_inferred_from_the_presets_or_the_query_is_planned_without_the_library(robot, library):
     assert [infer_sector(np.r_[posture_preset(k), 0.1, -0.2]) for k in (1, 2, 3, 4)] == [1, 2, 3, 4]
     assert infer_sector(np.r_[posture_preset(1) + 0.01, 0.0, 0.0]) is None
     start, goal = _query(robot, 1, 2, 0)
     start = start.copy()
     start[0] += 0.01  # valid, but at no Table-1 preset
-    if robot.is_valid(start):
-        _, _, status = _solve(robot, library, start, goal, max_samples=10)
-        assert status == ob.PlannerStatus.INVALID_START
+    assert robot.is_valid(start)
+    ss, planner, status = _solve(robot, library, start, goal, max_samples=3000, seed=0)
+    assert status == ob.PlannerStatus.EXACT_SOLUTION
+    assert planner.last_run_stats()["library_outcome"] in ("direct", "planned")
+    W = path_to_array(ss.getSolutionPath(), 4)
+    assert np.allclose(W[0], start) and np.allclose(W[-1], goal)
+    assert path_passes_motion_checks(ss.getSpaceInformation(), ss.getSolutionPath())
+
+
+def test_start_and_goal_in_one_sector_are_planned_as_any_query(robot, library):
+    start, goal = _query(robot, 1, 2, 0)
+    ss, planner, status = _solve(robot, library, start, start, max_samples=100, seed=0)  # start == goal
+    assert status == ob.PlannerStatus.EXACT_SOLUTION and planner.last_run_stats()["library_outcome"] == "direct"
+    assert path_passes_motion_checks(ss.getSpaceInformation(), ss.getSolutionPath())
 
 
 @pytest.mark.parametrize(("kwargs", "match"), [

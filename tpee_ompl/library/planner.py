@@ -59,7 +59,9 @@ class LibraryDimensionRRT(PythonPlanner):
         fallback planner is not used (this planner plans under the termination condition instead).
     from_sector, to_sector : int, optional
         The sector pair; by default inferred at each solve from the start's and goal's DOF1/DOF2
-        (the Table-1 presets, :func:`infer_sector`).
+        (the Table-1 presets, :func:`infer_sector`).  A query whose start and goal are not at two
+        different presets has no demonstrations and no Table 3 row: it is planned without the library
+        (its direct motion when free, else :class:`DimensionRRT` over every DOF, nothing prescribed).
     options : DimensionRRTOptions, optional
         Settings of the refining dimension-RRT (its ``name`` is ignored; this planner's is ``name``).
         Left out: the defaults with ``release_after=RELEASE_AFTER`` (Table 3's rows released once the
@@ -156,17 +158,17 @@ class LibraryDimensionRRT(PythonPlanner):
         n = si.getStateDimension()
         start, goal = state_to_array(ends[0], n), state_to_array(ends[1], n)
         i, j = self.pair if self.pair is not None else (infer_sector(start), infer_sector(goal))
-        if i is None or j is None or i == j:
-            log.error("LibraryDimensionRRT: start and goal are not at two different Table-1 posture presets "
-                      "(give from_sector/to_sector); start DOF1/DOF2 %s, goal %s", start[:2], goal[:2])
-            return planner_status(ob.PlannerStatus.INVALID_START if i is None else ob.PlannerStatus.INVALID_GOAL)
+        cross = i is not None and j is not None and i != j
+        if not cross:  # no demonstration and no Table 3 row: the direct motion, else dimension-RRT over every DOF
+            log.info("LibraryDimensionRRT: start and goal are not at two different Table-1 posture presets "
+                     "(start DOF1/DOF2 %s, goal %s): planned without the library", start[:2], goal[:2])
         stats, progress = self._stats, self._stats["progress"]
         opt = problem_objective(pdef)  # asked with its own cost of a path; the costs here are lengths
         best_path = None
         lib = self.library
         have_exact = False
         seed = None
-        if (i, j) in lib.pairs and len(lib.pairs[(i, j)].starts):
+        if cross and (i, j) in lib.pairs and len(lib.pairs[(i, j)].starts):
             order = lib.demo_order(start, goal, i, j)
             for rank, k in enumerate(order[: lib.n_candidates]):
                 stats["candidates_tried"] += 1
@@ -184,7 +186,7 @@ class LibraryDimensionRRT(PythonPlanner):
             seed = lib.generate(start, goal, i, j, int(order[0]), stride=lib.per_step)
             # near the joint limits a DMP seed can leave them; it is only a head start: clip it
             seed = np.clip(seed, lib.robot.lower, lib.robot.upper)
-        if not have_exact:  # Table 3's straight motion: often free when the library's paths are not
+        if cross and not have_exact:  # Table 3's straight motion: often free when the library's paths are not
             path = array_to_path(si, straight_motion(start, goal, i, j))
             if path_passes_motion_checks(si, path):
                 pdef.addSolutionPath(path, False, 0.0, self.getName())
@@ -211,9 +213,10 @@ class LibraryDimensionRRT(PythonPlanner):
             return planner_status(ob.PlannerStatus.EXACT_SOLUTION)
         if stats["library_outcome"] is None:
             stats["library_outcome"] = "planned"
-        inner = tpee_dimension_rrt(si, i, j, dataclasses.replace(self.options, seed=self._run_seed()),
-                                   initial_waypoints=seed if seed is not None and seed.shape[0] == self.options.h
-                                   else None)
+        opts = dataclasses.replace(self.options, seed=self._run_seed())
+        inner = (tpee_dimension_rrt(si, i, j, opts, initial_waypoints=seed if seed is not None
+                                    and seed.shape[0] == self.options.h else None) if cross
+                 else DimensionRRT(si, opts))
         inner.setProblemDefinition(pdef)
         self._inner = inner
         t_inner = time.perf_counter() - t0
