@@ -242,3 +242,12 @@ def test_another_objective_is_asked_with_its_own_cost_and_the_costs_stay_lengths
     assert stats["library_outcome"] in ("dmp", "repaired"), stats["library_outcome"]
     assert all(c < 50.0 for _, c, _ in stats["progress"])  # the library path's cost too is a length
     assert ss.getSolutionPath().length() == pytest.approx(stats["best_cost"])
+
+
+def test_a_given_sector_pair_that_start_and_goal_are_not_at_is_refused_as_by_dimension_rrt(robot, library, caplog):
+    start, goal = _query(robot, 1, 4, 0)
+    for pair, status in (((2, 4), ob.PlannerStatus.INVALID_START), ((1, 3), ob.PlannerStatus.INVALID_GOAL)):
+        with caplog.at_level("ERROR"):
+            ss, _, got = _solve(robot, library, start, goal, from_sector=pair[0], to_sector=pair[1], seed=0)
+        assert got == status and not ss.haveSolutionPath()
+        assert "Table-1 preset" in caplog.text

@@ -62,6 +62,8 @@ class LibraryDimensionRRT(PythonPlanner):
         (the Table-1 presets, :func:`infer_sector`).  A query whose start and goal are not at two
         different presets has no demonstrations and no Table 3 row: it is planned without the library
         (its direct motion when free, else :class:`DimensionRRT` over every DOF, nothing prescribed).
+        Given, the start and goal must be at their presets (else INVALID_START / INVALID_GOAL, logged), as
+        for :func:`~tpee_ompl.planning.tpee.tpee_dimension_rrt`.
     options : DimensionRRTOptions, optional
         Settings of the refining dimension-RRT (its ``name`` is ignored; this planner's is ``name``).
         Left out: the defaults with ``release_after=RELEASE_AFTER`` (Table 3's rows released once the
@@ -157,6 +159,12 @@ class LibraryDimensionRRT(PythonPlanner):
             return ends
         n = si.getStateDimension()
         start, goal = state_to_array(ends[0], n), state_to_array(ends[1], n)
+        if self.pair is not None:  # as dimension-RRT on the pair's Table 3 row: the ends must be at its presets
+            for end, q, k in (("start", start, self.pair[0]), ("goal", goal, self.pair[1])):
+                if infer_sector(q) != k:
+                    log.error("LibraryDimensionRRT: the %s's DOF1/DOF2 %s is not sector %d's Table-1 preset %s "
+                              "(from_sector=%d, to_sector=%d)", end, q[:2], k, posture_preset(k), *self.pair)
+                    return planner_status(ob.PlannerStatus.INVALID_START if end == "start" else ob.PlannerStatus.INVALID_GOAL)
         i, j = self.pair if self.pair is not None else (infer_sector(start), infer_sector(goal))
         cross = i is not None and j is not None and i != j
         if not cross:  # no demonstration and no Table 3 row: the direct motion, else dimension-RRT over every DOF
