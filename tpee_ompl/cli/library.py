@@ -189,7 +189,7 @@ def register(subparsers: argparse._SubParsersAction, formatter_class: type = arg
     """Add ``library build|query|stats`` to the main CLI's subparsers; returns the ``library`` parser."""
     lib = subparsers.add_parser("library", help="build, query or inspect the DMP path library",
                                 description="The cross-sector DMP path library (paper sec. 4.2).",
-                                epilog=_BUILD_EXAMPLE + _QUERY_EXAMPLE + _STATS_EXAMPLE, formatter_class=formatter_class)
+                                epilog="examples:\n" + "".join(e.split("\n", 1)[1] for e in (_BUILD_EXAMPLE, _QUERY_EXAMPLE, _STATS_EXAMPLE)), formatter_class=formatter_class)
     sub = lib.add_subparsers(dest="library_command", metavar="{build,query,stats}", required=True)
 
     def common(p: argparse.ArgumentParser) -> None:

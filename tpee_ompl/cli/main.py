@@ -29,7 +29,7 @@ __all__ = ["get_argument_parser", "main"]
 
 def get_argument_parser() -> argparse.ArgumentParser:
     """The full ``tpee-ompl`` argument parser."""
-    parser = Parser(prog="tpee-ompl", description=__doc__.split("\n")[0])
+    parser = Parser(prog="tpee-ompl", description=__doc__.split("\n")[0].replace("``", ""))
     parser.add_argument("-v", "--verbose", action="store_true", help="log at INFO level")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     fmt = argparse.RawDescriptionHelpFormatter
