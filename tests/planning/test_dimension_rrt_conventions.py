@@ -4,6 +4,10 @@ from __future__ import annotations
 
 import logging
 import math
+import os
+import subprocess
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -259,3 +263,31 @@ def test_bounds_that_leave_the_initial_waypoints_outside_abort_with_a_reason(cap
         status = ss.solve(ob.timedPlannerTerminationCondition(5.0))
     assert status == ob.PlannerStatus.ABORT and not ss.haveSolutionPath()
     assert "bounds changed" in caplog.text and "initial_waypoints lie outside" in caplog.text
+
+
+_CALLBACK_SCRIPT = """
+import numpy as np
+from ompl import base as ob, geometric as og
+from tpee_ompl import WearerArm, make_simple_setup, posture_preset, tpee_dimension_rrt
+robot = WearerArm()
+ss = make_simple_setup(robot, np.r_[posture_preset(1), 0.0, 0.0], np.r_[posture_preset(4), 0.0, 0.0])
+planner = og.RRTstar(ss.getSpaceInformation())
+ss.setPlanner(planner)
+ss.solve(ob.PlannerTerminationCondition(lambda: planner.numIterations() >= 20))
+path = ss.getSolutionPath()
+planner = tpee_dimension_rrt(ss.getSpaceInformation(), 1, 4, max_samples=100, seed=0)
+ss.setPlanner(planner)
+ss.solve(5.0)
+planner.set_intermediate_solution_callback(lambda p, states, cost: None)
+"""
+
+
+def test_a_script_that_keeps_its_callback_set_exits_without_leak_warnings(tmp_path) -> None:
+    # the callback refers to the script's globals, which hold the planner: nanobind used to report leaked
+    # instances at exit (the README's example, run as a script after "In fifteen lines")
+    script = tmp_path / "callback.py"
+    script.write_text(_CALLBACK_SCRIPT)
+    done = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=120,
+                          cwd=tmp_path, env={**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[2])})
+    assert done.returncode == 0, done.stderr
+    assert "leaked" not in done.stderr

@@ -100,9 +100,11 @@ the search in :mod:`tpee_ompl.planning.dimension_search`, the goal states in :mo
 
 from __future__ import annotations
 
+import atexit
 import logging
 import math
 import time
+import weakref
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
@@ -122,6 +124,17 @@ from .solution_posting import SolutionPoster
 __all__ = ["RELEASE_AFTER", "DimensionRRT", "DimensionRRTOptions", "shortcuts_on"]
 
 log = logging.getLogger(__name__)
+
+_WITH_CALLBACKS: weakref.WeakSet[DimensionRRT] = weakref.WeakSet()
+"""Planners holding an intermediate-solution callback.  A callback defined in a script refers to the
+script's globals, which hold the planner: that cycle outlived the bindings at exit, and nanobind
+printed "leaked instances" warnings; :func:`_drop_callbacks` breaks it first."""
+
+
+@atexit.register
+def _drop_callbacks() -> None:
+    for planner in list(_WITH_CALLBACKS):
+        planner._callback = None
 
 _REFINE_AFTER = 500
 """Samples without a first path after which ``h`` is raised (when ``max_h`` allows; see "Raising h")."""
@@ -273,6 +286,8 @@ class DimensionRRT(PythonPlanner):
         if callback is not None and not callable(callback):
             raise ValueError(f"callback must be callable or None, got {type(callback).__name__}")
         self._callback = callback
+        if callback is not None:
+            _WITH_CALLBACKS.add(self)
 
     def set_sample_checkpoints(self, counts: Sequence[int]) -> None:
         """Make the termination condition be asked exactly when the run has drawn each of ``counts``
