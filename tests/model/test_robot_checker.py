@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import time
+
 import coal
 import numpy as np
 import pinocchio as pin
@@ -246,3 +248,47 @@ def test_first_invalid_of_an_empty_batch_finds_none_and_checks_nothing(robot) ->
     c0 = robot.collision_checks
     assert robot.first_invalid(np.zeros((0, robot.nq))) == -1
     assert robot.collision_checks == c0
+
+
+def _slow_parallel_calls(monkeypatch, delay: float) -> list[int]:
+    """Make Pinocchio's calls on several threads take ``delay`` s longer (a core held by another process); the
+    threads of every call are recorded."""
+    real = pin.computeCollisionsInParallel
+    threads: list[int] = []
+
+    def slow(n, *args):
+        threads.append(n)
+        if n > 1:
+            time.sleep(delay)
+        return real(n, *args)
+
+    monkeypatch.setattr(pin, "computeCollisionsInParallel", slow)
+    return threads
+
+
+def test_a_checker_whose_threaded_calls_stall_goes_on_one_thread_for_a_while_with_the_same_answers(rng, monkeypatch):
+    two = WearerArm(n_threads=2)
+    good, bad = valid_and_colliding(two, rng, 10)
+    Q = np.vstack([good, bad])
+    want, first = two.are_valid(Q), two.first_invalid(np.vstack([good, bad[:1]]))
+    monkeypatch.setattr(robot_checker, "SERIAL_SECONDS", 0.3)
+    threads = _slow_parallel_calls(monkeypatch, 0.005)
+    assert (two.are_valid(Q) == want).all() and two.stalls == 0  # one slow call: the machine's noise
+    assert (two.are_valid(Q) == want).all() and two.stalls == 1  # a second one soon after: one thread now
+    c0, before = two.collision_checks, len(threads)
+    assert two.first_invalid(np.vstack([good, bad[:1]])) == first
+    assert two.collision_checks - c0 == len(good) + 1 and set(threads[before:]) == {1}  # one call, stopped there
+    time.sleep(0.3)
+    assert (two.are_valid(Q) == want).all() and threads[-1] == 2  # the spell is over: its threads again
+
+
+def test_first_invalid_finishes_on_one_thread_once_its_pairs_stall(rng, monkeypatch):
+    two = WearerArm(n_threads=2)
+    good, bad = valid_and_colliding(two, rng, 12)
+    Q = np.vstack([good, bad[:1], good])  # first invalid row: 12
+    threads = _slow_parallel_calls(monkeypatch, 0.005)
+    c0 = two.collision_checks
+    assert two.first_invalid(Q) == len(good)
+    # two pairs on two threads (the second stalls within the window of the first), the rest on one thread up to row 12
+    assert threads == [2, 2, 1] and two.stalls == 1
+    assert two.collision_checks - c0 == len(good) + 1
