@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["MAX_SEED", "as_float_array", "check_bool", "check_int", "check_name", "check_number", "check_seed", "sub_seed"]
+__all__ = ["MAX_SECONDS", "MAX_SEED", "as_float_array", "check_bool", "check_int", "check_name", "check_number", "check_seed", "sub_seed"]
 
 
 def check_int(name: str, value: Any, *, minimum: int | None = None, maximum: int | None = None,
@@ -73,6 +73,10 @@ def as_float_array(x: object, what: str) -> np.ndarray:
     except (TypeError, ValueError) as exc:
         raise ValueError(f"{what} must be real numbers, got {x!r} ({exc})"[:400]) from exc
 
+
+MAX_SECONDS = 86_400.0
+"""Longest time limit (s) a planning run may be given: a day.  OMPL turns a budget into a time point, and
+a far larger one (1e10 s) overflows it into the past: every run stopped at once as a TIMEOUT."""
 
 MAX_SEED = 2**32 - 1
 """Largest accepted seed (OMPL's ``RNG.setSeed`` takes an unsigned integer; numpy's generators accept it too)."""

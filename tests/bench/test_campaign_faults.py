@@ -175,3 +175,31 @@ def test_signal_keeps_finished_runs_never_half_writes_the_db_and_resume_complete
     con.close()
     assert len(names) == len(set(names)) == meta["expected_experiments"]
     assert len(list(tmp_path.glob("*_sig"))) == 1  # resumed in place, no new folder
+
+
+def test_a_campaign_already_running_in_another_process_is_not_resumed_a_second_time(query_file, tmp_path):
+    import fcntl
+
+    cfg = tiny_config(query_file, tmp_path, sample_caps=(20,), anytime_budgets=(), max_queries=1)
+    res = run_campaign(cfg, report=False, progress_bar=False)
+    before = (res.directory / "tasks.jsonl").read_text()
+    with open(res.directory / ".lock", "a") as held:  # what a running campaign holds
+        fcntl.flock(held, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        with pytest.raises(ValueError, match="being run by another process"):
+            resume_campaign(res.directory, report=False, progress_bar=False)
+    assert (res.directory / "tasks.jsonl").read_text() == before  # nothing ran
+    assert resume_campaign(res.directory, report=False, progress_bar=False).database is not None  # once free
+
+
+def test_an_interrupt_while_the_database_is_built_names_the_campaign_to_resume(query_file, tmp_path, monkeypatch, capsys):
+    from tpee_ompl.bench import campaign
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(campaign, "build_database", interrupted)
+    code = main(["--queries", str(query_file), "--max-queries", "1", "--samples", "20", "--anytime", "--planners",
+                 STANDIN, "RRTstar", "--checkers", "batched", "--workers", "1", "--out", str(tmp_path),
+                 "--no-progress"])
+    (folder,) = tmp_path.iterdir()
+    assert code == 130 and f"--resume {folder}" in capsys.readouterr().err

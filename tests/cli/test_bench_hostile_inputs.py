@@ -35,6 +35,9 @@ def inputs(tmp_path_factory, robot) -> Path:
     (d / "other_model.json").write_text(json.dumps({**doc, "model_hash": "0123456789abcdef"}))
     (d / "not_a_set.json").write_text(json.dumps([1, 2, 3]))
     (d / "string_start.json").write_text(json.dumps({**doc, "queries": [{**doc["queries"][0], "start": "abc"}]}))
+    q0 = doc["queries"][0]
+    (d / "outside_limits.json").write_text(json.dumps({**doc, "queries": [{**q0, "start": q0["start"][:3] + [10.0]}]}))
+    (d / "swapped.json").write_text(json.dumps({**doc, "queries": [{**q0, "start": q0["goal"], "goal": q0["start"]}]}))
     (d / "plain.txt").write_text("an existing file\n")
     (d / "not_a_campaign").mkdir()
     (d / "not_a_campaign" / "notes.txt").write_text("hello\n")
@@ -74,6 +77,11 @@ CASES = [
     ("queries-other-model", ["--queries", "{in}/other_model.json"], 2, ["--queries", "model_hash"]),
     ("queries-not-a-set", ["--queries", "{in}/not_a_set.json"], 2, ["--queries", "JSON object"]),
     ("queries-string-start", ["--queries", "{in}/string_start.json"], 2, ["--queries", "field 'start'"]),
+    ("queries-start-outside-limits", ["--queries", "{in}/outside_limits.json"], 2,
+     ["--queries", "outside_limits.json", "joint limits"]),
+    ("queries-start-and-goal-swapped", ["--queries", "{in}/swapped.json"], 2, ["--queries", "swapped.json", "Table-1 preset"]),
+    ("max-time-beyond-a-day", ["--max-time", "1e300"], 2, ["--max-time", "86400"]),
+    ("anytime-beyond-a-day", ["--anytime", "1e10"], 2, ["--anytime", "86400"]),
     ("queries-a-folder", ["--queries", "{in}/not_a_campaign"], 2, ["--queries", "not_a_campaign"]),
     ("queries-unknown-name", ["--queries", "no_such_set"], 2, ["--queries", "no_such_set"]),
     ("out-is-a-file", ["--out", "{in}/plain.txt"], 2, ["--out", "plain.txt"]),

@@ -61,7 +61,10 @@ def test_bad_query_files_and_queries_raise(tmp_path):
         Query(0, 1, 2, [np.nan, 0, 0], np.zeros(3), np.zeros(4), np.zeros(4))
     with pytest.raises(ValueError, match="unknown sector"):
         Query(0, 1, 7, np.zeros(3), np.zeros(3), np.zeros(4), np.zeros(4))
-    q = Query(0, 1, 2, np.zeros(3), np.ones(3), np.zeros(4), np.zeros(4))
+    at1, at2 = np.r_[posture_preset(1), 0.0, 0.0], np.r_[posture_preset(2), 0.0, 0.0]
+    with pytest.raises(ValueError, match="goal DOF1/DOF2 .* is not sector 2's Table-1 preset"):
+        Query(0, 1, 2, np.zeros(3), np.ones(3), at1, at1)  # a goal at sector 1's preset, declared in sector 2
+    q = Query(0, 1, 2, np.zeros(3), np.ones(3), at1, at2)
     with pytest.raises(ValueError):
         q.start[0] = 1.0  # stored arrays are read-only
 

@@ -109,6 +109,32 @@ def _sigterm_as_keyboard_interrupt():
         signal.signal(signal.SIGTERM, previous)
 
 
+class CampaignInterrupted(KeyboardInterrupt):
+    """A second interrupt (Ctrl-C, SIGTERM) while the database was built from the finished logs: ``directory``
+    is the campaign to finish with ``--resume``."""
+
+    def __init__(self, directory: Path) -> None:
+        super().__init__(str(directory))
+        self.directory = directory
+
+
+@contextlib.contextmanager
+def _campaign_lock(directory: Path):
+    """Hold ``directory/.lock`` for the block: a second process running the same campaign (two ``--resume``
+    at once) is refused with ValueError instead of writing the same logs and ``tasks.jsonl`` lines twice."""
+    import fcntl
+
+    with open(directory / ".lock", "a") as fh:
+        try:
+            fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            raise ValueError(f"campaign {directory} is being run by another process (its .lock is held)") from None
+        try:
+            yield
+        finally:
+            fcntl.flock(fh, fcntl.LOCK_UN)
+
+
 @dataclasses.dataclass(frozen=True)
 class CampaignPlan:
     """A checked campaign, ready to run: the query set's name and the queries it will use."""
@@ -300,6 +326,11 @@ def _tasks(meta: dict, log_dir: Path, done_names: set[str], n_threads, shared_fs
 
 
 def _execute(directory: Path, meta: dict, executor, on_task_done, report: bool, progress_bar: bool) -> CampaignResult:
+    with _campaign_lock(directory):
+        return _execute_locked(directory, meta, executor, on_task_done, report, progress_bar)
+
+
+def _execute_locked(directory: Path, meta: dict, executor, on_task_done, report: bool, progress_bar: bool) -> CampaignResult:
     cfg = meta["config"]
     log_dir = directory / "logs"
     interrupted = False
@@ -344,26 +375,36 @@ def _execute(directory: Path, meta: dict, executor, on_task_done, report: bool, 
         finally:
             if executor is not None:
                 executor.shutdown(cancel=True)
-        for part in log_dir.glob("*.part"):
-            part.unlink()
-        logs = sorted(log_dir.glob("*.log"))
-        lost_attempts = list(getattr(executor, "lost", []) or [])
-        if lost_attempts:
-            meta.setdefault("lost_attempts", []).extend({**a, "utc": utc_now()} for a in lost_attempts)
-        meta.update({"finished_utc": utc_now(), "interrupted": interrupted, "failed_tasks": failed,
-                     "finished_experiments": len(logs), "wall_time_s": time.perf_counter() - t0})
-        result = CampaignResult(directory=directory, logs=logs, database=None, interrupted=interrupted,
-                                failed_tasks=failed, broken_logs=[p for p, _ in broken])
-        if logs:
-            result.database, result.skipped_logs = build_database(logs, directory / "benchmark.db")
-            meta["corrupt_logs"] = [p.name for p in result.skipped_logs]
-        write_json(directory / "campaign.json", meta)
-        if result.database is not None and report:
-            from . import plots
-            from . import report as rep
+        try:
+            return _finish(directory, meta, executor, failed, broken, interrupted, report, time.perf_counter() - t0)
+        except KeyboardInterrupt as exc:  # a second interrupt: say which campaign to resume
+            raise CampaignInterrupted(directory) from exc
 
-            result.report = rep.write_report(result.database, directory, expected=meta)
-            result.plots = plots.make_plots(result.database, directory / "plots")
+
+def _finish(directory: Path, meta: dict, executor, failed: list[dict], broken: list, interrupted: bool, report: bool,
+            wall_time: float) -> CampaignResult:
+    """After the tasks: the database from the finished logs, ``campaign.json``, the report and the plots."""
+    log_dir = directory / "logs"
+    for part in log_dir.glob("*.part"):
+        part.unlink()
+    logs = sorted(log_dir.glob("*.log"))
+    lost_attempts = list(getattr(executor, "lost", []) or [])
+    if lost_attempts:
+        meta.setdefault("lost_attempts", []).extend({**a, "utc": utc_now()} for a in lost_attempts)
+    meta.update({"finished_utc": utc_now(), "interrupted": interrupted, "failed_tasks": failed,
+                 "finished_experiments": len(logs), "wall_time_s": wall_time})
+    result = CampaignResult(directory=directory, logs=logs, database=None, interrupted=interrupted,
+                            failed_tasks=failed, broken_logs=[p for p, _ in broken])
+    if logs:
+        result.database, result.skipped_logs = build_database(logs, directory / "benchmark.db")
+        meta["corrupt_logs"] = [p.name for p in result.skipped_logs]
+    write_json(directory / "campaign.json", meta)
+    if result.database is not None and report:
+        from . import plots
+        from . import report as rep
+
+        result.report = rep.write_report(result.database, directory, expected=meta)
+        result.plots = plots.make_plots(result.database, directory / "plots")
     return result
 
 

@@ -137,7 +137,7 @@ class CampaignConfig:
         return cls(problem=problem, **fields)
 
     def __post_init__(self) -> None:
-        from ..validation import check_bool, check_int, check_name, check_number, check_seed
+        from ..validation import MAX_SECONDS, check_bool, check_int, check_name, check_number, check_seed
 
         from .problems import get_problem
 
@@ -149,7 +149,7 @@ class CampaignConfig:
                 raise ValueError(f"queries: problem {self.problem} has built-in queries (give no query set)")
         check_name("out", self.out)
         caps = tuple(check_int("sample_caps", n, minimum=1) for n in self.sample_caps)
-        budgets = tuple(check_number("anytime_budgets", b, low=0, low_open=True) for b in self.anytime_budgets)
+        budgets = tuple(check_number("anytime_budgets", b, low=0, low_open=True, high=MAX_SECONDS) for b in self.anytime_budgets)
         if not caps and not budgets:
             raise ValueError("nothing to run: sample_caps and anytime_budgets are both empty")
         for field_name, names in (("iteration_planners", self.iteration_planners),
@@ -190,7 +190,7 @@ class CampaignConfig:
         check_int("runs", self.runs, minimum=1)
         check_int("workers", self.workers, minimum=0)
         check_seed("seed", self.seed)
-        check_number("max_time", self.max_time, low=0, low_open=True)
+        check_number("max_time", self.max_time, low=0, low_open=True, high=MAX_SECONDS)
         check_bool("simplify", self.simplify)
         check_bool("one_run_per_ladder", self.one_run_per_ladder)
         check_bool("one_run_per_anytime_ladder", self.one_run_per_anytime_ladder)

@@ -37,6 +37,8 @@ from multiprocessing.connection import Connection, wait
 from pathlib import Path
 from typing import Protocol
 
+from ..child_processes import child_sigint, sigint_blocked_for_children
+
 __all__ = [
     "DASK_INSTALL_HINT",
     "CampaignExecutor",
@@ -87,7 +89,7 @@ class InProcessExecutor:
 
 def _child_main(fn: TaskFn, task: dict, conn) -> None:
     """A pool child: run ``fn(task)`` and send ``("ok", result)`` or ``("error", message)`` to the parent."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C goes to the parent, which ends us
+    child_sigint(signal.SIG_IGN)  # Ctrl-C goes to the parent, which ends us
     _die_with_parent()
     try:
         msg = ("ok", fn(task))
@@ -157,7 +159,8 @@ class ProcessPoolExecutor:
     def _start(self, ctx, fn: TaskFn, task: dict, attempt: int) -> None:
         recv, send = ctx.Pipe(duplex=False)
         proc = ctx.Process(target=_child_main, args=(fn, task, send), daemon=True)
-        proc.start()
+        with sigint_blocked_for_children():  # a Ctrl-C now must not reach the child's imports
+            proc.start()
         send.close()  # the child holds the only write end: EOF when it dies
         limit = task.get("time_limit_s")
         self._running.append(_Running(proc, recv, task, attempt,
@@ -287,6 +290,17 @@ def _import_distributed():
     return distributed
 
 
+def _quiet_dask_logs() -> None:
+    """Dask's INFO lines (scheduler and workers starting, plugins, addresses) only when the root logger shows INFO
+    (``tpee-ompl -v``): a local cluster printed some 30 of them per campaign."""
+    if logging.getLogger().isEnabledFor(logging.INFO):
+        return
+    import dask
+
+    dask.config.set({"logging.distributed": "warning"})  # the workers' processes read it
+    logging.getLogger("distributed").setLevel(logging.WARNING)
+
+
 class DaskExecutor:
     """One Dask task per campaign task, each in a fresh subprocess on a worker.
 
@@ -316,6 +330,7 @@ class DaskExecutor:
             self.client = client
             self.description = f"Dask client {client.scheduler.address}"
         elif scheduler == "local":
+            _quiet_dask_logs()
             self._cluster = distributed.LocalCluster(n_workers=int(n_workers), threads_per_worker=1, processes=True,
                                                      dashboard_address=":0")
             self.client = distributed.Client(self._cluster)

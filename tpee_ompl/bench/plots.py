@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import math
 import sqlite3
+import warnings
 from collections import defaultdict
 from pathlib import Path
 
@@ -35,7 +36,16 @@ def _pyplot():
 
 def make_plots(db_path: str | Path, directory: str | Path, planner: str | None = None,
                reference: str | None = None) -> list[Path]:
-    """Write the PNGs into ``directory`` and return their paths (only the plots the data allow)."""
+    """Write the PNGs into ``directory`` and return their paths (only the plots the data allow).  Matplotlib's
+    warnings about the data (a legend with no labelled line when a planner solved nothing, overflow on a log
+    axis) are not printed: the plots are drawn from what there is."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)
+        warnings.simplefilter("ignore", RuntimeWarning)
+        return _make_plots(db_path, directory, planner, reference)
+
+
+def _make_plots(db_path: str | Path, directory: str | Path, planner: str | None, reference: str | None) -> list[Path]:
     from .report import PAPER_TABLE4, RATIO_METRICS, load_runs, ratio_table, resolve_planner_name
 
     directory = Path(directory)

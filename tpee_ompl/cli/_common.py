@@ -23,6 +23,8 @@ from typing import TYPE_CHECKING, Any, NoReturn
 if TYPE_CHECKING:
     from ..model.wearer_arm import WearerArm
 
+from ..validation import MAX_SECONDS
+
 __all__ = [
     "MAX_COUNT",
     "MAX_SECONDS",
@@ -132,10 +134,6 @@ def angle(text: str) -> float:
     if abs(v) > 2 * math.pi:
         raise argparse.ArgumentTypeError(f"an angle in radians must be within [-2 pi, 2 pi]: {text}")
     return v
-
-
-MAX_SECONDS = 86_400.0
-"""Longest time limit a ``--time`` argument may give (a day)."""
 
 
 def seconds(text: str) -> float:

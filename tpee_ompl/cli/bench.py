@@ -18,7 +18,7 @@ from pathlib import Path
 
 from ..bench.config import CHECKERS, CampaignConfig, check_planner_name
 from ..bench.problems import DEFAULT_PROBLEM, get_problem
-from ._common import Parser, positive_float, positive_int, seed
+from ._common import Parser, positive_int, seconds, seed
 
 __all__ = ["DESCRIPTION", "EXAMPLE", "add_arguments", "build_parser", "config_from_args", "list_problems", "main",
            "register", "run"]
@@ -92,7 +92,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--name", default=None, help="results folder suffix (default: the query-set name)")
     p.add_argument("--samples", type=positive_int, nargs="*", default=_default("sample_caps"),
                    help="sample/iteration caps of the Table-4 comparison (default: %(default)s); none to skip")
-    p.add_argument("--anytime", type=positive_float, nargs="*", default=_default("anytime_budgets"),
+    p.add_argument("--anytime", type=seconds, nargs="*", default=_default("anytime_budgets"),
                    help="time budgets (s) of the anytime comparison (default: %(default)s); none to skip")
     p.add_argument("--planners", type=_planner, nargs="+", default=_default("iteration_planners"),
                    help="iteration-matched planners; the first is compared with the second (default: %(default)s)")
@@ -114,7 +114,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="worker processes, one fresh process per query (default: %(default)s)")
     p.add_argument("--seed", type=seed, default=_default("seed"),
                    help="campaign seed in [1, 2**32-1]; query k's process uses seed + k (default: %(default)s)")
-    p.add_argument("--max-time", type=positive_float, default=_default("max_time"), help="safety limit per iteration-capped run, s")
+    p.add_argument("--max-time", type=seconds, default=_default("max_time"), help="safety limit per iteration-capped run, s")
     p.add_argument("--out", default=_default("out"), help="parent folder of the timestamped results folder")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     g = p.add_argument_group("executor (default: local process pool of --workers)")
@@ -223,8 +223,9 @@ def run(args: argparse.Namespace) -> int:
                                      progress_bar=not args.no_progress)
         else:
             result = run_campaign(config, executor=executor, progress_bar=not args.no_progress, plan=plan)
-    except KeyboardInterrupt:  # a second Ctrl-C while the database was built
-        print(f"{prog}: interrupted; finished logs are kept: finish the campaign with --resume DIR", file=sys.stderr)
+    except KeyboardInterrupt as exc:  # a second Ctrl-C while the database was built
+        where = getattr(exc, "directory", None) or args.resume or "DIR"
+        print(f"{prog}: interrupted; finished logs are kept: finish the campaign with --resume {where}", file=sys.stderr)
         return 130
     except Exception as exc:  # noqa: BLE001 (a runtime failure: one line, no traceback)
         print(f"{prog}: error: {type(exc).__name__}: {_user_message(exc)}", file=sys.stderr)
@@ -250,7 +251,8 @@ def _print_result(result) -> None:
     if result.report.get("markdown_text"):
         print(result.report["markdown_text"])
     print(f"results: {result.directory}")
-    print(f"database: {result.database}  (open in Planner Arena: plannerarena.org)")
+    print(f"database: {result.database}  (open in Planner Arena: plannerarena.org)" if result.database is not None
+          else "database: none (no experiment finished)")
     if result.report:
         print(f"report: {result.report.get('markdown')}  {result.report.get('csv')}")
     if result.plots:

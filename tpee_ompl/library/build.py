@@ -14,15 +14,16 @@ from __future__ import annotations
 
 import dataclasses
 import logging
+import signal
 from collections import Counter
 from collections.abc import Mapping, Sequence
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import asdict, dataclass
 from multiprocessing import get_context
 from typing import Any
 
 import numpy as np
 
+from ..child_processes import child_sigint, sigint_blocked_for_children
 from ..model.sectors import SECTOR_PAIRS, check_sector
 from ..model.wearer_arm import WearerArm
 from ..planning.paths import resample_waypoints
@@ -167,8 +168,11 @@ def collect_default_demos(
     model = (robot.files.urdf, robot.files.srdf, robot.security_margin, dict(robot.link_margins), robot.n_threads)
     jobs = [(model, i, j, child, opts) for (i, j), child in zip(opts.pairs, children)]
     if opts.workers > 1 and len(jobs) > 1:
-        with ProcessPoolExecutor(min(opts.workers, len(jobs)), mp_context=get_context("spawn")) as ex:
-            results = list(ex.map(_collect_default_pair, jobs))
+        with sigint_blocked_for_children():  # Ctrl-C is the parent's: it ends the pool (the with block terminates it)
+            pool = get_context("spawn").Pool(min(opts.workers, len(jobs)), initializer=child_sigint,
+                                             initargs=(signal.SIG_IGN,))
+        with pool:
+            results = pool.map_async(_collect_default_pair, jobs, chunksize=1).get()
     else:
         results = [_collect_default_pair(job, robot) for job in jobs]
     stats: Counter[str] = Counter()

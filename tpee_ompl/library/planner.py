@@ -23,7 +23,7 @@ import numpy as np
 from ompl import base as ob
 
 from ..model.queries import straight_motion
-from ..model.sectors import SECTORS, check_sector, posture_preset
+from ..model.sectors import check_sector, infer_sector, posture_preset
 from ..planning.dimension_rrt import RELEASE_AFTER, DimensionRRT, DimensionRRTOptions, shortcuts_on
 from ..planning.paths import array_to_path, path_passes_motion_checks, state_to_array
 from ..planning.planner_base import PythonPlanner, planner_status, problem_objective
@@ -34,18 +34,6 @@ from .path_library import PathLibrary
 __all__ = ["LibraryDimensionRRT", "infer_sector"]
 
 log = logging.getLogger(__name__)
-
-PRESET_TOLERANCE = 1e-6
-"""Radians. How close DOF1/DOF2 must be to a Table-1 preset for :func:`infer_sector` to name its sector."""
-
-
-def infer_sector(q: np.ndarray) -> int | None:
-    """The posture sector whose Table-1 preset (DOF1, DOF2) the configuration ``q`` is at, or None."""
-    for k in SECTORS:
-        if np.allclose(np.asarray(q[:2], dtype=float), posture_preset(k), atol=PRESET_TOLERANCE, rtol=0.0):
-            return k
-    return None
-
 
 class LibraryDimensionRRT(PythonPlanner):
     """A validated library path in milliseconds, refined by dimension-RRT until the termination condition.

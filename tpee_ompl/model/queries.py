@@ -28,7 +28,7 @@ import numpy as np
 
 from ..files import atomic_write_text
 from ..resources import query_set_path
-from .sectors import check_sector, cross_sector_trajectory
+from .sectors import POSTURE_PRESETS, PRESET_TOLERANCE, check_sector, cross_sector_trajectory
 from .wearer_arm import WearerArm
 
 __all__ = [
@@ -86,6 +86,10 @@ class Query:
                 raise ValueError(f"query {self.id}: {name} must be {n} finite numbers, got {a!r}")
             a.setflags(write=False)
             object.__setattr__(self, name, a)
+        for name, k in (("start", self.from_sector), ("goal", self.to_sector)):  # Table 3's rows begin and end there
+            if not np.allclose(getattr(self, name)[:2], POSTURE_PRESETS[k], atol=PRESET_TOLERANCE, rtol=0.0):
+                raise ValueError(f"query {self.id}: {name} DOF1/DOF2 {getattr(self, name)[:2].tolist()} is not sector "
+                                 f"{k}'s Table-1 preset {POSTURE_PRESETS[k].tolist()}")
 
     def to_dict(self) -> dict:
         """JSON-ready dict (lists of floats)."""
@@ -213,6 +217,13 @@ def load_query_set(name_or_path: str | os.PathLike, robot: WearerArm | None = No
             f"{p}: made for model_hash {header.get('model_hash')!r}, but the robot's is {robot.model_hash!r} "
             "(regenerate the set for this model)"
         )
+    if robot is not None:
+        for q in queries:
+            for name in ("start", "goal"):
+                v = getattr(q, name)
+                if np.any(v < robot.lower) or np.any(v > robot.upper):
+                    raise QuerySetError(f"{p}: query {q.id}: {name} {v.tolist()} is outside the joint limits "
+                                        f"[{robot.lower.tolist()}, {robot.upper.tolist()}]")
     return queries, header
 
 

@@ -16,12 +16,14 @@ __all__ = [
     "POLAR_CAP",
     "POSTURE_AZIMUTH",
     "POSTURE_PRESETS",
+    "PRESET_TOLERANCE",
     "SECTORS",
     "SECTOR_PAIRS",
     "check_sector",
     "cross_sector_trajectory",
     "cross_sector_length_bound",
     "in_pointing_sector",
+    "infer_sector",
     "pointing_sectors",
     "posture_preset",
     "posture_sector",
@@ -72,6 +74,18 @@ def check_sector(k: object) -> int:
     if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or int(k) not in SECTORS:
         raise ValueError(f"unknown sector {k!r}: sectors are 1, 2, 3, 4")
     return int(k)
+
+
+PRESET_TOLERANCE = 1e-6
+"""Radians. How close DOF1/DOF2 must be to a Table-1 preset to be at it (:func:`infer_sector`, query files)."""
+
+
+def infer_sector(q: np.ndarray) -> int | None:
+    """The posture sector whose Table-1 preset (DOF1, DOF2) the configuration ``q`` is at, or None."""
+    for k in SECTORS:
+        if np.allclose(np.asarray(q[:2], dtype=float), POSTURE_PRESETS[k], atol=PRESET_TOLERANCE, rtol=0.0):
+            return k
+    return None
 
 
 def posture_preset(k: int) -> np.ndarray:

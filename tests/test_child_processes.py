@@ -1,0 +1,30 @@
+"""Children started in ``sigint_blocked_for_children`` cannot be interrupted by a Ctrl-C while they import."""
+
+from __future__ import annotations
+
+import multiprocessing as mp
+import os
+import signal
+
+from tpee_ompl.child_processes import child_sigint, sigint_blocked_for_children
+
+
+def _report_sigint(conn) -> None:
+    blocked_at_start = signal.SIGINT in signal.pthread_sigmask(signal.SIG_BLOCK, set())
+    os.kill(os.getpid(), signal.SIGINT)  # a Ctrl-C while "importing": held, not raised
+    child_sigint(signal.SIG_IGN)  # then ignored: the pending one is dropped
+    conn.send((blocked_at_start, signal.SIGINT in signal.pthread_sigmask(signal.SIG_BLOCK, set())))
+    conn.close()
+
+
+def test_a_child_starts_with_sigint_blocked_and_a_ctrl_c_before_it_is_ready_does_not_reach_it() -> None:
+    ctx = mp.get_context("spawn")
+    recv, send = ctx.Pipe(duplex=False)
+    with sigint_blocked_for_children():
+        proc = ctx.Process(target=_report_sigint, args=(send,))
+        proc.start()
+    send.close()
+    blocked_at_start, blocked_after = recv.recv()
+    proc.join(timeout=60)
+    assert proc.exitcode == 0 and blocked_at_start and not blocked_after
+    assert signal.SIGINT not in signal.pthread_sigmask(signal.SIG_BLOCK, set())  # the parent's mask is back

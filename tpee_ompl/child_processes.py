@@ -1,0 +1,43 @@
+"""Child processes that a Ctrl-C cannot interrupt while they start.
+
+A Ctrl-C in a terminal sends SIGINT to every process of the foreground group, children included.  A child
+spawned a moment earlier is still importing (unpickling its task imports OMPL), and a KeyboardInterrupt
+raised inside the bindings' import aborts it with a C++ ``terminate`` and a page of traceback.  Children
+started within :func:`sigint_blocked_for_children` begin with SIGINT blocked (the signal mask survives fork
+and exec); once running, each one says what SIGINT does to it with :func:`child_sigint`.  The parent's own
+SIGINT is held, not lost, while the block lasts (starting a process: milliseconds).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import signal
+import threading
+from collections.abc import Callable, Iterator
+from typing import Any
+
+__all__ = ["child_sigint", "sigint_blocked_for_children"]
+
+
+@contextlib.contextmanager
+def sigint_blocked_for_children() -> Iterator[None]:
+    """Start child processes inside this block: they begin with SIGINT blocked (POSIX main thread only; a no-op elsewhere)."""
+    if not hasattr(signal, "pthread_sigmask") or threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    from multiprocessing import resource_tracker
+
+    resource_tracker.ensure_running()  # started on a spawn's first use, it unblocks SIGINT afterwards: start it first
+    previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+
+
+def child_sigint(handler: Callable[[int, Any], Any] | int) -> None:
+    """In a child started by :func:`sigint_blocked_for_children`: SIGINT's handler (``signal.SIG_IGN`` when the
+    parent ends the child itself), then SIGINT unblocked (a pending one then goes to ``handler``, or is dropped)."""
+    signal.signal(signal.SIGINT, handler)
+    if hasattr(signal, "pthread_sigmask"):
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
