@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 PACKAGE = Path(__file__).resolve().parents[1] / "tpee_ompl"
-FLOORS = {"validation": 0, "resources": 0, "files": 0, "model": 1, "planning": 2, "viz": 2, "library": 3, "examples": 3,
+FLOORS = {"validation": 0, "resources": 0, "files": 0, "signals": 0, "model": 1, "planning": 2, "viz": 2, "library": 3, "examples": 3,
           "bench": 4, "cli": 5}
 MAX_LINES = 500
 

@@ -70,3 +70,11 @@ def test_track_jitter_on_a_boundary_causes_no_cross_sector_motion(capsys):
     assert main(["track", "--script", "jitter", "--duration", "5", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["events"]["cross-sector"] <= 1 and out["events"]["aim"] > 0
+
+
+def test_plan_reports_its_samples_and_says_when_the_time_limit_came_before_the_sample_cap(capsys):
+    assert main(_args("--planner", "rrtstar", "--samples", "10000000", "--time", "0.3")) == 0
+    out = capsys.readouterr().out
+    assert "stopped by --time 0.3 before --samples 10000000" in out
+    assert main(_args("--planner", "dimension-rrt", "--samples", "300", "--json")) == 0
+    assert json.loads(capsys.readouterr().out)["samples"] == 300

@@ -25,7 +25,6 @@ import dataclasses
 import json
 import logging
 import os
-import signal
 import socket
 import sys
 import time
@@ -36,6 +35,7 @@ from .config import CampaignConfig, CampaignResult
 from .database import build_database, set_aside_broken_logs
 from .experiment import experiment_specs, log_name, run_query_task
 from ..files import write_new_file
+from ..signals import sigterm_as_keyboard_interrupt
 from .results import append_json_line, make_results_dir, package_versions, utc_now, write_json
 
 __all__ = ["CampaignPlan", "load_campaign", "prepare_campaign", "query_rows", "resume_campaign", "run_campaign",
@@ -90,25 +90,6 @@ def stratified_subset(queries: list[dict], k: int | None) -> list[dict]:
 
 
 # --------------------------------------------------------------------------- campaign
-@contextlib.contextmanager
-def _sigterm_as_keyboard_interrupt():
-    """Within the block, SIGTERM interrupts like Ctrl-C (main thread only)."""
-    import threading
-
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-
-    def handler(signum, frame):
-        raise KeyboardInterrupt(f"signal {signum}")
-
-    previous = signal.signal(signal.SIGTERM, handler)
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGTERM, previous)
-
-
 class CampaignInterrupted(KeyboardInterrupt):
     """A second interrupt (Ctrl-C, SIGTERM) while the database was built from the finished logs: ``directory``
     is the campaign to finish with ``--resume``."""
@@ -215,7 +196,7 @@ def run_campaign(
     plan = plan if plan is not None else prepare_campaign(config)
     if plan.config != config:
         raise ValueError("plan was prepared for another configuration")
-    with _sigterm_as_keyboard_interrupt():
+    with sigterm_as_keyboard_interrupt():
         return _run_campaign(plan, on_task_done, report, progress_bar, executor)
 
 
@@ -337,7 +318,7 @@ def _execute_locked(directory: Path, meta: dict, executor, on_task_done, report:
     failed: list[dict] = []
     broken: list[tuple[Path, str]] = []
     t0 = time.perf_counter()
-    with _sigterm_as_keyboard_interrupt():
+    with sigterm_as_keyboard_interrupt():
         try:
             from tqdm import tqdm
 

@@ -37,7 +37,7 @@ from multiprocessing.connection import Connection, wait
 from pathlib import Path
 from typing import Protocol
 
-from ..child_processes import child_sigint, sigint_blocked_for_children
+from ..signals import child_sigint, sigint_blocked_for_children
 
 __all__ = [
     "DASK_INSTALL_HINT",

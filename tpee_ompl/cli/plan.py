@@ -135,7 +135,8 @@ def plan_motion(args: argparse.Namespace) -> tuple[dict, WearerArm]:
         status = ss.solve(args.time)
     result: dict = {"planner": args.planner, "from_sector": args.from_sector, "to_sector": args.to_sector,
                     "query_id": qid, "status": str(status), "exact": bool(ss.haveExactSolutionPath()),
-                    "time_s": ss.getLastPlanComputationTime(), "collision_checks": robot.collision_checks - checks0}
+                    "time_s": ss.getLastPlanComputationTime(), "collision_checks": robot.collision_checks - checks0,
+                    "samples": _samples_drawn(planner)}
     if ss.haveSolutionPath():
         path = ss.getSolutionPath()
         result["valid"] = path_passes_motion_checks(si, path)
@@ -144,14 +145,25 @@ def plan_motion(args: argparse.Namespace) -> tuple[dict, WearerArm]:
     return result, robot
 
 
+def _samples_drawn(planner: Any) -> int | None:
+    """Samples (iterations) the planner drew in its solve: ours report them, OMPL's count iterations; else None."""
+    if hasattr(planner, "last_run_stats"):
+        return planner.last_run_stats().get("samples")
+    return int(planner.numIterations()) if hasattr(planner, "numIterations") else None
+
+
 def cmd_plan(args: argparse.Namespace) -> int:
     """Plan one cross-sector motion and print the path, its validity and length."""
     result, _ = plan_motion(args)
     if args.json:
         print(json.dumps(result))
     else:
+        drawn = "" if result["samples"] is None else f", {result['samples']} samples"
         print(f"{args.planner}: sector {args.from_sector} -> {args.to_sector}, status {result['status']}, "
-              f"{result['time_s']:.3f} s, {result['collision_checks']} collision checks")
+              f"{result['time_s']:.3f} s{drawn}, {result['collision_checks']} collision checks")
+        if args.samples is not None and result["samples"] is not None and result["samples"] < args.samples \
+                and result["time_s"] >= 0.99 * args.time:
+            print(f"stopped by --time {args.time:g} before --samples {args.samples}")
         if "path" in result:
             print(f"valid (checkMotion on every segment): {result['valid']}, length {result['length_rad']:.4f} rad, "
                   f"{len(result['path'])} waypoints (DOF1..DOF4, rad):")

@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from ..child_processes import child_sigint, sigint_blocked_for_children
+from ..signals import child_sigint, sigint_blocked_for_children
 from ..model.sectors import SECTOR_PAIRS, check_sector
 from ..model.wearer_arm import WearerArm
 from ..planning.paths import resample_waypoints

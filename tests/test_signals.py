@@ -1,4 +1,4 @@
-"""Children started in ``sigint_blocked_for_children`` cannot be interrupted by a Ctrl-C while they import."""
+"""Signals: children started in ``sigint_blocked_for_children`` cannot be interrupted while they import; SIGTERM as Ctrl-C."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ import multiprocessing as mp
 import os
 import signal
 
-from tpee_ompl.child_processes import child_sigint, sigint_blocked_for_children
+from tpee_ompl.signals import child_sigint, sigint_blocked_for_children, sigterm_as_keyboard_interrupt
 
 
 def _report_sigint(conn) -> None:
@@ -28,3 +28,16 @@ def test_a_child_starts_with_sigint_blocked_and_a_ctrl_c_before_it_is_ready_does
     proc.join(timeout=60)
     assert proc.exitcode == 0 and blocked_at_start and not blocked_after
     assert signal.SIGINT not in signal.pthread_sigmask(signal.SIG_BLOCK, set())  # the parent's mask is back
+
+
+def test_sigterm_within_the_block_interrupts_like_ctrl_c_and_the_handler_is_restored_after() -> None:
+    before = signal.getsignal(signal.SIGTERM)
+    try:
+        with sigterm_as_keyboard_interrupt():
+            os.kill(os.getpid(), signal.SIGTERM)
+            for _ in range(1000):  # the handler runs between bytecodes
+                pass
+        raise AssertionError("SIGTERM did not interrupt")
+    except KeyboardInterrupt:
+        pass
+    assert signal.getsignal(signal.SIGTERM) == before

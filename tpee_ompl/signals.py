@@ -1,4 +1,4 @@
-"""Child processes that a Ctrl-C cannot interrupt while they start.
+"""Signals: child processes that a Ctrl-C cannot interrupt while they start, and SIGTERM handled like Ctrl-C.
 
 A Ctrl-C in a terminal sends SIGINT to every process of the foreground group, children included.  A child
 spawned a moment earlier is still importing (unpickling its task imports OMPL), and a KeyboardInterrupt
@@ -6,6 +6,9 @@ raised inside the bindings' import aborts it with a C++ ``terminate`` and a page
 started within :func:`sigint_blocked_for_children` begin with SIGINT blocked (the signal mask survives fork
 and exec); once running, each one says what SIGINT does to it with :func:`child_sigint`.  The parent's own
 SIGINT is held, not lost, while the block lasts (starting a process: milliseconds).
+
+:func:`sigterm_as_keyboard_interrupt`: within it SIGTERM (``kill``, a cluster's scheduler) ends the work the
+way Ctrl-C does, so the same cleanup runs (finished logs kept, child processes ended).
 """
 
 from __future__ import annotations
@@ -16,7 +19,7 @@ import threading
 from collections.abc import Callable, Iterator
 from typing import Any
 
-__all__ = ["child_sigint", "sigint_blocked_for_children"]
+__all__ = ["child_sigint", "sigint_blocked_for_children", "sigterm_as_keyboard_interrupt"]
 
 
 @contextlib.contextmanager
@@ -41,3 +44,20 @@ def child_sigint(handler: Callable[[int, Any], Any] | int) -> None:
     signal.signal(signal.SIGINT, handler)
     if hasattr(signal, "pthread_sigmask"):
         signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+
+
+@contextlib.contextmanager
+def sigterm_as_keyboard_interrupt() -> Iterator[None]:
+    """Within the block, SIGTERM raises KeyboardInterrupt like Ctrl-C (main thread only; a no-op elsewhere)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def handler(signum: int, frame: object) -> None:
+        raise KeyboardInterrupt(f"signal {signum}")
+
+    previous = signal.signal(signal.SIGTERM, handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
