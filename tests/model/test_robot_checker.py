@@ -266,27 +266,37 @@ def _slow_parallel_calls(monkeypatch, delay: float) -> list[int]:
     return threads
 
 
-def test_a_checker_whose_threaded_calls_stall_goes_on_one_thread_for_a_while_with_the_same_answers(rng, monkeypatch):
+def _stall_at(monkeypatch, seconds: float) -> None:
+    """A call counts as stalled above ``seconds`` (far above this machine's own hiccups, even under a loaded CI)."""
+    monkeypatch.setattr(robot_checker, "STALL_SECONDS", (seconds, 0.0))
+
+
+def test_a_checker_whose_threaded_calls_stall_goes_on_one_thread_for_a_while_with_the_same_answers(robot, rng,
+                                                                                                     monkeypatch):
+    _stall_at(monkeypatch, 0.05)
+    monkeypatch.setattr(robot_checker, "SERIAL_SECONDS", 0.5)
+    monkeypatch.setattr(robot_checker, "STALL_WINDOW", 0.5)
+    good, bad = valid_and_colliding(robot, rng, 10)  # the answers from another checker of the model: `two`'s
+    Q = np.vstack([good, bad])                        # only calls are the slowed ones below
+    want, first = robot.are_valid(Q), robot.first_invalid(np.vstack([good, bad[:1]]))
     two = WearerArm(n_threads=2)
-    good, bad = valid_and_colliding(two, rng, 10)
-    Q = np.vstack([good, bad])
-    want, first = two.are_valid(Q), two.first_invalid(np.vstack([good, bad[:1]]))
-    monkeypatch.setattr(robot_checker, "SERIAL_SECONDS", 0.3)
-    threads = _slow_parallel_calls(monkeypatch, 0.005)
+    threads = _slow_parallel_calls(monkeypatch, 0.1)
     assert (two.are_valid(Q) == want).all() and two.stalls == 0  # one slow call: the machine's noise
     assert (two.are_valid(Q) == want).all() and two.stalls == 1  # a second one soon after: one thread now
     c0, before = two.collision_checks, len(threads)
     assert two.first_invalid(np.vstack([good, bad[:1]])) == first
     assert two.collision_checks - c0 == len(good) + 1 and set(threads[before:]) == {1}  # one call, stopped there
-    time.sleep(0.3)
+    time.sleep(0.5)
     assert (two.are_valid(Q) == want).all() and threads[-1] == 2  # the spell is over: its threads again
 
 
-def test_first_invalid_finishes_on_one_thread_once_its_pairs_stall(rng, monkeypatch):
-    two = WearerArm(n_threads=2)
-    good, bad = valid_and_colliding(two, rng, 12)
+def test_first_invalid_finishes_on_one_thread_once_its_pairs_stall(robot, rng, monkeypatch):
+    _stall_at(monkeypatch, 0.05)
+    monkeypatch.setattr(robot_checker, "STALL_WINDOW", 0.5)
+    good, bad = valid_and_colliding(robot, rng, 12)
     Q = np.vstack([good, bad[:1], good])  # first invalid row: 12
-    threads = _slow_parallel_calls(monkeypatch, 0.005)
+    two = WearerArm(n_threads=2)
+    threads = _slow_parallel_calls(monkeypatch, 0.1)
     c0 = two.collision_checks
     assert two.first_invalid(Q) == len(good)
     # two pairs on two threads (the second stalls within the window of the first), the rest on one thread up to row 12
