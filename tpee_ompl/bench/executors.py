@@ -290,15 +290,24 @@ def _import_distributed():
     return distributed
 
 
-def _quiet_dask_logs() -> None:
-    """Dask's INFO lines (scheduler and workers starting, plugins, addresses) only when the root logger shows INFO
-    (``tpee-ompl -v``): a local cluster printed some 30 of them per campaign."""
+@contextlib.contextmanager
+def _quiet_dask_logs() -> Iterator[None]:
+    """Dask's own lines only when the root logger shows INFO (``tpee-ompl -v``): a local cluster printed some 30
+    (scheduler and workers starting, plugins, addresses) per campaign, and its workers' warnings about the tasks
+    cancelled at a Ctrl-C.  A lost task is the campaign's to report (it lists them), not Dask's."""
     if logging.getLogger().isEnabledFor(logging.INFO):
+        yield
         return
-    import dask
-
-    dask.config.set({"logging.distributed": "warning"})  # the workers' processes read it
-    logging.getLogger("distributed").setLevel(logging.WARNING)
+    logging.getLogger("distributed").setLevel(logging.ERROR)
+    key, before = "DASK_LOGGING__DISTRIBUTED", os.environ.get("DASK_LOGGING__DISTRIBUTED")
+    os.environ[key] = "error"  # the worker processes started within the block configure their logging from it
+    try:
+        yield
+    finally:
+        if before is None:
+            os.environ.pop(key, None)
+        else:
+            os.environ[key] = before
 
 
 class DaskExecutor:
@@ -330,9 +339,9 @@ class DaskExecutor:
             self.client = client
             self.description = f"Dask client {client.scheduler.address}"
         elif scheduler == "local":
-            _quiet_dask_logs()
-            self._cluster = distributed.LocalCluster(n_workers=int(n_workers), threads_per_worker=1, processes=True,
-                                                     dashboard_address=":0")
+            with _quiet_dask_logs(), sigint_blocked_for_children():  # Ctrl-C is ours: shutdown() closes the cluster
+                self._cluster = distributed.LocalCluster(n_workers=int(n_workers), threads_per_worker=1, processes=True,
+                                                         dashboard_address=":0")
             self.client = distributed.Client(self._cluster)
             self.description = f"Dask LocalCluster ({n_workers} workers)"
         else:
