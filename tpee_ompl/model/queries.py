@@ -28,7 +28,7 @@ import numpy as np
 
 from ..files import atomic_write_text
 from ..resources import query_set_path
-from .sectors import POSTURE_PRESETS, PRESET_TOLERANCE, check_sector, cross_sector_trajectory
+from .sectors import POSTURE_PRESETS, check_sector, cross_sector_trajectory, infer_sector
 from .wearer_arm import WearerArm
 
 __all__ = [
@@ -87,7 +87,7 @@ class Query:
             a.setflags(write=False)
             object.__setattr__(self, name, a)
         for name, k in (("start", self.from_sector), ("goal", self.to_sector)):  # Table 3's rows begin and end there
-            if not np.allclose(getattr(self, name)[:2], POSTURE_PRESETS[k], atol=PRESET_TOLERANCE, rtol=0.0):
+            if infer_sector(getattr(self, name)) != k:
                 raise ValueError(f"query {self.id}: {name} DOF1/DOF2 {getattr(self, name)[:2].tolist()} is not sector "
                                  f"{k}'s Table-1 preset {POSTURE_PRESETS[k].tolist()}")
 
