@@ -46,17 +46,18 @@ def test_smoke_campaign_fills_the_database(query_file, tmp_path):
     con = sqlite3.connect(res.database)
     rows = con.execute(
         "SELECT plannerConfigs.name, runs.correct_solution, runs.best_cost, runs.iterations, runs.collision_checks, "
-        "runs.length_dof12, runs.length_dof34, runs.path_valid_dense, runs.solution_length "
+        "runs.length_dof12, runs.length_dof34, runs.path_valid_dense, runs.solution_length, runs.reaches_goal "
         "FROM runs JOIN plannerConfigs ON runs.plannerid = plannerConfigs.id "
         "JOIN experiments ON runs.experimentid = experiments.id WHERE experiments.comparison = 'iterations'").fetchall()
     planners = {r[0] for r in rows}
     assert planners == {"geometric_StandIn", "geometric_RRTstar"}
-    for name, correct, best, iters, checks, l12, l34, dense, length in rows:
+    for name, correct, best, iters, checks, l12, l34, dense, length, reaches in rows:
         assert correct is not None and iters is not None and checks > 0  # filled for every run
-        if length is not None:  # solved: every column of the raw path is there
-            assert correct == 1 and dense == 1 and best == pytest.approx(length, rel=1e-4)
-            assert l12 + l34 >= length - 1e-6  # triangle inequality per segment
-    assert {r[0] for r in rows if r[8] is not None} == planners  # each planner solved something
+        if length is not None:  # a path: every column of the raw path is there
+            assert correct == 1 and dense == 1 and l12 + l34 >= length - 1e-6  # triangle inequality per segment
+            # its best cost when it reaches the goal; RRT* at 30 iterations can end with an approximate path
+            assert best == pytest.approx(length, rel=1e-4) if reaches else best is None
+    assert {r[0] for r in rows if r[9]} == planners  # each planner solved something
     caps = dict(con.execute("SELECT sample_cap, COUNT(*) FROM experiments WHERE comparison='iterations' "
                             "GROUP BY sample_cap").fetchall())
     assert caps == {30: 2, 60: 2}

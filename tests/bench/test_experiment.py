@@ -36,3 +36,22 @@ def test_anytime_without_validators_uses_the_problems_headline_validator():
     assert [s["checker"] for s in experiment_specs(cfg, 0)] == ["discrete"]
     wearer = dataclasses.asdict(CampaignConfig(sample_caps=(), checkers=(), anytime_budgets=(0.5,)))
     assert [s["checker"] for s in experiment_specs(wearer, 0)] == ["batched"]
+
+
+def test_every_run_starts_from_the_experiments_cost_threshold_whatever_the_planner_before_left(tmp_path, robot):
+    # OMPL's AORRTC leaves the shared objective's threshold at its own cost; BIT*, run next, then stopped at once
+    import sqlite3
+
+    from helpers.bench_standins import tiny_config, write_query_file
+
+    from tpee_ompl.bench.campaign import run_campaign
+
+    lowers, honours = "helpers.bench_standins:make_lowers_threshold", "helpers.bench_standins:make_honours_threshold"
+    cfg = tiny_config(write_query_file(tmp_path / "q.json", robot, n=2), tmp_path, sample_caps=(30,),
+                      iteration_planners=(lowers, honours), anytime_budgets=())
+    res = run_campaign(cfg, report=False, progress_bar=False)
+    with sqlite3.connect(res.database) as db:
+        rows = db.execute("SELECT plannerConfigs.name, runs.iterations FROM runs JOIN plannerConfigs "
+                          "ON runs.plannerid = plannerConfigs.id").fetchall()
+    assert sorted(name.rsplit("_", 1)[-1] for name, _ in rows) == ["HonoursThreshold"] * 2 + ["LowersThreshold"] * 2
+    assert [it for _, it in rows] == [30] * 4  # HonoursThreshold drew its 30 samples: the threshold was 0 again

@@ -39,10 +39,20 @@ def test_failed_runs_are_counted_and_excluded_from_ratios():
     assert counts["R"]["success"] == 2
 
 
-def test_missing_queries_are_reported_from_the_campaign_metadata():
-    runs = [run("D", 0, 500, 1.0, 2.0, 1.0, 1.0), run("R", 0, 500, 2.0, 4.0, 2.0, 2.0)]
-    expected = {"queries": [0, 1, 2], "config": {"checkers": ["batched"]}}
-    assert all(r["missing_queries"] == 2 for r in success_table(runs, expected))
+def test_missing_queries_are_reported_from_the_campaign_metadata_for_every_validator_and_budget():
+    import dataclasses
+
+    from tpee_ompl.bench.config import CampaignConfig
+
+    cfg = dataclasses.asdict(CampaignConfig(sample_caps=(500,), checkers=("batched", "discrete"), alt_checker_queries=2,
+                                            anytime_budgets=(0.1,), anytime_queries=2))
+    runs = [run("D", 0, 500, 1.0, 2.0, 1.0, 1.0), run("R", 0, 500, 2.0, 4.0, 2.0, 2.0),
+            {**run("D", 0, 500, 1.0, 2.0, 1.0, 1.0), "motion_validator": "discrete"}]
+    table = success_table(runs, {"queries": [0, 1, 2], "config": cfg})
+    missing = {(r["checker"], r["setting"], r["planner"]): r["missing_queries"] for r in table}
+    assert missing == {("batched", "N=500", "D"): 2, ("batched", "N=500", "R"): 2,  # 3 queries, 1 finished
+                       ("discrete", "N=500", "D"): 1,  # on the first 2 queries only
+                       ("batched", "T=0.1s", "(every planner)"): 2}  # the anytime comparison: not one run
 
 
 def test_length_quality_is_relative_to_straight_segment_and_best_found():

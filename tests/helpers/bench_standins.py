@@ -93,6 +93,37 @@ def make_standin(si, ctx: PlannerContext):
     return StandInPlanner(si, max_samples=ctx.max_samples, seed=ctx.seed)
 
 
+class LowersThreshold(StandInPlanner):
+    """Leaves the shared objective's cost threshold at a cost every path meets after its run, as OMPL's AORRTC
+    leaves it at its own path's cost."""
+
+    def solve(self, ptc):
+        status = super().solve(ptc)
+        self.getProblemDefinition().getOptimizationObjective().setCostThreshold(ob.Cost(1e9))
+        return status
+
+
+class HonoursThreshold(StandInPlanner):
+    """Stops after one sample when the objective is already satisfied by any path, as BIT* stops once it is."""
+
+    def solve(self, ptc):
+        if self.getProblemDefinition().getOptimizationObjective().isSatisfied(ob.Cost(1e6)):
+            self.max_samples = 1
+        return super().solve(ptc)
+
+
+def make_lowers_threshold(si, ctx: PlannerContext):
+    planner = LowersThreshold(si, max_samples=ctx.max_samples, seed=ctx.seed)
+    planner.setName("LowersThreshold")
+    return planner
+
+
+def make_honours_threshold(si, ctx: PlannerContext):
+    planner = HonoursThreshold(si, max_samples=ctx.max_samples, seed=ctx.seed)
+    planner.setName("HonoursThreshold")
+    return planner
+
+
 # --------------------------------------------------------------------------- planners that fail
 class SolveRaises(StandInPlanner):
     """Raises inside ``solve`` (called by OMPL's Benchmark from C++)."""

@@ -27,6 +27,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import numpy as np
+from ompl import base as ob
 from ompl import tools as ot
 from ompl import util as ou
 
@@ -266,9 +267,14 @@ def _run_experiment(cfg: dict, task: dict, spec: dict, ladder=None, only: list[s
 
     records: dict[str, list[dict]] = {n: [] for n in wrappers}
     counter = {"before": 0}
+    pdef = ss.getProblemDefinition()
+    objective = pdef.getOptimizationObjective() if pdef.hasOptimizationObjective() else None
+    threshold = objective.getCostThreshold().value() if objective is not None else None
 
     def pre_run(planner) -> None:
         counter["before"] = checker.collision_checks
+        if objective is not None:  # AORRTC lowers the shared objective's threshold to its own cost as it runs:
+            objective.setCostThreshold(ob.Cost(threshold))  # the next planner (BIT*) then stopped once it beat that
 
     def post_run_props(planner) -> dict:
         rec = wrappers[planner.getName()].last

@@ -151,7 +151,7 @@ def success_table(runs: list[dict], expected: dict | None = None) -> list[dict]:
     for r in runs:
         key = (r["comparison"], r["motion_validator"], _setting(r), r["planner"])
         groups[key].append(r)
-    n_queries = len(expected["queries"]) if expected else None
+    wanted = _expected_queries(expected) if expected else None
     out = []
     for (comp, chk, setting, planner), rs in sorted(groups.items(), key=lambda kv: tuple(map(str, kv[0]))):
         ids = {r["query_id"] for r in rs}
@@ -160,10 +160,28 @@ def success_table(runs: list[dict], expected: dict | None = None) -> list[dict]:
                "invalid_path": sum(1 for r in rs if r["solved"] == 1 and not r["success"]),
                "unsolved": sum(1 for r in rs if r["solved"] != 1),
                "queries": len(ids), "missing_queries": None}
-        if n_queries is not None and comp == "iterations" and chk == (expected["config"]["checkers"] or [None])[0]:
-            row["missing_queries"] = n_queries - len(ids)
+        if wanted is not None:
+            row["missing_queries"] = wanted.get((comp, chk, setting), 0) - len(ids)
         out.append(row)
+    present = {k[:3] for k in groups}
+    for (comp, chk, setting), n in sorted((wanted or {}).items()):
+        if (comp, chk, setting) not in present:  # not one run of it finished
+            out.append({"comparison": comp, "checker": chk, "setting": setting, "planner": "(every planner)",
+                        "runs": 0, "success": 0, "invalid_path": 0, "unsolved": 0, "queries": 0, "missing_queries": n})
     return out
+
+
+def _expected_queries(expected: dict) -> dict[tuple[str, str, str], int]:
+    """(comparison, validator, cap/budget setting) -> how many queries the campaign (``campaign.json``) runs it on."""
+    from .experiment import experiment_specs
+
+    cfg, n = expected["config"], len(expected["queries"])
+    out: dict[tuple[str, str, str], int] = defaultdict(int)
+    for k in range(n):
+        for spec in experiment_specs(cfg, k):
+            setting = _setting({"comparison": spec["comparison"], "sample_cap": spec["cap"], "time_budget": spec["budget"]})
+            out[(spec["comparison"], spec["checker"], setting)] += 1
+    return dict(out)
 
 
 def _setting(r: dict) -> str:
