@@ -302,3 +302,44 @@ def test_first_invalid_finishes_on_one_thread_once_its_pairs_stall(robot, rng, m
     # two pairs on two threads (the second stalls within the window of the first), the rest on one thread up to row 12
     assert threads == [2, 2, 1] and two.stalls == 1
     assert two.collision_checks - c0 == len(good) + 1
+
+
+def _two_joint_urdf(path, j2: str, b_collision: bool = True, a_collision: bool = True):
+    """A base with two arms: j1 revolute, j2 as given (its <joint> attributes and children after the parent/child)."""
+    sphere = '<collision><origin xyz="0.3 0 0"/><geometry><sphere radius="0.05"/></geometry></collision>'
+    path.write_text(f"""<robot name="t"><link name="base"/><link name="a">{sphere if a_collision else ""}</link>
+      <link name="b">{sphere if b_collision else ""}</link>
+      <joint name="j1" type="revolute"><parent link="base"/><child link="a"/><origin xyz="0 0 0.5"/><axis xyz="0 0 1"/>
+        <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+      <joint name="j2" {j2}</joint></robot>""")
+    return path
+
+
+_J2 = '<parent link="base"/><child link="b"/><origin xyz="0 0 -0.5"/><axis xyz="0 0 1"/>'
+
+
+def test_joints_it_cannot_plan_are_refused_with_what_to_do_and_locking_them_works(tmp_path):
+    limits = '<limit lower="-1" upper="1" effort="1" velocity="1"/>'
+    mimic = _two_joint_urdf(tmp_path / "mimic.urdf", f'type="revolute">{_J2}{limits}<mimic joint="j1" multiplier="-1"/>')
+    with pytest.raises(ValueError, match="joint 'j2' mimics 'j1'.*lock it"):  # it used to be planned on its own
+        RobotChecker(mimic)
+    assert RobotChecker(mimic, locked={"j2": 0.0}).nq == 1
+    continuous = _two_joint_urdf(tmp_path / "continuous.urdf", f'type="continuous">{_J2}')
+    with pytest.raises(ValueError, match="joint 'j2' is continuous.*lock it at an angle"):
+        RobotChecker(continuous)
+    assert RobotChecker(continuous, locked={"j2": 0.3}).nq == 1  # the advice can be followed
+    floating = _two_joint_urdf(tmp_path / "floating.urdf", 'type="floating"><parent link="base"/><child link="b"/>')
+    with pytest.raises(ValueError, match="'j2' .*7 position values.*fixed joint"):
+        RobotChecker(floating)
+    with pytest.raises(ValueError, match="7 position values; only 1-DOF and continuous joints can be locked"):
+        RobotChecker(floating, locked={"j2": 0.0})
+
+
+def test_a_robot_with_nothing_to_check_or_plan_is_refused_naming_the_file(tmp_path):
+    limits = '<limit lower="-1" upper="1" effort="1" velocity="1"/>'
+    bare = _two_joint_urdf(tmp_path / "bare.urdf", f'type="revolute">{_J2}{limits}', b_collision=False, a_collision=False)
+    with pytest.raises(ValueError, match="bare.urdf: no <collision> geometry moves"):  # was a ZeroDivisionError later
+        RobotChecker(bare)
+    fixed = _two_joint_urdf(tmp_path / "fixed.urdf", f'type="revolute">{_J2}{limits}')
+    with pytest.raises(ValueError, match="fixed.urdf: no joint left to plan"):
+        RobotChecker(fixed, locked={"j1": 0.0, "j2": 0.0})

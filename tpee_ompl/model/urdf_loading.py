@@ -179,6 +179,11 @@ def load_urdf_model(
         model, gmodel = _lock_joints(model, gmodel, locked, urdf)
         extra.append("locked=" + ",".join(f"{k}={float(v)!r}" for k, v in sorted(locked.items())))
     _check_joints(model, urdf)
+    _check_mimics(root, model, urdf)
+    if model.nq == 0:
+        raise ValueError(f"URDF {urdf}: no joint left to plan (every joint is fixed or locked)")
+    if not any(go.parentJoint != 0 for go in gmodel.geometryObjects):
+        raise ValueError(f"URDF {urdf}: no <collision> geometry moves with the planned joints: nothing to check")
     for go in gmodel.geometryObjects:
         _check_shape_sizes(go.geometry, go.name, urdf)
         if cylinders_as_capsules and isinstance(go.geometry, coal.Cylinder):
@@ -242,14 +247,19 @@ def _lock_joints(model: pin.Model, gmodel: pin.GeometryModel, locked: Mapping[st
         if jid >= model.njoints or jid == 0:
             raise ValueError(f"locked names unknown joint {name!r} of URDF {urdf} (joints: {list(model.names[1:])})")
         j = model.joints[jid]
-        if j.nq != 1:
-            raise ValueError(f"locked joint {name!r} has {j.nq} position values; only 1-DOF joints can be locked")
+        continuous = j.nq == 2 and j.nv == 1  # an unbounded revolute joint: (cos, sin) of its angle
+        if j.nq != 1 and not continuous:
+            raise ValueError(f"locked joint {name!r} ({j.shortname()}) has {j.nq} position values; only 1-DOF and "
+                             "continuous joints can be locked (make it a fixed joint in the URDF)")
         if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(value):
             raise ValueError(f"locked[{name!r}] must be a finite number, got {value!r}")
-        lo, hi = model.lowerPositionLimit[j.idx_q], model.upperPositionLimit[j.idx_q]
-        if not lo <= value <= hi:
-            raise ValueError(f"locked[{name!r}] = {value} is outside the joint limits [{lo}, {hi}]")
-        q[j.idx_q] = float(value)
+        if continuous:
+            q[j.idx_q : j.idx_q + 2] = [math.cos(value), math.sin(value)]
+        else:
+            lo, hi = model.lowerPositionLimit[j.idx_q], model.upperPositionLimit[j.idx_q]
+            if not lo <= value <= hi:
+                raise ValueError(f"locked[{name!r}] = {value} is outside the joint limits [{lo}, {hi}]")
+            q[j.idx_q] = float(value)
         ids.append(jid)
     return pin.buildReducedModel(model, gmodel, sorted(ids), q)
 
@@ -258,12 +268,26 @@ def _check_joints(model: pin.Model, urdf: Path) -> None:
     """Every planned joint is 1-DOF (revolute or prismatic) with finite limits."""
     for jid in range(1, model.njoints):
         j, name = model.joints[jid], model.names[jid]
+        if j.nq == 2 and j.nv == 1:
+            raise ValueError(f"URDF {urdf}: joint {name!r} is continuous (no limits): give it limits as a revolute "
+                             f"joint in the URDF, or lock it at an angle (locked={{{name!r}: angle}})")
         if j.nq != 1 or j.nv != 1:
-            raise ValueError(f"URDF {urdf}: joint {name!r} ({j.shortname()}) is not a 1-DOF joint with limits; "
-                             "lock it (locked={name: value})")
+            raise ValueError(f"URDF {urdf}: joint {name!r} ({j.shortname()}) has {j.nq} position values; only 1-DOF "
+                             "joints are planned: make it a fixed joint in the URDF")
         lo, hi = model.lowerPositionLimit[j.idx_q], model.upperPositionLimit[j.idx_q]
         if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi):
             raise ValueError(f"URDF {urdf}: joint {name!r} has limits [{lo}, {hi}] (need finite lower < upper)")
+
+
+def _check_mimics(root: ET.Element, model: pin.Model, urdf: Path) -> None:
+    """No planned joint is a URDF mimic joint: Pinocchio's parser loads one as an independent joint, so the
+    planner would give it values the robot cannot take."""
+    planned = set(model.names[1:])
+    for joint in root.iter("joint"):
+        mimic = joint.find("mimic")
+        if mimic is not None and joint.get("name") in planned:
+            raise ValueError(f"URDF {urdf}: joint {joint.get('name')!r} mimics {mimic.get('joint')!r}, which would be "
+                             f"planned as an independent joint: lock it (locked={{{joint.get('name')!r}: value}})")
 
 
 def is_prismatic(joint: pin.JointModel) -> bool:
