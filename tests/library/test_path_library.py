@@ -221,3 +221,22 @@ def test_build_takes_options_or_keyword_overrides_alike(robot: WearerArm, librar
     with pytest.raises(ValueError, match="LibraryBuildOptions"):
         PathLibrary.build(robot, sampler(robot), straight_plan(robot), {"per_pair": 3})
 
+
+
+def test_generate_refuses_a_pair_without_demonstrations_a_bad_index_or_a_non_finite_end(library):
+    import numpy as np
+
+    (i, j), pd = next(iter(library.pairs.items()))
+    start, goal = pd.starts[0].copy(), pd.goals[0].copy()
+    assert library.generate(start, goal, i, j, 0).shape[1] == 4
+    with pytest.raises(ValueError, match="demo_index must be"):  # was a bare IndexError
+        library.generate(start, goal, i, j, len(pd.starts))
+    missing = next((a, b) for a in range(1, 5) for b in range(1, 5) if a != b and (a, b) not in library.pairs) \
+        if len(library.pairs) < 12 else None
+    if missing is not None:
+        with pytest.raises(ValueError, match="no demonstrations"):  # was a KeyError
+            library.generate(start, goal, *missing, 0)
+    bad = start.copy()
+    bad[2] = np.nan
+    with pytest.raises(ValueError, match="NaN"):  # it returned a path of NaN
+        library.generate(bad, goal, i, j, 0)

@@ -153,3 +153,41 @@ def test_tracker_rejects_a_planner_path_with_wrong_ends(robot):
     tracker = Tracker(robot, lambda s, g, i, j: np.array([s, s]), initial_sector=3)
     with pytest.raises(ValueError, match="does not start"):
         tracker.step(0.0, sector_origin() + 6.0 * _direction(-100.0, -10.0))
+
+
+def test_a_target_another_posture_reaches_is_not_reported_unreachable(robot, planner):
+    tracker = Tracker(robot, planner, initial_sector=3)
+    tracker.run([(0.0, np.array([5.0, 2.0, 1.5])), (0.4, np.array([-0.3, 0.0, 1.75]))])  # near, above the pivot
+    result = tracker.result()
+    assert result.count("unreachable") == 0 and result.count("cross-sector") == 1  # it used to report both
+    assert "not reachable from posture" in result.events[-1].detail
+
+
+def test_the_rows_times_increase_whenever_the_arm_moves(robot, planner):
+    circle = [(0.05 * k, sector_origin() + 6.0 * _direction(8.0 * k, 10.0)) for k in range(60)]
+    result = Tracker(robot, planner, initial_sector=3).run(circle)
+    moved = np.max(np.abs(np.diff(result.configurations, axis=0)), axis=1) > 0
+    dt = np.diff(result.times)
+    assert np.all(dt[moved] > 0)  # re-aims right after a crossing used to share its arrival time
+    assert np.all(np.max(np.abs(np.diff(result.configurations, axis=0)), axis=1)[moved] <= dt[moved] * 1.0 + 1e-9)
+
+
+def test_a_planner_that_finds_no_path_gives_an_unreachable_event_and_the_arm_holds_still(robot):
+    def no_path(start, goal, i, j):
+        raise RuntimeError(f"no collision-free path {i}->{j}")
+
+    tracker = Tracker(robot, no_path, initial_sector=3)
+    tracker.step(0.0, sector_origin() + 6.0 * _direction(-100.0, -10.0))  # another posture's target
+    result = tracker.result()
+    assert result.count("unreachable") == 1 and "no collision-free path" in result.events[-1].detail
+    np.testing.assert_array_equal(result.configurations[-1], tracker.q)
+
+
+def test_an_initial_configuration_off_its_sectors_preset_or_a_coarse_check_step_is_refused(robot, planner):
+    from tpee_ompl.library.tracker import TrackerOptions
+    from tpee_ompl.model.sectors import posture_preset
+
+    with pytest.raises(ValueError, match="not sector 3's Table-1 preset"):
+        Tracker(robot, planner, initial=np.r_[posture_preset(1), 0.0, 0.0], initial_sector=3)
+    with pytest.raises(ValueError, match="check_step 10 rad is larger than the robot's max_joint_step"):
+        Tracker(robot, planner, options=TrackerOptions(check_step=10.0))

@@ -206,13 +206,19 @@ class PathLibrary:
     def generate(
         self, start: np.ndarray, goal: np.ndarray, from_sector: int, to_sector: int, demo_index: int, stride: int = 1
     ) -> np.ndarray:
-        """The blended DMP path (section 4.2.3) for one demonstration, unchecked.
+        """The blended DMP path (section 4.2.3) for one demonstration, not checked for collision.
 
         Shape (P, 4) with P = (N_FAKE_TIME_STEPS - 1) per_step + 1; with ``stride`` > 1 only every
-        ``stride``-th sample and the last one are kept.
+        ``stride``-th sample and the last one are kept.  Raises ValueError for a start or goal that is not
+        a finite configuration, a pair the library has no demonstrations for, or a
+        ``demo_index`` out of range.
         """
-        pd = self.pairs[(from_sector, to_sector)]
-        start, goal = np.asarray(start, dtype=float), np.asarray(goal, dtype=float)
+        start, goal = self.robot.check_config(start), self.robot.check_config(goal)
+        pd = self.pairs.get((check_sector(from_sector), check_sector(to_sector)))
+        if pd is None:
+            raise ValueError(f"the library has no demonstrations for {from_sector}->{to_sector} (pairs: {sorted(self.pairs)})")
+        if isinstance(demo_index, bool) or not isinstance(demo_index, (int, np.integer)) or not 0 <= demo_index < len(pd.starts):
+            raise ValueError(f"demo_index must be 0..{len(pd.starts) - 1} for {from_sector}->{to_sector}, got {demo_index!r}")
         dof34 = generate_blended(pd.forward[demo_index], pd.reverse[demo_index], start[2:], goal[2:])
         path = np.hstack([self._dof12(start, goal, from_sector, to_sector), dof34])
         if stride > 1:

@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..model.pointing import AimingError, PointingGeometry, aim_batch, check_target
-from ..model.sectors import SECTORS, check_sector, in_pointing_sector, posture_preset, posture_sector
+from ..model.sectors import SECTORS, check_sector, in_pointing_sector, infer_sector, posture_preset, posture_sector
 from ..model.wearer_arm import WearerArm
 from ..planning.paths import MIN_JOINT_STEP, motion_is_valid, motion_states
 from ..validation import as_float_array, check_number, check_seed
@@ -51,9 +51,11 @@ class TrackerOptions:
     Attributes
     ----------
     joint_speed : float, rad/s
-        Largest joint speed used to time-stamp cross-sector motions (max-norm over joints).
+        Largest joint speed used to time-stamp the motions (max-norm over joints): a cross-sector motion's
+        waypoints, and a re-aim that a target sample asks sooner than that speed allows.
     check_step : float, radians
-        Joint step at which every motion the tracker commands is checked for collision.
+        Joint step at which every motion the tracker commands is checked for collision (at most the
+        robot's ``max_joint_step()``, the step its collision guarantee holds for).
     """
 
     joint_speed: float = 1.0
@@ -71,7 +73,7 @@ class TrackEvent:
 
     kind is one of ``"aim"`` (re-aimed inside the sector), ``"cross-sector"`` (switched posture),
     ``"blind-area"`` (the target was in the current posture's blind cylinder), ``"unreachable"``
-    (no sector can aim at it; the arm holds still).
+    (no sector can aim at it, or the planner found no path to those that can: the arm holds still).
     """
 
     time: float
@@ -133,6 +135,13 @@ class Tracker:
         self.geometry = PointingGeometry.from_robot(robot)
         self.sector = check_sector(initial_sector)
         q0 = np.r_[posture_preset(self.sector), 0.0, 0.0] if initial is None else robot.check_config(initial)
+        if infer_sector(q0) != self.sector:
+            raise ValueError(f"initial configuration's DOF1/DOF2 {np.round(q0[:2], 4).tolist()} is not sector "
+                             f"{self.sector}'s Table-1 preset {np.round(posture_preset(self.sector), 4).tolist()} "
+                             "(initial_sector)")
+        if self.options.check_step > robot.max_joint_step():
+            raise ValueError(f"check_step {self.options.check_step:g} rad is larger than the robot's max_joint_step() "
+                             f"{robot.max_joint_step():.4g}: motions could pass through obstacles between checked states")
         if not robot.within_limits(q0):
             raise ValueError(f"initial configuration {np.round(q0, 4).tolist()} is outside the joint limits")
         if not robot.is_valid(q0):
@@ -144,6 +153,7 @@ class Tracker:
         self._targets: list[np.ndarray] = []
         self._sectors: list[int] = []
         self.events: list[TrackEvent] = []
+        self._no_path: list[str] = []
 
     # ------------------------------------------------------------------ helpers
     def _record(self, t: float, q: np.ndarray, target: np.ndarray | None, sector: int) -> None:
@@ -171,9 +181,19 @@ class Tracker:
         order += [k for k in SECTORS if k not in order]
         return [k for k in order if k != self.sector]
 
-    def _cross(self, t: float, goal: np.ndarray, k: int, target: np.ndarray, why: str) -> float:
-        """Run the planner from the current configuration to goal in sector k; return the arrival time."""
-        waypoints = np.asarray(self.planner(self.q.copy(), goal.copy(), self.sector, k), dtype=float)
+    def _cross(self, t: float, goal: np.ndarray, k: int, target: np.ndarray, why: str) -> float | None:
+        """Run the planner from the current configuration to goal in sector k; return the arrival time, or None
+        when the planner found no path (it returned None or raised RuntimeError: the reason goes to
+        ``self._no_path``).  A path that does not start and end there, or collides, raises ValueError."""
+        try:
+            found = self.planner(self.q.copy(), goal.copy(), self.sector, k)
+        except RuntimeError as exc:
+            self._no_path.append(f"{self.sector}->{k}: {exc}")
+            return None
+        if found is None:
+            self._no_path.append(f"{self.sector}->{k}: the planner found no path")
+            return None
+        waypoints = np.asarray(found, dtype=float)
         if waypoints.ndim != 2 or waypoints.shape[1] != 4 or len(waypoints) < 2:
             raise ValueError(f"planner returned waypoints of shape {waypoints.shape}, expected (K >= 2, 4)")
         if not (np.allclose(waypoints[0], self.q, atol=1e-6) and np.allclose(waypoints[-1], goal, atol=1e-6)):
@@ -195,7 +215,8 @@ class Tracker:
     def step(self, t: float, target: np.ndarray, new_target: bool = False) -> None:
         """Process one target sample at time t (seconds); ``new_target`` marks a 'lock a new target' event.
 
-        A time before the last one is clamped to it.  A target that is not finite, too far
+        A time before the last one is clamped to it, and a re-aim takes at least the time ``joint_speed``
+        allows.  A target that is not finite, too far
         (``MAX_TARGET_DISTANCE``) or inside the wearer is recorded as an ``"unreachable"`` event.
 
         Raises
@@ -216,31 +237,41 @@ class Tracker:
             self.time = t
             return
         why = "new target outside the pointing sector" if new_target else "target left the pointing sector"
+        self._no_path = []
         if in_pointing_sector(target, self.sector, self.geometry.pivot):
             try:
                 aim_batch(target[None], self.sector, geometry=self.geometry, pan_reference=self.q[2])
             except AimingError as exc:
-                kind = "blind-area" if type(exc).__name__ == "BlindAreaError" else "unreachable"
-                self.events.append(TrackEvent(t, kind, self.sector, str(exc)))
-                why = kind
+                if type(exc).__name__ == "BlindAreaError":
+                    self.events.append(TrackEvent(t, "blind-area", self.sector, str(exc)))
+                    why = "blind-area"
+                else:  # an "unreachable" event only if no other posture can aim at it either (below)
+                    why = f"not reachable from posture {self.sector} ({exc})"
             else:
                 q = self._aim_from(target, self.sector)
                 if q is not None and self._motion_free(self.q, q):
                     self.events.append(TrackEvent(t, "aim", self.sector))
+                    # a re-aim takes the time joint_speed allows (the rows' times increase while the arm moves)
+                    t = max(t, self.time + float(np.max(np.abs(q - self.q))) / self.options.joint_speed)
                     self.q = q
                     self._record(t, q, target, self.sector)
                     self.time = t
                     return
                 if q is not None:  # the re-aim itself would collide: plan it inside the sector
-                    self.time = self._cross(t, q, self.sector, target, "re-aim motion collides")
-                    return
+                    arrival = self._cross(t, q, self.sector, target, "re-aim motion collides")
+                    if arrival is not None:
+                        self.time = arrival
+                        return
                 why = "no collision-free aim with a clear line of sight from this posture"
         for k in self._candidate_sectors(target):
             q = self._aim_from(target, k)
             if q is not None:
-                self.time = self._cross(t, q, k, target, why)
-                return
-        self.events.append(TrackEvent(t, "unreachable", self.sector, "no posture can aim at the target"))
+                arrival = self._cross(t, q, k, target, why)
+                if arrival is not None:
+                    self.time = arrival
+                    return
+        detail = "no posture can aim at the target" if not self._no_path else "no path: " + "; ".join(self._no_path)
+        self.events.append(TrackEvent(t, "unreachable", self.sector, detail))
         self._record(t, self.q, None, self.sector)
         self.time = t
 
