@@ -73,12 +73,14 @@ def separated_pairs(robot: RobotChecker) -> list[int]:
             grid[:, j] = values
             gap = R[p, j] * (values[1] - values[0]) / 2
         gd.activateCollisionPair(p)
-        lowest = math.inf
+        apart = True
         for q in grid:
             pin.computeDistances(model, data, gmodel, gd, q)
-            lowest = min(lowest, gd.distanceResults[p].min_distance)
+            if gd.distanceResults[p].min_distance - gap - SEPARATION_TOLERANCE < margins[p]:
+                apart = False  # one grid point close enough decides: the rest cannot prove it apart
+                break
         gd.deactivateCollisionPair(p)
-        if lowest - gap - SEPARATION_TOLERANCE >= margins[p]:
+        if apart:
             out.append(p)
     return out
 
