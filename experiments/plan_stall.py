@@ -10,6 +10,7 @@ per pair the stalled run's time and length against the 2 s run's, then the media
 
 from __future__ import annotations
 
+import argparse
 import json
 import statistics
 import subprocess
@@ -22,7 +23,8 @@ def _plan(i: int, j: int, *extra: str) -> dict:
     return json.loads(out)
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> None:
+    argparse.ArgumentParser(description=__doc__.splitlines()[0]).parse_args(argv)  # --help; no options
     times, excess = [], []
     for i in range(1, 5):
         for j in range(1, 5):
