@@ -17,6 +17,7 @@ import logging
 import signal
 from collections import Counter
 from collections.abc import Mapping, Sequence
+from concurrent.futures import ProcessPoolExecutor
 from dataclasses import asdict, dataclass
 from multiprocessing import get_context
 from typing import Any
@@ -168,11 +169,19 @@ def collect_default_demos(
     model = (robot.files.urdf, robot.files.srdf, robot.security_margin, dict(robot.link_margins), robot.n_threads)
     jobs = [(model, i, j, child, opts) for (i, j), child in zip(opts.pairs, children)]
     if opts.workers > 1 and len(jobs) > 1:
-        with sigint_blocked_for_children():  # Ctrl-C is the parent's: it ends the pool (the with block terminates it)
-            pool = get_context("spawn").Pool(min(opts.workers, len(jobs)), initializer=child_sigint,
-                                             initargs=(signal.SIG_IGN,))
-        with pool:
-            results = pool.map_async(_collect_default_pair, jobs, chunksize=1).get()
+        # the workers ignore Ctrl-C: the parent ends them (a worker that dies breaks the pool: an error, not a hang)
+        ex = ProcessPoolExecutor(min(opts.workers, len(jobs)), mp_context=get_context("spawn"),
+                                 initializer=child_sigint, initargs=(signal.SIG_IGN,))
+        try:
+            with sigint_blocked_for_children():  # the workers start on submit
+                futures = [ex.submit(_collect_default_pair, job) for job in jobs]
+            results = [f.result() for f in futures]
+        except BaseException:
+            for proc in list((getattr(ex, "_processes", None) or {}).values()):  # no public way before 3.14
+                proc.terminate()
+            ex.shutdown(wait=False, cancel_futures=True)
+            raise
+        ex.shutdown()
     else:
         results = [_collect_default_pair(job, robot) for job in jobs]
     stats: Counter[str] = Counter()
