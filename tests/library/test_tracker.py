@@ -183,11 +183,12 @@ def test_a_planner_that_finds_no_path_gives_an_unreachable_event_and_the_arm_hol
     np.testing.assert_array_equal(result.configurations[-1], tracker.q)
 
 
-def test_an_initial_configuration_off_its_sectors_preset_or_a_coarse_check_step_is_refused(robot, planner):
+def test_an_initial_configuration_off_its_sectors_preset_is_refused_and_the_check_step_is_capped(robot, planner):
     from tpee_ompl.library.tracker import TrackerOptions
     from tpee_ompl.model.sectors import posture_preset
 
     with pytest.raises(ValueError, match="not sector 3's Table-1 preset"):
         Tracker(robot, planner, initial=np.r_[posture_preset(1), 0.0, 0.0], initial_sector=3)
-    with pytest.raises(ValueError, match="check_step 10 rad is larger than the robot's max_joint_step"):
-        Tracker(robot, planner, options=TrackerOptions(check_step=10.0))
+    coarse = Tracker(robot, planner, options=TrackerOptions(check_step=10.0))
+    assert coarse.check_step == robot.max_joint_step()  # never coarser than the robot's guarantee (10 rad was used)
+    assert Tracker(robot, planner).check_step == min(0.01, robot.max_joint_step())

@@ -291,3 +291,14 @@ def test_a_script_that_keeps_its_callback_set_exits_without_leak_warnings(tmp_pa
                           cwd=tmp_path, env={**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[2])})
     assert done.returncode == 0, done.stderr
     assert "leaked" not in done.stderr
+
+
+def test_initial_waypoints_set_after_the_bounds_widened_are_checked_against_the_new_bounds() -> None:
+    ss = _wall_setup(1.0)
+    planner = DimensionRRT(ss.getSpaceInformation(), seed=0, max_samples=CAP)
+    ss.getStateSpace().setBounds(-2.0, 2.0)
+    W = np.linspace([-0.5, 0.0, 0.0], [0.5, 0.0, 0.0], 7)
+    W[1:-1, 1] = 1.5  # round the wall, outside the bounds the planner was built with
+    planner.set_initial_waypoints(W)  # was refused: checked against the old bounds
+    ss.setPlanner(planner)
+    assert ss.solve(ob.timedPlannerTerminationCondition(60.0)) == ob.PlannerStatus.EXACT_SOLUTION

@@ -355,7 +355,10 @@ def _execute_locked(directory: Path, meta: dict, executor, on_task_done, report:
             log.warning("interrupted: building the database from the finished logs")
         finally:
             if executor is not None:
-                executor.shutdown(cancel=True)
+                try:
+                    executor.shutdown(cancel=True)
+                except KeyboardInterrupt as exc:  # a second interrupt: say which campaign to resume
+                    raise CampaignInterrupted(directory) from exc
         try:
             return _finish(directory, meta, executor, failed, broken, interrupted, report, time.perf_counter() - t0)
         except KeyboardInterrupt as exc:  # a second interrupt: say which campaign to resume

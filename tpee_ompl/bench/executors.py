@@ -159,12 +159,13 @@ class ProcessPoolExecutor:
     def _start(self, ctx, fn: TaskFn, task: dict, attempt: int) -> None:
         recv, send = ctx.Pipe(duplex=False)
         proc = ctx.Process(target=_child_main, args=(fn, task, send), daemon=True)
-        with sigint_blocked_for_children():  # a Ctrl-C now must not reach the child's imports
-            proc.start()
-        send.close()  # the child holds the only write end: EOF when it dies
         limit = task.get("time_limit_s")
-        self._running.append(_Running(proc, recv, task, attempt,
-                                      None if limit is None else time.monotonic() + float(limit)))
+        # a Ctrl-C now must not reach the child's imports; one held until the block ends finds it registered
+        with sigint_blocked_for_children():
+            proc.start()
+            send.close()  # the child holds the only write end: EOF when it dies
+            self._running.append(_Running(proc, recv, task, attempt,
+                                          None if limit is None else time.monotonic() + float(limit)))
 
     def run(self, fn: TaskFn, tasks: Sequence[dict]) -> Iterator[dict]:  # noqa: D102
         ctx = mp.get_context("spawn")
@@ -298,7 +299,7 @@ def _quiet_dask_logs() -> Iterator[None]:
     if logging.getLogger().isEnabledFor(logging.INFO):
         yield
         return
-    logging.getLogger("distributed").setLevel(logging.ERROR)
+    logging.getLogger("distributed").setLevel(logging.ERROR)  # back at the executor's shutdown
     key, before = "DASK_LOGGING__DISTRIBUTED", os.environ.get("DASK_LOGGING__DISTRIBUTED")
     os.environ[key] = "error"  # the worker processes started within the block configure their logging from it
     try:
@@ -339,6 +340,7 @@ class DaskExecutor:
             self.client = client
             self.description = f"Dask client {client.scheduler.address}"
         elif scheduler == "local":
+            self._log_level = logging.getLogger("distributed").level
             with _quiet_dask_logs(), sigint_blocked_for_children():  # Ctrl-C is ours: shutdown() closes the cluster
                 self._cluster = distributed.LocalCluster(n_workers=int(n_workers), threads_per_worker=1, processes=True,
                                                          dashboard_address=":0")
@@ -379,6 +381,7 @@ class DaskExecutor:
         if self._cluster is not None:
             with contextlib.suppress(Exception):
                 self._cluster.close()
+            logging.getLogger("distributed").setLevel(self._log_level)
 
 
 def make_executor(workers: int = 1, dask: str | None = None, dask_workers: int = 2,

@@ -54,8 +54,8 @@ class TrackerOptions:
         Largest joint speed used to time-stamp the motions (max-norm over joints): a cross-sector motion's
         waypoints, and a re-aim that a target sample asks sooner than that speed allows.
     check_step : float, radians
-        Joint step at which every motion the tracker commands is checked for collision (at most the
-        robot's ``max_joint_step()``, the step its collision guarantee holds for).
+        Joint step at which every motion the tracker commands is checked for collision (a larger one than
+        the robot's ``max_joint_step()``, the step its collision guarantee holds for, is taken as that).
     """
 
     joint_speed: float = 1.0
@@ -139,9 +139,8 @@ class Tracker:
             raise ValueError(f"initial configuration's DOF1/DOF2 {np.round(q0[:2], 4).tolist()} is not sector "
                              f"{self.sector}'s Table-1 preset {np.round(posture_preset(self.sector), 4).tolist()} "
                              "(initial_sector)")
-        if self.options.check_step > robot.max_joint_step():
-            raise ValueError(f"check_step {self.options.check_step:g} rad is larger than the robot's max_joint_step() "
-                             f"{robot.max_joint_step():.4g}: motions could pass through obstacles between checked states")
+        self.check_step = min(self.options.check_step, robot.max_joint_step())
+        """The step the tracker checks its motions at: ``check_step``, at most the robot's ``max_joint_step()``."""
         if not robot.within_limits(q0):
             raise ValueError(f"initial configuration {np.round(q0, 4).tolist()} is outside the joint limits")
         if not robot.is_valid(q0):
@@ -172,7 +171,7 @@ class Tracker:
         return q
 
     def _motion_free(self, a: np.ndarray, b: np.ndarray) -> bool:
-        return bool(self.robot.are_valid(motion_states(a, b, self.options.check_step)).all())
+        return bool(self.robot.are_valid(motion_states(a, b, self.check_step)).all())
 
     def _candidate_sectors(self, target: np.ndarray) -> list[int]:
         """Sectors to try after the current one: the posture sector, other pointing sectors, the rest."""
@@ -199,8 +198,8 @@ class Tracker:
         if not (np.allclose(waypoints[0], self.q, atol=1e-6) and np.allclose(waypoints[-1], goal, atol=1e-6)):
             raise ValueError("planner path does not start at the current configuration and end at the goal")
         waypoints[0], waypoints[-1] = self.q, goal
-        if not motion_is_valid(self.robot, waypoints, self.options.check_step):
-            raise ValueError(f"planner path {self.sector}->{k} collides (checked every {self.options.check_step} rad)")
+        if not motion_is_valid(self.robot, waypoints, self.check_step):
+            raise ValueError(f"planner path {self.sector}->{k} collides (checked every {self.check_step:g} rad)")
         self.events.append(TrackEvent(t, "cross-sector", k, f"{self.sector}->{k}: {why}, {len(waypoints)} waypoints"))
         clock = t
         for i in range(1, len(waypoints)):

@@ -228,19 +228,24 @@ class DimensionRRT(PythonPlanner):
         """Take the space's bounds as they are now, as OMPL's planners do (their samplers read them at each
         solve): when they changed since this planner was built, the groups, ``range_`` and the initial
         waypoints are set up again for them.  None when the planner can go on, else ABORT (the reason logged)."""
-        space = self.getSpaceInformation().getStateSpace()
-        old = self.grouped
         try:
-            layout = RealVectorLayout(space)
-            if np.array_equal(layout.lower, old.layout.lower) and np.array_equal(layout.upper, old.layout.upper):
+            grouped = self._regrouped()
+            if grouped is None:
                 return None
-            grouped = GroupedSpace(space, old.groups, old.h, old.prescribed)
             initial = self._check_initial(grouped, self._initial)
         except ValueError as e:
             log.error("%s: the space's bounds changed and %s", self.getName(), e)
             return planner_status(ob.PlannerStatus.ABORT)
         self.grouped, self.range_, self._initial = grouped, self._full_range(self.options, grouped), initial
         return None
+
+    def _regrouped(self) -> GroupedSpace | None:
+        """The grouped space for the space's bounds as they are now, or None when they have not changed."""
+        space, old = self.getSpaceInformation().getStateSpace(), self.grouped
+        layout = RealVectorLayout(space)
+        if np.array_equal(layout.lower, old.layout.lower) and np.array_equal(layout.upper, old.layout.upper):
+            return None
+        return GroupedSpace(space, old.groups, old.h, old.prescribed)
 
     def _ranges(self, grouped: GroupedSpace) -> dict[int, np.ndarray]:
         """Group index -> the smallest narrowed padding of its DOFs (``range_``), for ``grouped``'s groups."""
@@ -271,7 +276,10 @@ class DimensionRRT(PythonPlanner):
         motions are checked like any other, and an invalid W only gives the feasibility phase a head
         start (its valid prefix and suffix seed the layered trees).  Kept across :meth:`clear`.
         """
-        self._initial = self._check_initial(self.grouped, W)
+        grouped = self._regrouped() or self.grouped  # checked against the bounds as they are now
+        self._initial = self._check_initial(grouped, W)
+        if grouped is not self.grouped:
+            self.grouped, self.range_ = grouped, self._full_range(self.options, grouped)
 
     def set_intermediate_solution_callback(
         self, callback: Callable[[ob.Planner, list[ob.State], ob.Cost], object] | None
