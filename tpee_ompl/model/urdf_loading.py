@@ -247,7 +247,7 @@ def _lock_joints(model: pin.Model, gmodel: pin.GeometryModel, locked: Mapping[st
         if jid >= model.njoints or jid == 0:
             raise ValueError(f"locked names unknown joint {name!r} of URDF {urdf} (joints: {list(model.names[1:])})")
         j = model.joints[jid]
-        continuous = j.nq == 2 and j.nv == 1  # an unbounded revolute joint: (cos, sin) of its angle
+        continuous = is_continuous(j)
         if j.nq != 1 and not continuous:
             raise ValueError(f"locked joint {name!r} ({j.shortname()}) has {j.nq} position values; only 1-DOF and "
                              "continuous joints can be locked (make it a fixed joint in the URDF)")
@@ -268,7 +268,7 @@ def _check_joints(model: pin.Model, urdf: Path) -> None:
     """Every planned joint is 1-DOF (revolute or prismatic) with finite limits."""
     for jid in range(1, model.njoints):
         j, name = model.joints[jid], model.names[jid]
-        if j.nq == 2 and j.nv == 1:
+        if is_continuous(j):
             raise ValueError(f"URDF {urdf}: joint {name!r} is continuous (no limits): give it limits as a revolute "
                              f"joint in the URDF, or lock it at an angle (locked={{{name!r}: angle}})")
         if j.nq != 1 or j.nv != 1:
@@ -288,6 +288,11 @@ def _check_mimics(root: ET.Element, model: pin.Model, urdf: Path) -> None:
         if mimic is not None and joint.get("name") in planned:
             raise ValueError(f"URDF {urdf}: joint {joint.get('name')!r} mimics {mimic.get('joint')!r}, which would be "
                              f"planned as an independent joint: lock it (locked={{{joint.get('name')!r}: value}})")
+
+
+def is_continuous(joint: pin.JointModel) -> bool:
+    """True for an unbounded revolute joint: one velocity, two position values (cos, sin of its angle)."""
+    return joint.nq == 2 and joint.nv == 1
 
 
 def is_prismatic(joint: pin.JointModel) -> bool:
