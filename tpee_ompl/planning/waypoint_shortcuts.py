@@ -8,7 +8,10 @@ waypoint's other DOFs fixed, ``|A - X| + |X - B|`` is least at the point of the 
 distances to the neighbours (exact for the Euclidean metric; with no fixed DOF, the projection of
 ``W[t]`` onto the segment).  The length through the neighbours is convex along the way there, so each
 fraction of the move shortens the path; the largest of :data:`SHORTCUT_FRACTIONS` whose waypoint and
-both motions pass is taken, by the same checks as a sample's candidate.  A waypoint that lands on its
+both motions pass is taken, by the same checks as a sample's candidate.  One sweep can leave the
+path short of what the next gives (a moved waypoint moves its neighbours' shortest points), so with a
+prescribed group the sweeps repeat (:func:`sweep_until_settled`) while each still shortens the path by
+:data:`SWEEP_MIN_GAIN` of its length, at most :data:`MAX_SWEEPS` times.  A waypoint that lands on its
 neighbours' segment in every DOF can never move again by the paper's rule (nothing is shorter there),
 which is why :class:`~tpee_ompl.planning.dimension_rrt.DimensionRRT` uses them by default only with a
 prescribed group.  Measured in ``docs/dimension_rrt.md`` ("Shortcuts between fake-time waypoints").
@@ -31,10 +34,15 @@ if TYPE_CHECKING:  # pragma: no cover
     from .grouped_space import RealVectorLayout
     from .search_checker import Checker
 
-__all__ = ["COLLAPSED_FRACTION", "SHORTCUT_FRACTIONS", "respread_candidate", "shortcut_targets", "shortcut_waypoints"]
+__all__ = ["COLLAPSED_FRACTION", "MAX_SWEEPS", "SHORTCUT_FRACTIONS", "SWEEP_MIN_GAIN", "respread_candidate",
+           "shortcut_targets", "shortcut_waypoints", "sweep_until_settled"]
 
 SHORTCUT_FRACTIONS = (1.0, 0.5, 0.25)
 """Fractions of the way to the shortest point tried, largest first (the first that passes is kept)."""
+MAX_SWEEPS = 8
+"""Most sweeps in a row after one improvement of the rows' search (the released search sweeps once)."""
+SWEEP_MIN_GAIN = 0.003
+"""Another sweep follows only while the last one shortened the path by at least this fraction of it."""
 COLLAPSED_FRACTION = 0.1
 """A segment shorter than this fraction of the path's mean segment has collapsed (its step is wasted)."""
 
@@ -84,6 +92,21 @@ def shortcut_waypoints(W: np.ndarray, L: np.ndarray, dims: np.ndarray, layout: R
                 L[t - 1], L[t] = dl[k], dr[k]
                 todo[k] = False
                 moved += 1
+    return moved
+
+
+def sweep_until_settled(W: np.ndarray, L: np.ndarray, dims: np.ndarray, layout: RealVectorLayout, checker: Checker,
+                        max_sweeps: int | None = None) -> int:
+    """:func:`shortcut_waypoints` again while the last sweep moved a waypoint and shortened the path by at
+    least :data:`SWEEP_MIN_GAIN` of its length, at most ``max_sweeps`` (default :data:`MAX_SWEEPS`) sweeps.
+    Returns the number of waypoint moves; W stays a valid path."""
+    moved = 0
+    for _ in range(MAX_SWEEPS if max_sweeps is None else max_sweeps):
+        before = float(L.sum())
+        m = shortcut_waypoints(W, L, dims, layout, checker)
+        moved += m
+        if not m or before - float(L.sum()) < SWEEP_MIN_GAIN * before:
+            break
     return moved
 
 
