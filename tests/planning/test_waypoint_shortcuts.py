@@ -11,7 +11,7 @@ from ompl import geometric as og
 from tpee_ompl.planning.dimension_rrt import DimensionRRT
 from tpee_ompl.planning.dimension_search import Search
 from tpee_ompl.planning.grouped_space import GroupedSpace
-from tpee_ompl.planning.paths import path_passes_motion_checks
+from tpee_ompl.planning.paths import path_passes_motion_checks, path_to_array
 from tpee_ompl.planning.search_checker import Checker
 from tpee_ompl.planning import waypoint_shortcuts
 from tpee_ompl.planning.waypoint_shortcuts import (
@@ -157,7 +157,7 @@ def test_the_released_search_respreads_collapsed_waypoints_into_a_valid_shorter_
     assert np.array_equal(search.W, moved)
 
 
-def _solve_3d(shortcuts: bool | None, seed: int, prescribed: bool = True) -> tuple[DimensionRRT, float]:
+def _solve_3d(shortcuts: bool | None, seed: int, prescribed: bool = True, **options: object) -> tuple[DimensionRRT, float]:
     si, _ = box_problem(lo=(-0.3, -0.3, -0.5), hi=(0.3, 0.3, 0.5))
     ss = og.SimpleSetup(si)
     start, goal = si.allocState(), si.allocState()
@@ -167,7 +167,7 @@ def _solve_3d(shortcuts: bool | None, seed: int, prescribed: bool = True) -> tup
     ss.setOptimizationObjective(ob.PathLengthOptimizationObjective(si))
     row = {0: np.linspace(-0.9, 0.9, 7)[:, None]} if prescribed else None
     planner = DimensionRRT(si, groups=[[0], [1, 2]], h=7, max_samples=300, seed=seed, shortcuts=shortcuts,
-                           prescribed=row)
+                           prescribed=row, **options)
     ss.setPlanner(planner)
     assert ss.solve(10.0) == ob.PlannerStatus.EXACT_SOLUTION
     path = ss.getSolutionPath()
@@ -196,7 +196,7 @@ def test_one_rule_decides_the_shortcuts_default() -> None:
     assert shortcuts_on(DimensionRRTOptions(shortcuts=True), prescribed=False) is True
 
 
-def test_the_rows_search_sweeps_until_settled_and_the_released_search_once(monkeypatch: pytest.MonkeyPatch) -> None:
+def test_rows_kept_to_the_end_sweep_until_settled_else_once(monkeypatch: pytest.MonkeyPatch) -> None:
     maxima: list[int | None] = []
     real = waypoint_shortcuts.sweep_until_settled
 
@@ -210,6 +210,9 @@ def test_the_rows_search_sweeps_until_settled_and_the_released_search_once(monke
     maxima.clear()
     _solve_3d(True, 0, prescribed=False)
     assert maxima and set(maxima) == {1}
+    maxima.clear()
+    planner, _ = _solve_3d(True, 0, release_after=30)  # rows to be released: once, before and after
+    assert planner.last_run_stats()["released_at"] is not None and maxima and set(maxima) == {1}
 
 
 def test_repeated_sweeps_give_shorter_paths_at_a_sample_cap(monkeypatch: pytest.MonkeyPatch) -> None:
@@ -217,3 +220,20 @@ def test_repeated_sweeps_give_shorter_paths_at_a_sample_cap(monkeypatch: pytest.
     monkeypatch.setattr(waypoint_shortcuts, "MAX_SWEEPS", 1)
     once = [_solve_3d(True, seed)[1] for seed in range(5)]
     assert np.mean(many) < np.mean(once)
+
+
+def test_settling_sweeps_skip_unmoved_waypoints_with_the_same_paths_and_fewer_checks(monkeypatch: pytest.MonkeyPatch) -> None:
+    def run() -> list[tuple[bytes, int]]:
+        out = []
+        for seed in range(3):
+            planner, _ = _solve_3d(True, seed)
+            out.append((path_to_array(planner.getProblemDefinition().getSolutionPath(), 3).tobytes(),
+                        planner.last_run_stats()["collision_checks"]))
+        return out
+
+    skipping = run()
+    real = waypoint_shortcuts.shortcut_waypoints
+    monkeypatch.setattr(waypoint_shortcuts, "shortcut_waypoints", lambda W, L, d, lay, c, dirty=None: real(W, L, d, lay, c))
+    full = run()
+    assert [p for p, _ in skipping] == [p for p, _ in full]
+    assert sum(c for _, c in skipping) < sum(c for _, c in full)

@@ -25,12 +25,13 @@ __all__ = ["Search"]
 
 class Search(SampleDraws):
     """The dimension-RRT iteration on a waypoint array; OMPL-free apart from the checker.  ``local``: narrowed
-    samples around one waypoint at a time (the released search; :meth:`SampleDraws._group_draws`)."""
+    samples around one waypoint at a time (the released search; :meth:`SampleDraws._group_draws`).  ``settle``:
+    the rows will not be released, so with a prescribed group the shortcut sweeps repeat until settled."""
 
     def __init__(self, grouped: GroupedSpace, checker: Checker, rng: np.random.Generator, start: np.ndarray,
                  goal: np.ndarray, narrow_after: int, narrowing: float, range_: dict[int, np.ndarray],
                  initial: np.ndarray | None = None, connect: bool = True, turns: np.ndarray | None = None,
-                 shortcuts: bool = False, local: bool = False) -> None:
+                 shortcuts: bool = False, local: bool = False, settle: bool = False) -> None:
         self.checker = checker
         self.dist = grouped.layout.distance
         W = grouped.initial_waypoints(start, goal)
@@ -68,6 +69,7 @@ class Search(SampleDraws):
         self._hold = not grouped.prescribed
         self.delta = grouped.layout.delta
         self._shortcuts = shortcuts
+        self._settle = settle and bool(grouped.prescribed)  # rows kept to the end: sweeps until settled
         self._shortcut_due = self.valid  # the valid path changed since the last sweep (or is new)
         if turns is not None and not self.valid:  # a connect path found with fewer steps (h raised)
             self._use_connect = False
@@ -89,9 +91,9 @@ class Search(SampleDraws):
     def iterate(self, limit: int = 1, stop: Callable[[], bool] | None = None) -> int:
         """Draw one sample and try it at every intermediate step (up to ``limit`` samples; see below).
 
-        On a valid path the sample is the current group's (paper's rule), followed with ``shortcuts``
-        by :func:`sweep_until_settled` over that group when the path changed (one sweep once released); before, it covers all
-        planned groups at once and grows the connect trees (no prescribed group) or the layered
+        On a valid path the sample is the current group's (paper's rule), followed with ``shortcuts`` by
+        :func:`sweep_until_settled` over that group when the path changed (one sweep unless ``settle``);
+        before, it covers all planned groups at once and grows the connect trees (no prescribed group) or the layered
         trees.  Returns the number of waypoints changed (feasibility phase: 1 when a path was found,
         0 otherwise).
 
@@ -135,10 +137,10 @@ class Search(SampleDraws):
         accepted = self._improve(gi, c)
         if self._shortcuts and (accepted or self._shortcut_due):
             self._shortcut_due = False
-            # the rows' search sweeps until settled (Table 4 at 500 samples: 1.2-1.9 % shorter); the released
-            # search once (more sweeps cost it more than they save)
+            # until settled on rows kept to the end (Table 4 at 500 samples: 1.2-1.9 % shorter), else once (the
+            # pipeline's rows phase and the released search: more sweeps cost them more than they save)
             accepted += sweep_until_settled(self.W, self.L, self._dims[gi], self.g.layout, self.checker,
-                                            None if self.g.prescribed else 1)
+                                            None if self._settle else 1)
             accepted += 0 if self.g.prescribed else self._respread()
         return accepted
 

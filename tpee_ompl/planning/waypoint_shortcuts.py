@@ -63,16 +63,23 @@ def shortcut_targets(A: np.ndarray, X: np.ndarray, B: np.ndarray, dims: np.ndarr
     return layout.wrap(T)
 
 
-def shortcut_waypoints(W: np.ndarray, L: np.ndarray, dims: np.ndarray, layout: RealVectorLayout, checker: Checker) -> int:
+def shortcut_waypoints(W: np.ndarray, L: np.ndarray, dims: np.ndarray, layout: RealVectorLayout, checker: Checker,
+                       dirty: np.ndarray | None = None) -> int:
     """Move the intermediate waypoints of the valid path W (h, n) towards their shortest points, in place.
 
     The odd steps go first, then the even ones, so no two neighbours move at once (the motion between
     them would be unchecked).  ``L`` (h - 1,) holds the segment lengths and is kept up to date; a
     waypoint moves only when the path gets shorter and the candidate and both its motions are valid,
-    so W stays a valid path.  Returns the number of waypoints moved."""
+    so W stays a valid path.  ``dirty`` (h,) bool, updated in place: only the waypoints marked are
+    tried (the others, with themselves and their neighbours where they were when last tried, would get
+    the same candidates and verdicts); a tried waypoint is unmarked, and a moved one marks itself and
+    its neighbours.  Returns the number of waypoints moved."""
     moved = 0
     for first in (1, 2):
         ts = np.arange(first, len(W) - 1, 2)
+        if dirty is not None:
+            ts = ts[dirty[ts]]
+            dirty[ts] = False
         if not len(ts):
             continue
         A, X, B = W[ts - 1], W[ts].copy(), W[ts + 1]
@@ -92,6 +99,8 @@ def shortcut_waypoints(W: np.ndarray, L: np.ndarray, dims: np.ndarray, layout: R
                 L[t - 1], L[t] = dl[k], dr[k]
                 todo[k] = False
                 moved += 1
+                if dirty is not None:
+                    dirty[t - 1 : t + 2] = True
     return moved
 
 
@@ -99,11 +108,14 @@ def sweep_until_settled(W: np.ndarray, L: np.ndarray, dims: np.ndarray, layout: 
                         max_sweeps: int | None = None) -> int:
     """:func:`shortcut_waypoints` again while the last sweep moved a waypoint and shortened the path by at
     least :data:`SWEEP_MIN_GAIN` of its length, at most ``max_sweeps`` (default :data:`MAX_SWEEPS`) sweeps.
-    Returns the number of waypoint moves; W stays a valid path."""
+    Each sweep after the first tries only the waypoints that moved or whose neighbours moved since they
+    were last tried (the same moves as full sweeps, fewer checks).  Returns the number of waypoint moves;
+    W stays a valid path."""
     moved = 0
+    dirty = np.ones(len(W), dtype=bool)
     for _ in range(MAX_SWEEPS if max_sweeps is None else max_sweeps):
         before = float(L.sum())
-        m = shortcut_waypoints(W, L, dims, layout, checker)
+        m = shortcut_waypoints(W, L, dims, layout, checker, dirty)
         moved += m
         if not m or before - float(L.sum()) < SWEEP_MIN_GAIN * before:
             break
