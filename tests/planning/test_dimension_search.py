@@ -185,9 +185,9 @@ def test_hits_checked_together_give_the_paths_of_hits_checked_one_by_one(
     given = []
     candidates = Checker.candidates
 
-    def recorded(self, C, A, B, left, right, strict, valid=None):
+    def recorded(self, C, A, B, left, right, strict, valid=None, screen_only=False):
         given.append(valid is not None)
-        return candidates(self, C, A, B, left, right, strict, valid)
+        return candidates(self, C, A, B, left, right, strict, valid, screen_only)
 
     monkeypatch.setattr(Checker, "candidates", recorded)
 

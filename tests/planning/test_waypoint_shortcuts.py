@@ -109,6 +109,44 @@ def test_sweeps_repeat_until_one_gains_less_than_the_threshold() -> None:
     assert np.allclose(L, grouped.layout.distance(W[:-1], W[1:]))
 
 
+def _settled_in_full(W: np.ndarray, L: np.ndarray, grouped: GroupedSpace, checker: Checker) -> np.ndarray:
+    """W after sweeps with every move checked in full, as long as each gains SWEEP_MIN_GAIN."""
+    W, L = W.copy(), L.copy()
+    for _ in range(100):
+        before = L.sum()
+        if not shortcut_waypoints(W, L, np.array([0, 1]), grouped.layout, checker) or before - L.sum() < SWEEP_MIN_GAIN * before:
+            return W
+    return W
+
+
+def test_settling_sweeps_check_the_changed_motions_in_full_once_at_the_end(monkeypatch: pytest.MonkeyPatch) -> None:
+    W, L, grouped, checker = _zigzag()
+    assert checker.batched
+    reference = _settled_in_full(W, L, grouped, checker)
+    calls: list[int] = []
+    real = checker.check_motions
+    monkeypatch.setattr(checker, "check_motions", lambda A, B: calls.append(len(A)) or real(A, B))
+    sweep_until_settled(W, L, np.array([0, 1]), grouped.layout, checker, max_sweeps=100)
+    assert calls == [6] and np.array_equal(W, reference)  # every segment changed; checked once
+
+
+def test_settling_sweeps_start_again_with_full_checks_when_a_screened_move_fails(monkeypatch: pytest.MonkeyPatch) -> None:
+    W, L, grouped, checker = _zigzag()
+    reference = _settled_in_full(W, L, grouped, checker)
+    calls: list[int] = []
+    real = checker.check_motions
+
+    def first_fails(A: np.ndarray, B: np.ndarray) -> np.ndarray:
+        calls.append(len(A))
+        return np.zeros(len(A), dtype=bool) if len(calls) == 1 else real(A, B)
+
+    monkeypatch.setattr(checker, "check_motions", first_fails)
+    moves = sweep_until_settled(W, L, np.array([0, 1]), grouped.layout, checker, max_sweeps=100)
+    assert moves > 0 and calls == [6] and np.array_equal(W, reference)
+    assert np.allclose(L, grouped.layout.distance(W[:-1], W[1:]))
+    assert checker.states(W).all() and checker.check_motions(W[:-1], W[1:]).all()
+
+
 def test_sweeps_stop_at_max_sweeps(monkeypatch: pytest.MonkeyPatch) -> None:
     W, L, grouped, checker = _zigzag()
     one_W, one_L = W.copy(), L.copy()
@@ -233,7 +271,7 @@ def test_settling_sweeps_skip_unmoved_waypoints_with_the_same_paths_and_fewer_ch
 
     skipping = run()
     real = waypoint_shortcuts.shortcut_waypoints
-    monkeypatch.setattr(waypoint_shortcuts, "shortcut_waypoints", lambda W, L, d, lay, c, dirty=None: real(W, L, d, lay, c))
+    monkeypatch.setattr(waypoint_shortcuts, "shortcut_waypoints", lambda W, L, d, lay, c, dirty=None, screen_only=False: real(W, L, d, lay, c, None, screen_only))
     full = run()
     assert [p for p, _ in skipping] == [p for p, _ in full]
     assert sum(c for _, c in skipping) < sum(c for _, c in full)

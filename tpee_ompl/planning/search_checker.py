@@ -24,6 +24,11 @@ _COARSE_STRIDE = 16
 """First pass over a motion checks every 16th interior state (collisions span many states): 8 until
 2026-11-25; 16 took 5 % less time to a first path at home (320-340 checks either way) and 26 % less on
 the Panda shelf (7,719 -> 5,741 checks), with Table 4 unchanged; 32 was no better, 64 had a longer tail."""
+_SCREEN_ONLY_STRIDE = 8
+"""Screen of candidates taken on their screens (``Checker.candidates(screen_only=True)``): the settling
+shortcut sweeps check the motions they changed in full once, at the end, and start again with full
+checks when one fails.  Paper's dimension-RRT at 500 samples, 24 queries x 4 seeds: every 16th state
+61 fallbacks, every 8th 39, every 4th 27; 8 took the least time (scratch A/B, 2026-11-26)."""
 _NEAREST_FIRST = True
 """Screens in bisection order check the states nearest the last collision a screen found first
 (:meth:`Checker._screen`); False: bisection order only (before 2026-11-26; a switch for experiments)."""
@@ -286,14 +291,16 @@ class Checker:
 
     def candidates(
         self, C: np.ndarray, A: np.ndarray, B: np.ndarray, left_known: np.ndarray, right_known: np.ndarray,
-        strict: np.ndarray, valid: np.ndarray | None = None,
+        strict: np.ndarray, valid: np.ndarray | None = None, screen_only: bool = False,
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Evaluate candidate waypoints C (m, n) between neighbours A and B (m, n).
 
         ``left_known[k]`` / ``right_known[k]`` false means that neighbour is invalid, so that motion is
         invalid without a check.  For ``strict[k]`` candidates only all-valid matters, so the motions are
         not finished once one fails.  ``valid``: the validity of C when it was checked already (not
-        checked again).  Returns validity of C, of A->C and of C->B (ends incl.).
+        checked again).  Returns validity of C, of A->C and of C->B (ends incl.).  ``screen_only``: a
+        motion passes on its screen (a lone candidate's, or every :data:`_SCREEN_ONLY_STRIDE`-th state),
+        not checked in full: the caller checks it later (the settling shortcut sweeps).
         """
         m = len(C)
         if m == 1 and self._first_invalid is not None and self._check_motions is not None \
@@ -310,16 +317,19 @@ class Checker:
             if i >= 0:
                 self._collision = S[i].copy()
                 return ~no, no, no
+            if screen_only:
+                return ~no, ~no, ~no
             ok = self.check_motions(A2, B2)
             return np.ones(1, dtype=bool), ok[:1], ok[1:]
         vc = self.states(C) if not self.batched and valid is None else valid
         if self.batched:
             # pass 1: candidate states (unless ``valid`` gives them) + every 16th interior state of motions
             # whose other end is valid (only those built when the validator checks the motions itself in pass 2)
-            stride = 1 if self._check_motions is None else _COARSE_STRIDE
+            coarse = _SCREEN_ONLY_STRIDE if screen_only else _COARSE_STRIDE
+            stride = 1 if self._check_motions is None else coarse
             SL, iL, jL = self.interior(A, C, stride)
             SR, iR, jR = self.interior(C, B, stride)
-            cL, cR = (jL % _COARSE_STRIDE == 0) & left_known[iL], (jR % _COARSE_STRIDE == 0) & right_known[iR]
+            cL, cR = (jL % coarse == 0) & left_known[iL], (jR % coarse == 0) & right_known[iR]
             if valid is None:
                 ok = self.states(np.concatenate([C, SL[cL], SR[cR]]))
                 vc = ok[:m]
@@ -333,6 +343,8 @@ class Checker:
             both = goL & goR
             goL &= both | ~strict
             goR &= both | ~strict
+            if screen_only:
+                return vc, goL, goR
             # pass 2: the remaining interior states of motions still in question
             if self._check_motions is not None:  # the motion validator's own verdicts, remembered as such
                 kL, kR = np.flatnonzero(goL), np.flatnonzero(goR)

@@ -10,8 +10,8 @@ distances to the neighbours (exact for the Euclidean metric; with no fixed DOF, 
 fraction of the move shortens the path; the largest of :data:`SHORTCUT_FRACTIONS` whose waypoint and
 both motions pass is taken, by the same checks as a sample's candidate.  One sweep can leave the
 path short of what the next gives (a moved waypoint moves its neighbours' shortest points), so with a
-prescribed group the sweeps repeat (:func:`sweep_until_settled`) while each still shortens the path by
-:data:`SWEEP_MIN_GAIN` of its length, at most :data:`MAX_SWEEPS` times.  A waypoint that lands on its
+prescribed group kept to the end the sweeps repeat (:func:`sweep_until_settled`) while each still
+shortens the path by :data:`SWEEP_MIN_GAIN` of its length, at most :data:`MAX_SWEEPS` times.  A waypoint that lands on its
 neighbours' segment in every DOF can never move again by the paper's rule (nothing is shorter there),
 which is why :class:`~tpee_ompl.planning.dimension_rrt.DimensionRRT` uses them by default only with a
 prescribed group.  Measured in ``docs/dimension_rrt.md`` ("Shortcuts between fake-time waypoints").
@@ -64,13 +64,14 @@ def shortcut_targets(A: np.ndarray, X: np.ndarray, B: np.ndarray, dims: np.ndarr
 
 
 def shortcut_waypoints(W: np.ndarray, L: np.ndarray, dims: np.ndarray, layout: RealVectorLayout, checker: Checker,
-                       dirty: np.ndarray | None = None) -> int:
+                       dirty: np.ndarray | None = None, screen_only: bool = False) -> int:
     """Move the intermediate waypoints of the valid path W (h, n) towards their shortest points, in place.
 
     The odd steps go first, then the even ones, so no two neighbours move at once (the motion between
     them would be unchecked).  ``L`` (h - 1,) holds the segment lengths and is kept up to date; a
     waypoint moves only when the path gets shorter and the candidate and both its motions are valid,
-    so W stays a valid path.  ``dirty`` (h,) bool, updated in place: only the waypoints marked are
+    so W stays a valid path (``screen_only``: its moves pass their candidate screens only, see
+    :meth:`~tpee_ompl.planning.search_checker.Checker.candidates`).  ``dirty`` (h,) bool, updated in place: only the waypoints marked are
     tried (the others, with themselves and their neighbours where they were when last tried, would get
     the same candidates and verdicts); a tried waypoint is unmarked, and a moved one marks itself and
     its neighbours.  Returns the number of waypoints moved."""
@@ -92,7 +93,7 @@ def shortcut_waypoints(W: np.ndarray, L: np.ndarray, dims: np.ndarray, layout: R
             if not len(sel):
                 break
             yes = np.ones(len(sel), dtype=bool)
-            vc, left, right = checker.candidates(C[sel], A[sel], B[sel], yes, yes, yes)
+            vc, left, right = checker.candidates(C[sel], A[sel], B[sel], yes, yes, yes, screen_only=screen_only)
             for k in sel[vc & left & right]:
                 t = ts[k]
                 W[t] = C[k]
@@ -108,14 +109,33 @@ def sweep_until_settled(W: np.ndarray, L: np.ndarray, dims: np.ndarray, layout: 
                         max_sweeps: int | None = None) -> int:
     """:func:`shortcut_waypoints` again while the last sweep moved a waypoint and shortened the path by at
     least :data:`SWEEP_MIN_GAIN` of its length, at most ``max_sweeps`` (default :data:`MAX_SWEEPS`) sweeps.
+
     Each sweep after the first tries only the waypoints that moved or whose neighbours moved since they
-    were last tried (the same moves as full sweeps, fewer checks).  Returns the number of waypoint moves;
-    W stays a valid path."""
+    were last tried.  With a batched checker and more than one sweep, a move is taken on its screen
+    (the candidate and every 8th state of its motions) and the motions that changed are checked in
+    full once, at the end: a waypoint often moves several times, and its passing motions need no full
+    check.  If one of them fails, W goes back to where it was and the sweeps run again with every move
+    checked in full.  Returns the number of waypoint moves; W stays a valid path."""
+    n = MAX_SWEEPS if max_sweeps is None else max_sweeps
+    lazy = n > 1 and checker.batched
+    W0, L0 = (W.copy(), L.copy()) if lazy else (W, L)
+    moved = _sweeps(W, L, dims, layout, checker, n, lazy)
+    if lazy and moved:
+        k = np.flatnonzero((W[:-1] != W0[:-1]).any(axis=1) | (W[1:] != W0[1:]).any(axis=1))
+        if not checker.check_motions(W[:-1][k], W[1:][k]).all():
+            W[:], L[:] = W0, L0
+            moved = _sweeps(W, L, dims, layout, checker, n, False)
+    return moved
+
+
+def _sweeps(W: np.ndarray, L: np.ndarray, dims: np.ndarray, layout: RealVectorLayout, checker: Checker, n: int,
+            screen_only: bool) -> int:
+    """Up to n sweeps of :func:`sweep_until_settled`, moves taken on their screens when ``screen_only``."""
     moved = 0
     dirty = np.ones(len(W), dtype=bool)
-    for _ in range(MAX_SWEEPS if max_sweeps is None else max_sweeps):
+    for _ in range(n):
         before = float(L.sum())
-        m = shortcut_waypoints(W, L, dims, layout, checker, dirty)
+        m = shortcut_waypoints(W, L, dims, layout, checker, dirty, screen_only)
         moved += m
         if not m or before - float(L.sum()) < SWEEP_MIN_GAIN * before:
             break
