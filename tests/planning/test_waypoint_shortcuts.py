@@ -147,6 +147,20 @@ def test_settling_sweeps_start_again_with_full_checks_when_a_screened_move_fails
     assert checker.states(W).all() and checker.check_motions(W[:-1], W[1:]).all()
 
 
+def test_settling_sweeps_end_after_the_sweep_in_which_the_termination_condition_holds(monkeypatch: pytest.MonkeyPatch) -> None:
+    W, L, grouped, checker = _zigzag()
+    one_W, one_L = W.copy(), L.copy()
+    shortcut_waypoints(one_W, one_L, np.array([0, 1]), grouped.layout, checker)
+    sweep_until_settled(W, L, np.array([0, 1]), grouped.layout, checker, max_sweeps=100, stop=lambda: True)
+    assert np.array_equal(W, one_W)  # one sweep, then its motions checked in full: it passes
+    # a failed final check with the condition holding: the path stays where it was, no sweeps in full
+    W, L, grouped, checker = _zigzag()
+    W0 = W.copy()
+    monkeypatch.setattr(checker, "check_motions", lambda A, B: np.zeros(len(A), dtype=bool))
+    assert sweep_until_settled(W, L, np.array([0, 1]), grouped.layout, checker, max_sweeps=100, stop=lambda: True) == 0
+    assert np.array_equal(W, W0) and np.allclose(L, grouped.layout.distance(W[:-1], W[1:]))
+
+
 def test_sweeps_stop_at_max_sweeps(monkeypatch: pytest.MonkeyPatch) -> None:
     W, L, grouped, checker = _zigzag()
     one_W, one_L = W.copy(), L.copy()

@@ -140,7 +140,7 @@ class Search(SampleDraws):
             # until settled on rows kept to the end (Table 4 at 500 samples: 1.2-1.9 % shorter), else once (the
             # pipeline's rows phase and the released search: more sweeps cost them more than they save)
             accepted += sweep_until_settled(self.W, self.L, self._dims[gi], self.g.layout, self.checker,
-                                            None if self._settle else 1)
+                                            None if self._settle else 1, stop)
             accepted += 0 if self.g.prescribed else self._respread()
         return accepted
 

@@ -24,6 +24,7 @@ than before that the search keeps once it passes.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -106,7 +107,7 @@ def shortcut_waypoints(W: np.ndarray, L: np.ndarray, dims: np.ndarray, layout: R
 
 
 def sweep_until_settled(W: np.ndarray, L: np.ndarray, dims: np.ndarray, layout: RealVectorLayout, checker: Checker,
-                        max_sweeps: int | None = None) -> int:
+                        max_sweeps: int | None = None, stop: Callable[[], bool] | None = None) -> int:
     """:func:`shortcut_waypoints` again while the last sweep moved a waypoint and shortened the path by at
     least :data:`SWEEP_MIN_GAIN` of its length, at most ``max_sweeps`` (default :data:`MAX_SWEEPS`) sweeps.
 
@@ -115,21 +116,23 @@ def sweep_until_settled(W: np.ndarray, L: np.ndarray, dims: np.ndarray, layout: 
     (the candidate and every 8th state of its motions) and the motions that changed are checked in
     full once, at the end: a waypoint often moves several times, and its passing motions need no full
     check.  If one of them fails, W goes back to where it was and the sweeps run again with every move
-    checked in full.  Returns the number of waypoint moves; W stays a valid path."""
+    checked in full.  ``stop()`` (the planner's termination condition) is asked after each sweep: once it
+    holds, no further sweep runs (a failed final check then leaves W where it was).  Returns the number
+    of waypoint moves; W stays a valid path."""
     n = MAX_SWEEPS if max_sweeps is None else max_sweeps
     lazy = n > 1 and checker.batched
     W0, L0 = (W.copy(), L.copy()) if lazy else (W, L)
-    moved = _sweeps(W, L, dims, layout, checker, n, lazy)
+    moved = _sweeps(W, L, dims, layout, checker, n, lazy, stop)
     if lazy and moved:
         k = np.flatnonzero((W[:-1] != W0[:-1]).any(axis=1) | (W[1:] != W0[1:]).any(axis=1))
         if not checker.check_motions(W[:-1][k], W[1:][k]).all():
             W[:], L[:] = W0, L0
-            moved = _sweeps(W, L, dims, layout, checker, n, False)
+            moved = 0 if stop is not None and stop() else _sweeps(W, L, dims, layout, checker, n, False, stop)
     return moved
 
 
 def _sweeps(W: np.ndarray, L: np.ndarray, dims: np.ndarray, layout: RealVectorLayout, checker: Checker, n: int,
-            screen_only: bool) -> int:
+            screen_only: bool, stop: Callable[[], bool] | None) -> int:
     """Up to n sweeps of :func:`sweep_until_settled`, moves taken on their screens when ``screen_only``."""
     moved = 0
     dirty = np.ones(len(W), dtype=bool)
@@ -137,7 +140,7 @@ def _sweeps(W: np.ndarray, L: np.ndarray, dims: np.ndarray, layout: RealVectorLa
         before = float(L.sum())
         m = shortcut_waypoints(W, L, dims, layout, checker, dirty, screen_only)
         moved += m
-        if not m or before - float(L.sum()) < SWEEP_MIN_GAIN * before:
+        if not m or before - float(L.sum()) < SWEEP_MIN_GAIN * before or (stop is not None and stop()):
             break
     return moved
 
