@@ -28,7 +28,7 @@ from ompl import util as ou
 from tpee_ompl import make_simple_setup
 from tpee_ompl.library.planner import LibraryDimensionRRT
 from tpee_ompl.model import robot_checker
-from tpee_ompl.planning import dimension_search
+from tpee_ompl.planning import dimension_search, waypoint_shortcuts
 from tpee_ompl.planning.paths import path_to_array
 
 _COUNTS = {"rule": 0, "accepted": 0, "sweeps": 0, "pin_calls": 0, "pin_time": 0.0}
@@ -36,7 +36,7 @@ _COUNTS = {"rule": 0, "accepted": 0, "sweeps": 0, "pin_calls": 0, "pin_time": 0.
 
 def _instrument() -> None:
     """Counting wrappers around the paper's rule, the sweeps and Pinocchio's batched collision call."""
-    improve, sweep, collide = dimension_search.Search._improve, dimension_search.shortcut_waypoints, pin.computeCollisionsInParallel
+    improve, sweep, collide = dimension_search.Search._improve, waypoint_shortcuts.shortcut_waypoints, pin.computeCollisionsInParallel
 
     def counted_improve(self, gi, c):
         n = improve(self, gi, c)
@@ -56,7 +56,7 @@ def _instrument() -> None:
         return out
 
     dimension_search.Search._improve = counted_improve
-    dimension_search.shortcut_waypoints = counted_sweep
+    waypoint_shortcuts.shortcut_waypoints = counted_sweep  # each sweep, also those sweep_until_settled repeats
     robot_checker.pin.computeCollisionsInParallel = timed_collide
 
 

@@ -82,7 +82,7 @@ def _strict_failures(robot: WearerArm, ss: og.SimpleSetup, q: Query, tight: bool
     if not robot.are_valid(dense).all():
         problems.append("a state at a quarter of the joint step collides")
     if tight and problems and all("4x" in p or "quarter" in p for p in problems):
-        least = _least_margin_fraction(robot, dense[~robot.are_valid(dense)])
+        least = _least_margin_fraction(robot, dense)  # every quarter-step state, valid ones included
         return [] if least >= 0.5 else [f"a state at a quarter of the joint step keeps only {least:.3f} of a margin"]
     return problems
 

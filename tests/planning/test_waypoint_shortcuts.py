@@ -8,12 +8,12 @@ from helpers.planning_spaces import box_problem, free_so2_space
 from ompl import base as ob
 from ompl import geometric as og
 
+from tpee_ompl.planning import waypoint_shortcuts
 from tpee_ompl.planning.dimension_rrt import DimensionRRT
 from tpee_ompl.planning.dimension_search import Search
 from tpee_ompl.planning.grouped_space import GroupedSpace
 from tpee_ompl.planning.paths import path_passes_motion_checks, path_to_array
 from tpee_ompl.planning.search_checker import Checker
-from tpee_ompl.planning import waypoint_shortcuts
 from tpee_ompl.planning.waypoint_shortcuts import (
     SWEEP_MIN_GAIN,
     respread_candidate,
@@ -128,6 +128,22 @@ def test_settling_sweeps_check_the_changed_motions_in_full_once_at_the_end(monke
     monkeypatch.setattr(checker, "check_motions", lambda A, B: calls.append(len(A)) or real(A, B))
     sweep_until_settled(W, L, np.array([0, 1]), grouped.layout, checker, max_sweeps=100)
     assert calls == [6] and np.array_equal(W, reference)  # every segment changed; checked once
+
+
+def test_a_waypoint_whose_neighbour_moved_after_it_was_tried_is_tried_again() -> None:
+    # free space, one waypoint off the line: its neighbours move towards it, then theirs, sweep after sweep
+    si, _ = box_problem(lo=(0.9, 0.9), hi=(1.0, 1.0))
+    grouped = GroupedSpace(si, [[0, 1]], 7)
+    checker = Checker(si, grouped.layout, True)
+    W = np.array([[-0.9, 0.0], [-0.6, 0.0], [-0.3, 0.5], [0.0, 0.0], [0.3, 0.0], [0.6, 0.0], [0.9, 0.0]])
+    L = grouped.layout.distance(W[:-1], W[1:])
+    reference = _settled_in_full(W, L, grouped, checker)
+    first = W.copy()
+    shortcut_waypoints(first, L.copy(), np.array([0, 1]), grouped.layout, checker)
+    assert np.array_equal(first[5], W[5])  # waypoint 5 does not move in the first sweep (it is on its chord) ...
+    assert not np.array_equal(reference[5], W[5])  # ... but once waypoint 4 has moved
+    sweep_until_settled(W, L, np.array([0, 1]), grouped.layout, checker, max_sweeps=100)
+    assert np.array_equal(W, reference)
 
 
 def test_settling_sweeps_start_again_with_full_checks_when_a_screened_move_fails(monkeypatch: pytest.MonkeyPatch) -> None:
@@ -252,7 +268,7 @@ def test_rows_kept_to_the_end_sweep_until_settled_else_once(monkeypatch: pytest.
     maxima: list[int | None] = []
     real = waypoint_shortcuts.sweep_until_settled
 
-    def spy(*a, **kw):  # noqa: ANN002, ANN003, ANN202
+    def spy(*a: object, **kw: object) -> int:
         maxima.append(a[5] if len(a) > 5 else kw.get("max_sweeps"))
         return real(*a, **kw)
 

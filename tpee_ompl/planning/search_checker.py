@@ -299,8 +299,9 @@ class Checker:
         invalid without a check.  For ``strict[k]`` candidates only all-valid matters, so the motions are
         not finished once one fails.  ``valid``: the validity of C when it was checked already (not
         checked again).  Returns validity of C, of A->C and of C->B (ends incl.).  ``screen_only``: a
-        motion passes on its screen (a lone candidate's, or every :data:`_SCREEN_ONLY_STRIDE`-th state),
-        not checked in full: the caller checks it later (the settling shortcut sweeps).
+        motion passes on its screen (a lone candidate's every 4th state, several candidates' every
+        :data:`_SCREEN_ONLY_STRIDE`-th), not checked in full: the caller checks it later (the settling
+        shortcut sweeps).
         """
         m = len(C)
         if m == 1 and self._first_invalid is not None and self._check_motions is not None \
@@ -323,10 +324,11 @@ class Checker:
             return np.ones(1, dtype=bool), ok[:1], ok[1:]
         vc = self.states(C) if not self.batched and valid is None else valid
         if self.batched:
-            # pass 1: candidate states (unless ``valid`` gives them) + every 16th interior state of motions
-            # whose other end is valid (only those built when the validator checks the motions itself in pass 2)
+            # pass 1: candidate states (unless ``valid`` gives them) + every 16th (``screen_only``: 8th) interior
+            # state of motions whose other end is valid (only those built when the validator checks the motions
+            # itself in pass 2, or when there is no pass 2)
             coarse = _SCREEN_ONLY_STRIDE if screen_only else _COARSE_STRIDE
-            stride = 1 if self._check_motions is None else coarse
+            stride = coarse if self._check_motions is not None or screen_only else 1
             SL, iL, jL = self.interior(A, C, stride)
             SR, iR, jR = self.interior(C, B, stride)
             cL, cR = (jL % coarse == 0) & left_known[iL], (jR % coarse == 0) & right_known[iR]

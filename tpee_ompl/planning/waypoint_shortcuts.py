@@ -72,10 +72,12 @@ def shortcut_waypoints(W: np.ndarray, L: np.ndarray, dims: np.ndarray, layout: R
     them would be unchecked).  ``L`` (h - 1,) holds the segment lengths and is kept up to date; a
     waypoint moves only when the path gets shorter and the candidate and both its motions are valid,
     so W stays a valid path (``screen_only``: its moves pass their candidate screens only, see
-    :meth:`~tpee_ompl.planning.search_checker.Checker.candidates`).  ``dirty`` (h,) bool, updated in place: only the waypoints marked are
-    tried (the others, with themselves and their neighbours where they were when last tried, would get
-    the same candidates and verdicts); a tried waypoint is unmarked, and a moved one marks itself and
-    its neighbours.  Returns the number of waypoints moved."""
+    :meth:`~tpee_ompl.planning.search_checker.Checker.candidates`).  ``dirty`` (h,) bool, updated in
+    place: only the waypoints marked are tried (the others, with themselves and their neighbours where
+    they were when last tried, get the same candidates; with full checks also the same verdicts, while
+    a screen's verdict can depend on whether the candidate was screened alone or with others); a tried
+    waypoint is unmarked, and a moved one marks itself and its neighbours.  Returns the number of
+    waypoints moved."""
     moved = 0
     for first in (1, 2):
         ts = np.arange(first, len(W) - 1, 2)
@@ -113,7 +115,7 @@ def sweep_until_settled(W: np.ndarray, L: np.ndarray, dims: np.ndarray, layout: 
 
     Each sweep after the first tries only the waypoints that moved or whose neighbours moved since they
     were last tried.  With a batched checker and more than one sweep, a move is taken on its screen
-    (the candidate and every 8th state of its motions) and the motions that changed are checked in
+    (the candidate and every 4th or 8th state of its motions) and the motions that changed are checked in
     full once, at the end: a waypoint often moves several times, and its passing motions need no full
     check.  If one of them fails, W goes back to where it was and the sweeps run again with every move
     checked in full.  ``stop()`` (the planner's termination condition) is asked after each sweep: once it
@@ -133,7 +135,8 @@ def sweep_until_settled(W: np.ndarray, L: np.ndarray, dims: np.ndarray, layout: 
 
 def _sweeps(W: np.ndarray, L: np.ndarray, dims: np.ndarray, layout: RealVectorLayout, checker: Checker, n: int,
             screen_only: bool, stop: Callable[[], bool] | None) -> int:
-    """Up to n sweeps of :func:`sweep_until_settled`, moves taken on their screens when ``screen_only``."""
+    """Up to n sweeps of :func:`shortcut_waypoints` for :func:`sweep_until_settled`, moves taken on their
+    screens when ``screen_only``."""
     moved = 0
     dirty = np.ones(len(W), dtype=bool)
     for _ in range(n):
