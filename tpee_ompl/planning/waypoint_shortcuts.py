@@ -41,7 +41,8 @@ __all__ = ["COLLAPSED_FRACTION", "MAX_SWEEPS", "SHORTCUT_FRACTIONS", "SWEEP_MIN_
 SHORTCUT_FRACTIONS = (1.0, 0.5, 0.25)
 """Fractions of the way to the shortest point tried, largest first (the first that passes is kept)."""
 MAX_SWEEPS = 8
-"""Most sweeps in a row after one improvement of the rows' search (the released search sweeps once)."""
+"""Most sweeps in a row after one improvement when the rows are kept to the end (a search whose rows are or
+will be released sweeps once)."""
 SWEEP_MIN_GAIN = 0.003
 """Another sweep follows only while the last one shortened the path by at least this fraction of it."""
 COLLAPSED_FRACTION = 0.1
