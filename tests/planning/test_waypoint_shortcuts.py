@@ -8,6 +8,7 @@ from helpers.planning_spaces import box_problem, free_so2_space
 from ompl import base as ob
 from ompl import geometric as og
 
+from tpee_ompl.model.wearer_arm import WearerArm
 from tpee_ompl.planning import waypoint_shortcuts
 from tpee_ompl.planning.dimension_rrt import DimensionRRT
 from tpee_ompl.planning.dimension_search import Search
@@ -305,3 +306,37 @@ def test_settling_sweeps_skip_unmoved_waypoints_with_the_same_paths_and_fewer_ch
     full = run()
     assert [p for p, _ in skipping] == [p for p, _ in full]
     assert sum(c for _, c in skipping) < sum(c for _, c in full)
+
+
+def test_on_the_wearer_settling_sweeps_leave_only_paths_that_pass_check_motion(robot: WearerArm, monkeypatch: pytest.MonkeyPatch) -> None:
+    """With the project's batched validator (lone candidates screened at every 4th state, ``check_motions``)."""
+    from tpee_ompl.model.queries import load_queries
+    from tpee_ompl.planning import dimension_search
+    from tpee_ompl.planning.setup import make_simple_setup
+    from tpee_ompl.planning.tpee import tpee_dimension_rrt
+
+    screened: list[bool] = []
+    real_candidates = Checker.candidates
+
+    def candidates(self: Checker, *a: object, screen_only: bool = False, **kw: object) -> tuple:
+        screened.append(screen_only)
+        return real_candidates(self, *a, screen_only=screen_only, **kw)
+
+    monkeypatch.setattr(Checker, "candidates", candidates)
+    real_settle = waypoint_shortcuts.sweep_until_settled
+    settles: list[int] = []
+    for q in load_queries("planning_necessary", robot)[::40]:  # three sector pairs
+        ss = make_simple_setup(robot, q.start, q.goal)
+        si = ss.getSpaceInformation()
+
+        def checked(W: np.ndarray, L: np.ndarray, *a: object, si: ob.SpaceInformation = si, **kw: object) -> int:
+            moved = real_settle(W, L, *a, **kw)
+            settles.append(moved)
+            assert path_passes_motion_checks(si, W) and np.allclose(L, np.linalg.norm(np.diff(W, axis=0), axis=1))
+            return moved
+
+        monkeypatch.setattr(dimension_search, "sweep_until_settled", checked)
+        ss.setPlanner(tpee_dimension_rrt(si, q.from_sector, q.to_sector, max_samples=400, seed=3))
+        assert ss.solve(10.0) == ob.PlannerStatus.EXACT_SOLUTION
+        assert path_passes_motion_checks(si, ss.getSolutionPath())
+    assert any(screened) and sum(m > 0 for m in settles) >= 3  # the lazy moves were exercised
