@@ -90,19 +90,26 @@ def _zigzag(batch: bool = True) -> tuple[np.ndarray, np.ndarray, GroupedSpace, C
     return W, grouped.layout.distance(W[:-1], W[1:]), grouped, checker
 
 
+def _settled_in_full(W: np.ndarray, L: np.ndarray, grouped: GroupedSpace, checker: Checker) -> tuple[np.ndarray, list[float]]:
+    """W after sweeps with every move checked in full, as long as each gains SWEEP_MIN_GAIN, and the path's
+    length before the first sweep and after each."""
+    W, L = W.copy(), L.copy()
+    lengths = [float(L.sum())]
+    for _ in range(100):
+        moved = shortcut_waypoints(W, L, np.array([0, 1]), grouped.layout, checker)
+        lengths.append(float(L.sum()))
+        if not moved or lengths[-2] - lengths[-1] < SWEEP_MIN_GAIN * lengths[-2]:
+            break
+    return W, lengths
+
+
 def test_sweeps_repeat_until_one_gains_less_than_the_threshold() -> None:
     W, L, grouped, checker = _zigzag()
     dims = np.array([0, 1])
     once_W, once_L = W.copy(), L.copy()
     shortcut_waypoints(once_W, once_L, dims, grouped.layout, checker)
     # the same sweeps one at a time: each gains at least SWEEP_MIN_GAIN of the length, but the last
-    lengths = [L.sum()]
-    R, RL = W.copy(), L.copy()
-    for _ in range(100):
-        moved = shortcut_waypoints(R, RL, dims, grouped.layout, checker)
-        lengths.append(RL.sum())
-        if not moved or lengths[-2] - lengths[-1] < SWEEP_MIN_GAIN * lengths[-2]:
-            break
+    R, lengths = _settled_in_full(W, L, grouped, checker)
     moves = sweep_until_settled(W, L, dims, grouped.layout, checker, max_sweeps=100)
     assert moves > 0 and np.array_equal(W, R) and np.isclose(L.sum(), lengths[-1])
     assert 2 < len(lengths) - 1 < 100 and L.sum() < once_L.sum()
@@ -110,20 +117,10 @@ def test_sweeps_repeat_until_one_gains_less_than_the_threshold() -> None:
     assert np.allclose(L, grouped.layout.distance(W[:-1], W[1:]))
 
 
-def _settled_in_full(W: np.ndarray, L: np.ndarray, grouped: GroupedSpace, checker: Checker) -> np.ndarray:
-    """W after sweeps with every move checked in full, as long as each gains SWEEP_MIN_GAIN."""
-    W, L = W.copy(), L.copy()
-    for _ in range(100):
-        before = L.sum()
-        if not shortcut_waypoints(W, L, np.array([0, 1]), grouped.layout, checker) or before - L.sum() < SWEEP_MIN_GAIN * before:
-            return W
-    return W
-
-
 def test_settling_sweeps_check_the_changed_motions_in_full_once_at_the_end(monkeypatch: pytest.MonkeyPatch) -> None:
     W, L, grouped, checker = _zigzag()
     assert checker.batched
-    reference = _settled_in_full(W, L, grouped, checker)
+    reference = _settled_in_full(W, L, grouped, checker)[0]
     calls: list[int] = []
     real = checker.check_motions
     monkeypatch.setattr(checker, "check_motions", lambda A, B: calls.append(len(A)) or real(A, B))
@@ -138,7 +135,7 @@ def test_a_waypoint_whose_neighbour_moved_after_it_was_tried_is_tried_again() ->
     checker = Checker(si, grouped.layout, True)
     W = np.array([[-0.9, 0.0], [-0.6, 0.0], [-0.3, 0.5], [0.0, 0.0], [0.3, 0.0], [0.6, 0.0], [0.9, 0.0]])
     L = grouped.layout.distance(W[:-1], W[1:])
-    reference = _settled_in_full(W, L, grouped, checker)
+    reference = _settled_in_full(W, L, grouped, checker)[0]
     first = W.copy()
     shortcut_waypoints(first, L.copy(), np.array([0, 1]), grouped.layout, checker)
     assert np.array_equal(first[5], W[5])  # waypoint 5 does not move in the first sweep (it is on its chord) ...
@@ -149,7 +146,7 @@ def test_a_waypoint_whose_neighbour_moved_after_it_was_tried_is_tried_again() ->
 
 def test_settling_sweeps_start_again_with_full_checks_when_a_screened_move_fails(monkeypatch: pytest.MonkeyPatch) -> None:
     W, L, grouped, checker = _zigzag()
-    reference = _settled_in_full(W, L, grouped, checker)
+    reference = _settled_in_full(W, L, grouped, checker)[0]
     calls: list[int] = []
     real = checker.check_motions
 
