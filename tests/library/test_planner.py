@@ -251,3 +251,49 @@ def test_a_given_sector_pair_that_start_and_goal_are_not_at_is_refused_as_by_dim
             ss, _, got = _solve(robot, library, start, goal, from_sector=pair[0], to_sector=pair[1], seed=0)
         assert got == status and not ss.haveSolutionPath()
         assert "Table-1 preset" in caplog.text
+
+
+@pytest.mark.parametrize("space", ["se2", "real3", "compound"])
+def test_a_space_that_is_not_the_robots_joint_space_is_refused_naming_it(library, space):
+    if space == "se2":
+        sp = ob.SE2StateSpace()
+    elif space == "real3":
+        sp = ob.RealVectorStateSpace(3)
+    else:
+        sp = ob.CompoundStateSpace()
+        sp.addSubspace(ob.RealVectorStateSpace(2), 1.0)
+        sp.addSubspace(ob.SO2StateSpace(), 1.0)
+    if space != "compound":
+        sp.setBounds(-1.0, 1.0) if space == "real3" else sp.setBounds(ob.RealVectorBounds(2))
+    si = ob.SpaceInformation(sp)
+    with pytest.raises(ValueError, match=r"RealVectorStateSpace\(4\)"):
+        LibraryDimensionRRT(si, library)
+
+
+def test_a_space_whose_bounds_the_library_path_and_table3_row_leave_gets_a_path_within_them(robot, library, caplog):
+    """A user's 4-D space bounded close around start and goal (its checker does not test the bounds): the
+    library's path and Table 3's row leave the bounds, so neither is posted; the query is planned over every DOF."""
+    start, goal = np.r_[posture_preset(1), 0.2, -0.1], np.r_[posture_preset(2), 0.5, -0.3]
+    lo, hi = np.minimum(start, goal) - 0.05, np.maximum(start, goal) + 0.05
+    space = ob.RealVectorStateSpace(4)
+    bounds = ob.RealVectorBounds(4)
+    for k in range(4):
+        bounds.setLow(k, float(lo[k]))
+        bounds.setHigh(k, float(hi[k]))
+    space.setBounds(bounds)
+    ss = og.SimpleSetup(space)
+    mid = 0.5 * (start + goal)
+    ss.setStateValidityChecker(lambda s: bool(sum((s[k] - mid[k]) ** 2 for k in range(4)) > 0.01))  # the direct motion collides
+    si = ss.getSpaceInformation()
+    a, b = si.allocState(), si.allocState()
+    set_state(a, start)
+    set_state(b, goal)
+    ss.setStartAndGoalStates(a, b)
+    planner = LibraryDimensionRRT(si, library, seed=1, max_samples=300)
+    ss.setPlanner(planner)
+    with caplog.at_level("WARNING"):
+        assert ss.solve(30.0) == ob.PlannerStatus.EXACT_SOLUTION
+    assert planner.last_run_stats()["library_outcome"] == "planned" and "without Table 3's row" in caplog.text
+    W = path_to_array(ss.getSolutionPath(), 4)
+    assert np.all(W >= lo - 1e-12) and np.all(W <= hi + 1e-12)
+    assert path_passes_motion_checks(si, ss.getSolutionPath(), in_bounds=True)

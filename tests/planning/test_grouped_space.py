@@ -10,9 +10,9 @@ from tpee_ompl.planning.grouped_space import GroupedSpace, RealVectorLayout, def
 from tpee_ompl.model.sectors import cross_sector_trajectory
 
 
-def _space(n: int = 4) -> ob.RealVectorStateSpace:
+def _space(n: int = 4, bound: float = 2.0) -> ob.RealVectorStateSpace:
     space = ob.RealVectorStateSpace(n)
-    space.setBounds(-2.0, 2.0)
+    space.setBounds(-bound, bound)
     return space
 
 
@@ -32,7 +32,7 @@ def test_bad_groups_and_h_raise(groups, h, match) -> None:
 
 def test_group_point_round_trip_and_initial_path() -> None:
     T = cross_sector_trajectory(1, 4)
-    gs = GroupedSpace(_space(), [[0, 1], [2, 3]], 7, {0: T})
+    gs = GroupedSpace(_space(bound=3.2), [[0, 1], [2, 3]], 7, {0: T})  # Table 3 rows reach 2.79 rad
     start, goal = np.r_[T[0], 0.5, -0.5], np.r_[T[-1], -1.0, 1.0]
     W = gs.initial_waypoints(start, goal)
     assert W.shape == (7, 4) and gs.planned == [1]
@@ -48,7 +48,7 @@ def test_group_point_round_trip_and_initial_path() -> None:
 
 
 def test_released_space_plans_every_dof_in_one_group_with_nothing_prescribed() -> None:
-    gs = GroupedSpace(_space(), [[0, 1], [2, 3]], 7, {0: cross_sector_trajectory(1, 4)})
+    gs = GroupedSpace(_space(bound=3.2), [[0, 1], [2, 3]], 7, {0: cross_sector_trajectory(1, 4)})
     released = gs.released()
     assert released.groups == [[0, 1, 2, 3]] and released.planned == [0] and not released.prescribed
     assert released.h == gs.h

@@ -129,6 +129,14 @@ def test_first_state_is_checked_unless_told_otherwise() -> None:
     assert not array_to_path(si, out_of_the_box).check()
 
 
+def test_in_bounds_also_requires_every_state_within_the_spaces_bounds() -> None:
+    si, _ = box_problem()  # [-1, 1]^2; the checker tests the box obstacle only, as a user's checker may
+    outside = np.array([[-0.5, 0.8], [0.0, 1.3], [0.5, 0.8]])  # round the obstacle, through y = 1.3
+    assert path_passes_motion_checks(si, outside) and array_to_path(si, outside).check()
+    assert not path_passes_motion_checks(si, outside, in_bounds=True)
+    assert path_passes_motion_checks(si, np.array([[-0.5, 0.8], [0.0, 1.0], [0.5, 0.8]]), in_bounds=True)
+
+
 def test_agrees_with_path_geometric_check_and_makes_the_same_checks(rng: np.random.Generator) -> None:
     si, checker = box_problem()
     verdicts = set()

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 from helpers.wearer_configs import valid_and_colliding
@@ -131,6 +133,9 @@ def test_a_candidate_screen_checks_first_where_the_last_screen_found_a_collision
     screen found: the same candidate again costs its own check and one state (two when the checker checks
     rows in pairs: that state and the next), with the same verdict."""
     monkeypatch.setattr(robot_checker, "FIRST_INVALID_PAIRS", pairs)
+    # the stall guard (a busy machine) would put the checker on one thread, one row at a time: not what is tested
+    monkeypatch.setattr(robot_checker, "STALL_SECONDS", (math.inf, 0.0))
+    monkeypatch.setattr(robot, "_serial_until", 0.0)
     expected = 3 if pairs and robot.n_threads > 1 else 2
     si = make_simple_setup(robot).getSpaceInformation()
     checker = Checker(si, GroupedSpace(si, [[0, 1], [2, 3]], 7).layout, batch=True)

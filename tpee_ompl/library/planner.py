@@ -81,6 +81,10 @@ class LibraryDimensionRRT(PythonPlanner):
             raise ValueError(f"library must be a PathLibrary, got {type(library).__name__}")
         if not isinstance(si, ob.SpaceInformation):
             raise ValueError(f"si must be an ompl.base.SpaceInformation, got {type(si).__name__}")
+        space, nq = si.getStateSpace(), library.robot.nq
+        if not isinstance(space, ob.RealVectorStateSpace) or space.getDimension() != nq:
+            raise ValueError(f"LibraryDimensionRRT plans in the library robot's joint space, a RealVectorStateSpace({nq}) "
+                             f"(make_simple_setup); got {type(space).__name__} of dimension {space.getDimension()}")
         if (from_sector is None) != (to_sector is None):
             raise ValueError("give both from_sector and to_sector, or neither (inferred from start and goal)")
         pair = None if from_sector is None else (check_sector(from_sector), check_sector(to_sector))
@@ -170,7 +174,7 @@ class LibraryDimensionRRT(PythonPlanner):
                 stats["candidates_tried"] += 1
                 W = lib.generate(start, goal, i, j, int(k), stride=lib.query_stride)
                 path = array_to_path(si, W)
-                if path_passes_motion_checks(si, path):
+                if path_passes_motion_checks(si, path, in_bounds=True):
                     pdef.addSolutionPath(path, False, 0.0, self.getName())
                     now = time.perf_counter() - t0
                     cost, best_path = path.length(), path
@@ -180,11 +184,12 @@ class LibraryDimensionRRT(PythonPlanner):
                     have_exact = True
                     break
             seed = lib.generate(start, goal, i, j, int(order[0]), stride=lib.per_step)
-            # near the joint limits a DMP seed can leave them; it is only a head start: clip it
-            seed = np.clip(seed, lib.robot.lower, lib.robot.upper)
+            # near the space's bounds (the joint limits) a DMP seed can leave them; it is only a head start: clip it
+            bounds = si.getStateSpace().getBounds()
+            seed = np.clip(seed, np.array(bounds.low, dtype=float), np.array(bounds.high, dtype=float))
         if cross and not have_exact:  # Table 3's straight motion: often free when the library's paths are not
             path = array_to_path(si, straight_motion(start, goal, i, j))
-            if path_passes_motion_checks(si, path):
+            if path_passes_motion_checks(si, path, in_bounds=True):
                 pdef.addSolutionPath(path, False, 0.0, self.getName())
                 now = time.perf_counter() - t0
                 cost, best_path = path.length(), path
@@ -196,7 +201,7 @@ class LibraryDimensionRRT(PythonPlanner):
             return planner_status(ob.PlannerStatus.EXACT_SOLUTION)
         # the direct joint-space motion, when free, is the shortest path there is: nothing to refine
         direct = array_to_path(si, np.stack([start, goal]))
-        if path_passes_motion_checks(si, direct):
+        if path_passes_motion_checks(si, direct, in_bounds=True):
             now = time.perf_counter() - t0
             cost = direct.length()
             if not have_exact or cost < stats["best_cost"]:
@@ -210,9 +215,14 @@ class LibraryDimensionRRT(PythonPlanner):
         if stats["library_outcome"] is None:
             stats["library_outcome"] = "planned"
         opts = dataclasses.replace(self.options, seed=self._run_seed())
-        inner = (tpee_dimension_rrt(si, i, j, opts, initial_waypoints=seed if seed is not None
-                                    and seed.shape[0] == self.options.h else None) if cross
-                 else DimensionRRT(si, opts))
+        inner = None
+        if cross:
+            try:
+                inner = tpee_dimension_rrt(si, i, j, opts, initial_waypoints=seed if seed is not None
+                                           and seed.shape[0] == self.options.h else None)
+            except ValueError as e:  # e.g. a space whose bounds the Table 3 row leaves
+                log.warning("LibraryDimensionRRT: planned over every DOF, without Table 3's row: %s", e)
+        inner = DimensionRRT(si, opts) if inner is None else inner
         inner.setProblemDefinition(pdef)
         self._inner = inner
         t_inner = time.perf_counter() - t0

@@ -193,7 +193,7 @@ class DimensionRRT(PythonPlanner):
             raise ValueError(f"si must be an ompl.base.SpaceInformation, got {type(si).__name__}")
         grouped = GroupedSpace(si, opts.groups, opts.h, prescribed)
         rng_full = self._full_range(opts, grouped)
-        initial = self._check_initial(grouped, initial_waypoints)
+        initial = grouped.check_initial(initial_waypoints)
         super().__init__(si, opts.name)
         self.options = opts
         self.grouped = grouped
@@ -233,7 +233,7 @@ class DimensionRRT(PythonPlanner):
             grouped = self._regrouped()
             if grouped is None:
                 return None
-            initial = self._check_initial(grouped, self._initial)
+            initial = grouped.check_initial(self._initial)
         except ValueError as e:
             log.error("%s: the space's bounds changed and %s", self.getName(), e)
             return planner_status(ob.PlannerStatus.ABORT)
@@ -252,23 +252,6 @@ class DimensionRRT(PythonPlanner):
         """Group index -> the smallest narrowed padding of its DOFs (``range_``), for ``grouped``'s groups."""
         return {gi: self.range_[grouped.group_dims(gi)] for gi in range(len(grouped.groups))}
 
-    @staticmethod
-    def _check_initial(grouped: GroupedSpace, W: np.ndarray | None) -> np.ndarray | None:
-        if W is None:
-            return None
-        layout = grouped.layout
-        try:
-            arr = np.array(W, dtype=float)
-        except (TypeError, ValueError):
-            raise ValueError(f"initial_waypoints must be a numeric array of shape ({grouped.h}, {layout.n})") from None
-        if arr.shape != (grouped.h, layout.n):
-            raise ValueError(f"initial_waypoints must have shape ({grouped.h}, {layout.n}), got {arr.shape}")
-        if not np.all(np.isfinite(arr)):
-            raise ValueError("initial_waypoints contains NaN or inf")
-        if np.any(arr < layout.lower - 1e-12) or np.any(arr > layout.upper + 1e-12):
-            raise ValueError("initial_waypoints lie outside the state space bounds")
-        return arr
-
     def set_initial_waypoints(self, W: np.ndarray | None) -> None:
         """Start the next solves from the waypoints W (h, n) instead of the straight line; None to unset.
 
@@ -278,7 +261,7 @@ class DimensionRRT(PythonPlanner):
         start (its valid prefix and suffix seed the layered trees).  Kept across :meth:`clear`.
         """
         grouped = self._regrouped() or self.grouped  # checked against the bounds as they are now
-        self._initial = self._check_initial(grouped, W)
+        self._initial = grouped.check_initial(W)
         if grouped is not self.grouped:
             self.grouped, self.range_ = grouped, self._full_range(self.options, grouped)
 
@@ -304,6 +287,8 @@ class DimensionRRT(PythonPlanner):
         :meth:`Search.iterate <tpee_ompl.planning.dimension_search.Search.iterate>`); a condition that
         reads :meth:`samples_drawn` then sees the search as a run capped there would end.  The path
         found does not depend on it."""
+        if isinstance(counts, (str, bytes)) or not isinstance(counts, Sequence):
+            raise ValueError(f"counts must be a sequence of sample counts, got {counts!r}")
         self._sample_checkpoints = tuple(sorted({check_int("sample checkpoint", c, minimum=1) for c in counts}))
 
     def samples_drawn(self) -> int:
@@ -314,8 +299,12 @@ class DimensionRRT(PythonPlanner):
         cb = self._callback
         if cb is None or self._callback_failed:
             return
+        si = self.getSpaceInformation()
+        states = [si.allocState() for _ in range(path.getStateCount())]  # copies: the posted path stays as checked
+        for c, s in zip(states, path.getStates()):
+            si.copyState(c, s)
         try:
-            cb(self, list(path.getStates()), ob.Cost(cost))
+            cb(self, states, ob.Cost(cost))
         except Exception:
             log.exception("DimensionRRT: the intermediate-solution callback raised; not called again in this solve")
             self._callback_failed = True
@@ -399,8 +388,11 @@ class DimensionRRT(PythonPlanner):
             return Search(grouped_, checker, self._rng, q0, goal, self.narrow_after, self.narrowing, self._ranges(grouped_),
                           initial, self.options.connect, turns, self.shortcuts, local, settle=release is None)
 
-        runs = [GoalRun(q1, grouped, new_search(grouped, q1, self._initial), release, float(layout.distance(q0, q1)))
-                for q1 in fits[: self.options.max_goals]]
+        runs = []  # each search checks its initial path: the termination condition is asked between them
+        for q1 in fits[: self.options.max_goals]:
+            if runs and ptc():
+                break
+            runs.append(GoalRun(q1, grouped, new_search(grouped, q1, self._initial), release, float(layout.distance(q0, q1))))
         runs[0].turn_end = GOAL_TURN
         poster = SolutionPoster(self, si, pdef, t0, grouped.to_path, self._notify, checker.passed)
         stats = self._stats

@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 
 from ..validation import check_bool, check_int, check_name, check_number
-from .grouped_space import MAX_H
+from .grouped_space import MAX_H, group_lists
 
 __all__ = ["RELEASE_AFTER", "DimensionRRTOptions", "resolve_options", "shortcuts_on"]
 
@@ -83,6 +83,9 @@ class DimensionRRTOptions:
     def __post_init__(self) -> None:
         check_name("name", self.name)
         set_ = lambda field_, value: object.__setattr__(self, field_, value)  # noqa: E731 (frozen dataclass)
+        if self.groups is not None:  # their form here; that they cover the space's DOFs, once the space is known
+            set_("groups", tuple(tuple(g) for g in group_lists(self.groups)))
+        set_("h", check_int("h (fake-time steps incl. start and goal)", self.h, minimum=3, maximum=MAX_H))
         set_("max_samples", check_int("max_samples", self.max_samples, minimum=1, optional=True))
         set_("seed", check_int("seed", self.seed, minimum=0, optional=True))
         set_("narrow_after", check_int("narrow_after", self.narrow_after, minimum=0))
@@ -93,7 +96,7 @@ class DimensionRRTOptions:
             set_("shortcuts", check_bool("shortcuts", self.shortcuts))
         set_("stall_samples", check_int("stall_samples", self.stall_samples, minimum=1, optional=True))
         set_("max_h", check_int("max_h", self.max_h, minimum=3, maximum=MAX_H, optional=True))
-        if self.max_h is not None and isinstance(self.h, int) and self.max_h < self.h:
+        if self.max_h is not None and self.max_h < self.h:
             raise ValueError(f"max_h must be at least h ({self.h}), got {self.max_h}")
         set_("release_after", check_int("release_after", self.release_after, minimum=1, optional=True))
         set_("max_goals", check_int("max_goals", self.max_goals, minimum=1))

@@ -109,11 +109,13 @@ def goal_states(planner: PythonPlanner, ptc: ob.PlannerTerminationCondition, max
         state = pis.nextGoal()
         if state is not None:
             q = read(state)
-            states.setdefault(q.tobytes(), q)
+            if np.isfinite(q).all():  # OMPL's bounds check lets NaN through
+                states.setdefault(q.tobytes(), q)
     if not states and isinstance(goal, ob.GoalLazySamples):
         state = pis.nextGoal(ptc)  # a sampler thread may need time for its first goal: waited for until ptc
-        if state is not None:
-            states[b""] = read(state)
+        q = None if state is None else read(state)
+        if q is not None and np.isfinite(q).all():
+            states[b""] = q
     if not states:
         log.error("%s: no valid goal state could be drawn from the goal region", planner.getName())
         return planner_status(ob.PlannerStatus.INVALID_GOAL)

@@ -36,6 +36,7 @@ __all__ = [
     "RealVectorLayout",
     "GroupedSpace",
     "default_groups",
+    "group_lists",
     "validate_groups",
     "validate_prescribed",
     "interpolate_waypoints",
@@ -45,6 +46,10 @@ __all__ = [
 
 MAX_H = 10_000
 """Largest number of fake-time steps accepted (the paper uses 7); bounds memory per path."""
+MAX_BOUND = 1e100
+"""Largest bound magnitude of a RealVector DOF accepted: beyond it squared distances overflow to inf."""
+_BOUND_TOL = 1e-12
+"""How far a given waypoint value may lie outside the bounds (rounding)."""
 
 
 def default_groups(n: int) -> list[list[int]]:
@@ -52,6 +57,42 @@ def default_groups(n: int) -> list[list[int]]:
     if n < 1:
         raise ValueError(f"the space must have at least one dimension, got {n}")
     return [list(range(i, min(i + 2, n))) for i in range(0, n, 2)]
+
+
+def group_lists(groups: Sequence[Sequence[int]]) -> list[list[int]]:
+    """Check the form of ``groups`` (non-empty lists of distinct non-negative DOF indices, no index in two
+    groups) without knowing the space; return them as lists of int (numpy arrays accepted).
+
+    Raises
+    ------
+    ValueError
+        On an empty group, an index that is not a non-negative integer, or an index in two groups.
+    """
+    if isinstance(groups, np.ndarray):
+        groups = groups.tolist()
+    if isinstance(groups, (str, bytes)) or not isinstance(groups, Sequence) or len(groups) == 0:
+        raise ValueError(f"groups must be a non-empty list of lists of DOF indices, got {groups!r}")
+    out: list[list[int]] = []
+    seen: dict[int, int] = {}
+    for gi, group in enumerate(groups):
+        if isinstance(group, np.ndarray) and group.ndim == 1:
+            group = group.tolist()
+        if isinstance(group, (str, bytes)) or not isinstance(group, Sequence) or len(group) == 0:
+            raise ValueError(f"group {gi} must be a non-empty list of DOF indices, got {group!r}")
+        g: list[int] = []
+        for d in group:
+            if isinstance(d, bool) or not isinstance(d, (int, np.integer)):
+                raise ValueError(f"group {gi}: DOF index {d!r} is not an integer")
+            d = int(d)
+            if d < 0:
+                raise ValueError(f"group {gi}: DOF index {d} is negative")
+            if d in seen:
+                raise ValueError(f"DOF index {d} appears twice in group {gi}" if seen[d] == gi else
+                                 f"DOF index {d} appears in more than one group ({seen[d]} and {gi}): groups overlap")
+            seen[d] = gi
+            g.append(d)
+        out.append(g)
+    return out
 
 
 def validate_groups(groups: Sequence[Sequence[int]], n: int) -> list[list[int]]:
@@ -62,37 +103,24 @@ def validate_groups(groups: Sequence[Sequence[int]], n: int) -> list[list[int]]:
     ValueError
         On an empty group, an index out of range, an index in two groups or an index in none.
     """
-    if isinstance(groups, np.ndarray):
-        groups = groups.tolist()
-    if isinstance(groups, (str, bytes)) or not isinstance(groups, Sequence) or len(groups) == 0:
-        raise ValueError(f"groups must be a non-empty list of lists of DOF indices, got {groups!r}")
-    out: list[list[int]] = []
-    seen: dict[int, int] = {}
-    for gi, group in enumerate(groups):
-        if isinstance(group, (str, bytes)) or not isinstance(group, Sequence) or len(group) == 0:
-            raise ValueError(f"group {gi} must be a non-empty list of DOF indices, got {group!r}")
-        g: list[int] = []
-        for d in group:
-            if isinstance(d, bool) or not isinstance(d, (int, np.integer)):
-                raise ValueError(f"group {gi}: DOF index {d!r} is not an integer")
-            d = int(d)
-            if not 0 <= d < n:
+    out = group_lists(groups)
+    seen = {d for g in out for d in g}
+    for gi, g in enumerate(out):
+        for d in g:
+            if d >= n:
                 raise ValueError(f"group {gi}: DOF index {d} is out of range for a {n}-D space")
-            if d in seen:
-                raise ValueError(f"DOF index {d} appears in more than one group ({seen[d]} and {gi}): groups overlap")
-            seen[d] = gi
-            g.append(d)
-        out.append(g)
-    missing = sorted(set(range(n)) - set(seen))
+    missing = sorted(set(range(n)) - seen)
     if missing:
         raise ValueError(f"DOF indices {missing} are in no group: groups must cover all {n} DOFs")
     return out
 
 
 def validate_prescribed(
-    prescribed: Mapping[int, np.ndarray] | None, groups: Sequence[Sequence[int]], h: int
+    prescribed: Mapping[int, np.ndarray] | None, groups: Sequence[Sequence[int]], h: int,
+    lower: np.ndarray | None = None, upper: np.ndarray | None = None,
 ) -> dict[int, np.ndarray]:
-    """Check prescribed group trajectories: keys are group indices, values arrays (h, k_i), finite."""
+    """Check prescribed group trajectories: keys are group indices, values arrays (h, k_i), finite, and
+    within the bounds ``lower`` / ``upper`` (n,) when given (a path along them must stay in the space)."""
     if prescribed is None:
         return {}
     if not isinstance(prescribed, Mapping):
@@ -113,6 +141,13 @@ def validate_prescribed(
         if not np.all(np.isfinite(arr)):
             bad = arr[~np.isfinite(arr)][0]
             raise ValueError(f"prescribed trajectory of group {int(key)} contains {bad} (NaN or inf)")
+        if lower is not None and upper is not None:
+            dims = list(groups[int(key)])
+            out_of = (arr < lower[dims] - _BOUND_TOL) | (arr > upper[dims] + _BOUND_TOL)
+            if out_of.any():
+                t, j = (int(v) for v in np.argwhere(out_of)[0])
+                raise ValueError(f"prescribed trajectory of group {int(key)} leaves the space's bounds: step {t}, "
+                                 f"DOF {dims[j]} = {arr[t, j]:g} is outside [{lower[dims[j]]:g}, {upper[dims[j]]:g}]")
         arr.setflags(write=False)
         out[int(key)] = arr
     return out
@@ -184,11 +219,16 @@ class RealVectorLayout:
             b = space.getBounds()
             lo, hi = [float(v) for v in b.low], [float(v) for v in b.high]
             bad = [i for i in range(len(lo)) if not (math.isfinite(lo[i]) and math.isfinite(hi[i]) and lo[i] < hi[i])]
+            where = f" (subspace {list(path)})" if path else ""
             if bad:
                 raise ValueError(
-                    f"RealVectorStateSpace{' (subspace ' + str(list(path)) + ')' if path else ''} has no valid bounds "
+                    f"RealVectorStateSpace{where} has no valid bounds "
                     f"for dimension(s) {bad} (low must be < high, both finite): call space.setBounds(low, high) first"
                 )
+            huge = [i for i in range(len(lo)) if max(abs(lo[i]), abs(hi[i])) > MAX_BOUND]
+            if huge:
+                raise ValueError(f"RealVectorStateSpace{where} has bounds beyond +/-{MAX_BOUND:g} for dimension(s) {huge}: "
+                                 "distances would overflow (rescale the coordinates)")
             self._leaves.append((path, int(space.getDimension()), weight, False))
             lows.extend(lo)
             highs.extend(hi)
@@ -310,7 +350,7 @@ class GroupedSpace:
         n = self.layout.n
         self.h = check_int("h (fake-time steps incl. start and goal)", h, minimum=3, maximum=MAX_H)
         self.groups = validate_groups(default_groups(n) if groups is None else groups, n)
-        self.prescribed = validate_prescribed(prescribed, self.groups, self.h)
+        self.prescribed = validate_prescribed(prescribed, self.groups, self.h, self.layout.lower, self.layout.upper)
         self.planned = [g for g in range(len(self.groups)) if g not in self.prescribed]
         """Indices of the groups to plan, in planning order."""
 
@@ -327,6 +367,23 @@ class GroupedSpace:
         """Lower and upper bounds (k_g,) of group g."""
         d = self.group_dims(g)
         return self.layout.lower[d], self.layout.upper[d]
+
+    def check_initial(self, W: np.ndarray | None) -> np.ndarray | None:
+        """A first guess of the path, W (h, n), as a float array: finite and within the bounds (None passes)."""
+        if W is None:
+            return None
+        layout = self.layout
+        try:
+            arr = np.array(W, dtype=float)
+        except (TypeError, ValueError):
+            raise ValueError(f"initial_waypoints must be a numeric array of shape ({self.h}, {layout.n})") from None
+        if arr.shape != (self.h, layout.n):
+            raise ValueError(f"initial_waypoints must have shape ({self.h}, {layout.n}), got {arr.shape}")
+        if not np.all(np.isfinite(arr)):
+            raise ValueError("initial_waypoints contains NaN or inf")
+        if np.any(arr < layout.lower - _BOUND_TOL) or np.any(arr > layout.upper + _BOUND_TOL):
+            raise ValueError("initial_waypoints lie outside the state space bounds")
+        return arr
 
     def endpoint_mismatch(self, start: np.ndarray, goal: np.ndarray, tol: float = 1e-6) -> str | None:
         """None if start/goal lie on every prescribed trajectory, else "start" or "goal"."""

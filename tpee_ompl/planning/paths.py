@@ -84,6 +84,7 @@ def path_passes_motion_checks(
     *,
     check_first: bool = True,
     segments: Sequence[int] | None = None,
+    in_bounds: bool = False,
 ) -> bool:
     """OMPL's whole-path check: the first state is valid and every segment passes ``si.checkMotion``.
 
@@ -94,7 +95,7 @@ def path_passes_motion_checks(
     the motions go through its ``check_motions`` instead: the same states ``checkMotion`` checks, in
     one batched call (a 61-waypoint path: one call instead of 60), without the early stop.  An empty path passes; the
     SpaceInformation is set up first if it is not (as ``check()`` does).  Neither checks the
-    bounds (``si.satisfiesBounds``) nor where the path starts or ends.
+    bounds (``si.satisfiesBounds``; ``in_bounds`` adds that) nor where the path starts or ends.
 
     Parameters
     ----------
@@ -108,6 +109,10 @@ def path_passes_motion_checks(
     segments : sequence of int, optional
         Check only these segments (k: ``w[k] -> w[k + 1]``), for a caller that knows the others
         passed ``si.checkMotion`` already (dimension-RRT re-checks only the segments an improvement changed).
+    in_bounds : bool
+        Also require every state within the space's bounds (``si.satisfiesBounds``; a validity checker need
+        not test them, and a path OMPL's planners return never leaves them): what the package's planners
+        ask of a path before they post it.
 
     Raises
     ------
@@ -137,6 +142,8 @@ def path_passes_motion_checks(
         si.setup()
     if not states:
         return True
+    if in_bounds and not all(si.satisfiesBounds(s) for s in states):
+        return False
     if check_first and not si.isValid(states[0]):
         return False
     ks = range(len(states) - 1) if segments is None else list(segments)

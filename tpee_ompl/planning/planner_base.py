@@ -15,7 +15,7 @@ from typing import Any
 
 from ompl import base as ob
 
-__all__ = ["PythonPlanner", "planner_status"]
+__all__ = ["PythonPlanner", "finite_state", "planner_status"]
 
 log = logging.getLogger(__name__)
 
@@ -23,6 +23,12 @@ log = logging.getLogger(__name__)
 def problem_objective(pdef: ob.ProblemDefinition) -> ob.OptimizationObjective | None:
     """The problem's optimization objective, or None when it has none (a plain ``og.SimpleSetup``)."""
     return pdef.getOptimizationObjective() if pdef.hasOptimizationObjective() else None
+
+
+def finite_state(si: ob.SpaceInformation, state: ob.State) -> bool:
+    """Whether every value of ``state`` is finite: its distance to itself is 0, not NaN, in any space
+    (``si.satisfiesBounds`` lets NaN through, and a NaN state would reach the checker)."""
+    return math.isfinite(si.distance(state, state))
 
 
 def planner_status(code: Any) -> ob.PlannerStatus:
@@ -91,6 +97,9 @@ class PythonPlanner(ob.Planner):
             start = pis.nextStart()
         if start is None:  # nextStart() skips start states out of bounds or invalid (OMPL checks them itself)
             return planner_status(ob.PlannerStatus.INVALID_START)
+        if not finite_state(self.getSpaceInformation(), start):  # OMPL's bounds check lets NaN through
+            log.error("%s: the start state has NaN or inf values", self.getName())
+            return planner_status(ob.PlannerStatus.INVALID_START)
         return start
 
     def _goal_state(self) -> ob.State | ob.PlannerStatus:
@@ -101,6 +110,9 @@ class PythonPlanner(ob.Planner):
             log.error("%s needs a goal that is a single state, got %s", self.getName(), type(goal).__name__)
             return planner_status(ob.PlannerStatus.UNRECOGNIZED_GOAL_TYPE)
         gstate = goal.getState()
+        if not finite_state(si, gstate):
+            log.error("%s: the goal state has NaN or inf values", self.getName())
+            return planner_status(ob.PlannerStatus.INVALID_GOAL)
         if not (si.satisfiesBounds(gstate) and si.isValid(gstate)):
             return planner_status(ob.PlannerStatus.INVALID_GOAL)
         return gstate

@@ -77,7 +77,7 @@ class SolutionPoster:
         keys = [W[k : k + 2].tobytes() for k in range(len(W) - 1)]
         states = path.getStates()
         todo = [k for k, key in enumerate(keys) if key not in self._passed]
-        if path_passes_motion_checks(self.si, states, check_first=False, segments=todo):
+        if path_passes_motion_checks(self.si, states, check_first=False, segments=todo, in_bounds=True):
             self._passed.update(keys)
             self.pdef.addSolutionPath(path, False, 0.0, planner.getName())
             self.posted += 1
@@ -86,5 +86,5 @@ class SolutionPoster:
                 self.first_time = time.perf_counter() - self.t0
             self.notify(path, cost)
         else:
-            log.warning("DimensionRRT: si.checkMotion rejected a path the search accepted; not reported")
+            log.warning("DimensionRRT: si.checkMotion or the bounds rejected a path the search accepted; not reported")
         self._spent += time.perf_counter() - t

@@ -13,6 +13,7 @@ from ompl import base as ob
 
 from ..model.sectors import cross_sector_trajectory
 from .dimension_rrt import DimensionRRT, DimensionRRTOptions
+from .dimension_rrt_options import resolve_options
 
 __all__ = ["tpee_dimension_rrt"]
 
@@ -31,8 +32,21 @@ def tpee_dimension_rrt(
     Groups ``[[0, 1], [2, 3]]`` unless ``options`` says otherwise; DOF1/DOF2 follow the Table 3 row
     (7 fake-time steps).  ``options``, ``initial_waypoints`` and the keyword overrides are those of
     :class:`DimensionRRT`.
+
+    Raises
+    ------
+    ValueError
+        Groups whose first group is not DOF1/DOF2 (``[0, 1]``, the row Table 3 prescribes), or ``h``
+        other than the row's 7 steps (``max_h`` may raise it during the search).
     """
     if options is None or options.groups is None:
         overrides.setdefault("groups", ((0, 1), (2, 3)))
-    prescribed = {0: cross_sector_trajectory(from_sector, to_sector)}
-    return DimensionRRT(si, options, prescribed=prescribed, initial_waypoints=initial_waypoints, **overrides)
+    opts = resolve_options(options, overrides)
+    if list(opts.groups[0]) != [0, 1]:
+        raise ValueError(f"groups: Table 3 prescribes DOF1/DOF2, so the first group must be [0, 1], got "
+                         f"{[list(g) for g in opts.groups]} (DimensionRRT plans other groupings without the rows)")
+    row = cross_sector_trajectory(from_sector, to_sector)
+    if opts.h != len(row):
+        raise ValueError(f"h must be {len(row)} for the wearer arm (Table 3's rows have {len(row)} fake-time steps), "
+                         f"got {opts.h}; max_h lets the search raise it")
+    return DimensionRRT(si, opts, prescribed={0: row}, initial_waypoints=initial_waypoints)

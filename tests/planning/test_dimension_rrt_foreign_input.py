@@ -1,0 +1,154 @@
+"""DimensionRRT given what another OMPL user may give it: bad values are refused or said through PlannerStatus,
+and nothing a caller does with what the planner hands out changes the path it posted."""
+
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+import pytest
+from ompl import base as ob
+from ompl import geometric as og
+
+from tpee_ompl.model.queries import load_queries
+from tpee_ompl.planning.dimension_rrt import DimensionRRT, DimensionRRTOptions
+from tpee_ompl.planning.paths import path_passes_motion_checks, path_to_array, set_state
+from tpee_ompl.planning.setup import make_simple_setup
+from tpee_ompl.planning.tpee import tpee_dimension_rrt
+
+
+def _box(bound: float = 1.0) -> tuple[og.SimpleSetup, ob.SpaceInformation]:
+    """2-D box with a wall at |x| < 0.2, |y| < 0.7 (the straight motion from (-0.8, 0) to (0.8, 0) collides)."""
+    space = ob.RealVectorStateSpace(2)
+    space.setBounds(-bound, bound)
+    ss = og.SimpleSetup(space)
+    ss.setStateValidityChecker(lambda s: not (abs(s[0]) < 0.2 and abs(s[1]) < 0.7))
+    return ss, ss.getSpaceInformation()
+
+
+def _ends(ss: og.SimpleSetup, start, goal) -> None:
+    si = ss.getSpaceInformation()
+    a, b = si.allocState(), si.allocState()
+    set_state(a, start)
+    set_state(b, goal)
+    ss.setStartAndGoalStates(a, b)
+
+
+def test_the_callbacks_states_are_copies_so_changing_them_leaves_the_posted_path_valid() -> None:
+    ss, si = _box()
+    _ends(ss, [-0.8, 0.0], [0.8, 0.0])
+    planner = DimensionRRT(si, seed=1, max_samples=300)
+    ss.setPlanner(planner)
+
+    def vandal(planner, states, cost):
+        for s in states:  # every state into the wall
+            s[0:2] = [0.0, 0.0]
+
+    planner.set_intermediate_solution_callback(vandal)
+    assert ss.solve(30.0) == ob.PlannerStatus.EXACT_SOLUTION
+    assert planner.last_run_stats()["solutions_posted"] >= 1
+    path = ss.getSolutionPath()
+    assert path.check() and path_passes_motion_checks(si, path)
+    W = path_to_array(path, 2)
+    assert np.allclose(W[0], [-0.8, 0.0]) and np.allclose(W[-1], [0.8, 0.0])
+
+
+@pytest.mark.parametrize("end", ["start", "goal"])
+def test_a_nan_start_or_goal_is_an_invalid_start_or_goal_not_a_crash(end, caplog) -> None:
+    ss, si = _box()
+    start, goal = [-0.8, 0.0], [0.8, 0.0]
+    (start if end == "start" else goal)[1] = float("nan")  # OMPL's bounds check lets NaN through
+    _ends(ss, start, goal)
+    ss.setPlanner(DimensionRRT(si, seed=1, max_samples=100))
+    with caplog.at_level(logging.ERROR):
+        status = ss.solve(5.0)
+    assert status == (ob.PlannerStatus.INVALID_START if end == "start" else ob.PlannerStatus.INVALID_GOAL)
+    assert f"the {end} state has NaN or inf values" in caplog.text and not ss.haveExactSolutionPath()
+
+
+def test_prescribed_rows_outside_the_bounds_are_refused_naming_the_step_and_dof() -> None:
+    ss, si = _box()
+    row = [-0.8, -1.5, -1.5, 0.0, 1.5, 1.5, 0.8]  # beyond |1|: a path along it would leave the space
+    with pytest.raises(ValueError, match=r"leaves the space's bounds: step 1, DOF 0 = -1\.5"):
+        DimensionRRT(si, groups=[[0], [1]], prescribed={0: row})
+    DimensionRRT(si, groups=[[0], [1]], prescribed={0: np.clip(row, -1.0, 1.0)})  # on the bounds: accepted
+
+
+def test_bounds_so_wide_that_distances_overflow_are_refused_at_construction() -> None:
+    _, si = _box(1e160)
+    with pytest.raises(ValueError, match="distances would overflow"):
+        DimensionRRT(si)
+    DimensionRRT(_box(1e6)[1])  # wide, but fine
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    ({"h": -5}, "h .* must be an integer in"), ({"h": "7"}, "h .* must be an integer"),
+    ({"groups": "x"}, "groups must be a non-empty list"), ({"groups": [[0, 0]]}, "appears twice in group 0"),
+    ({"groups": [[0, 1], [1]]}, "more than one group"), ({"groups": [[0, -1]]}, "negative"),
+])
+def test_options_are_checked_when_they_are_made(kwargs, match) -> None:
+    with pytest.raises(ValueError, match=match):
+        DimensionRRTOptions(**kwargs)
+
+
+def test_groups_given_as_numpy_arrays_are_taken_as_lists() -> None:
+    want = ((0, 1), (2, 3))
+    assert DimensionRRTOptions(groups=np.array([[0, 1], [2, 3]])).groups == want
+    assert DimensionRRTOptions(groups=[np.array([0, 1]), np.array([2, 3])]).groups == want
+
+
+def test_sample_checkpoints_must_be_a_sequence_of_counts() -> None:
+    planner = DimensionRRT(_box()[1])
+    with pytest.raises(ValueError, match="sequence of sample counts"):
+        planner.set_sample_checkpoints(5)
+    with pytest.raises(ValueError, match="sample checkpoint"):
+        planner.set_sample_checkpoints([0])
+    planner.set_sample_checkpoints([500, 100])
+
+
+def test_the_goal_states_searches_are_built_only_while_the_termination_condition_allows() -> None:
+    """Each goal state's search checks its initial path when it is built: with a slow checker, eight of them
+    ran a 0.1-s solve to 2 s; the condition is now asked between them."""
+    ss, si = _box()
+    calls = [0]
+
+    def valid(s) -> bool:
+        calls[0] += 1
+        return not (abs(s[0]) < 0.2 and abs(s[1]) < 0.7)
+
+    ss.setStateValidityChecker(valid)
+    a = si.allocState()
+    set_state(a, [-0.8, 0.0])
+    ss.setStartState(a)
+    goals = ob.GoalStates(si)
+    for k in range(8):
+        g = si.allocState()
+        set_state(g, [0.8, -0.9 + 0.25 * k])
+        goals.addState(g)
+    ss.setGoal(goals)
+    ss.setup()
+    drawn = 1 + 8  # the start's check and the goal states' (OMPL's input states)
+
+    def run(ptc):
+        planner = DimensionRRT(si, seed=1, max_samples=50)
+        ss.clear()
+        ss.setPlanner(planner)
+        calls[0] = 0
+        ss.solve(ptc)
+        return planner.last_run_stats()["goals"]
+
+    # true once anything past drawing the goal states was checked: after the first goal's search is built
+    assert run(ob.PlannerTerminationCondition(lambda: calls[0] > drawn)) == 1
+    assert run(ob.timedPlannerTerminationCondition(30.0)) == 8
+
+
+def test_the_wearer_factory_refuses_groups_that_do_not_start_with_dof1_dof2_and_another_h(robot) -> None:
+    q = load_queries("planning_necessary", robot)[0]
+    si = make_simple_setup(robot, q.start, q.goal).getSpaceInformation()
+    for groups in ([[2, 3], [0, 1]], [[1, 0], [2, 3]]):
+        with pytest.raises(ValueError, match=r"first group must be \[0, 1\]"):
+            tpee_dimension_rrt(si, q.from_sector, q.to_sector, groups=groups)
+    with pytest.raises(ValueError, match="h must be 7 for the wearer arm"):
+        tpee_dimension_rrt(si, q.from_sector, q.to_sector, h=5)
+    planner = tpee_dimension_rrt(si, q.from_sector, q.to_sector, groups=[[0, 1], [3], [2]])
+    assert planner.groups == [[0, 1], [3], [2]] and list(planner.prescribed) == [0]
