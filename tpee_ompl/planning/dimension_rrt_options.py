@@ -33,7 +33,9 @@ class DimensionRRTOptions:
     max_samples : int, optional
         Stop after this many samples even if the termination condition still allows time.
     seed : int, optional
-        Seed of the planner's own ``np.random.Generator`` (OMPL's seed does not cover it).
+        Seed of the planner's own ``np.random.Generator`` (OMPL's seed does not cover it).  Its stream runs
+        on across solves and ``clear()``, so a benchmark's runs of one planner differ, as OMPL's planners'
+        do; a new planner with the same seed repeats the first solve.
     narrow_after : int
         Samples of a group (and a valid path) before its sampling region narrows (default 200).
     narrowing : float in (0, 1]
