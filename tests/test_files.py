@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import os
+import stat
+
 import pytest
 
 from tpee_ompl.files import OutputExistsError, atomic_path, atomic_write_text, check_output_path, write_new_file
@@ -51,6 +54,36 @@ def test_output_path_that_is_a_folder_or_under_a_file_is_refused_naming_it(tmp_p
         check_output_path(tmp_path / "f" / "out.png")
     assert check_output_path(tmp_path / "new" / "out.png").name == "out.png"
     assert not (tmp_path / "new").exists()  # checking creates nothing
+
+
+def test_a_symlink_or_a_pipe_is_refused_even_with_force_and_left_as_it_was(tmp_path):
+    """Replacing would destroy them (``--force`` once turned /dev-like nodes and links into plain files)."""
+    real = tmp_path / "real.csv"
+    real.write_text("keep")
+    link = tmp_path / "link.csv"
+    link.symlink_to(real)
+    fifo = tmp_path / "fifo.csv"
+    os.mkfifo(fifo)
+    for target, words in ((link, "symbolic link"), (fifo, "not a regular file")):
+        with pytest.raises(ValueError, match=words):
+            check_output_path(target, force=True)
+        with pytest.raises(ValueError, match=words):
+            atomic_write_text(target, "new", force=True)
+    assert link.is_symlink() and real.read_text() == "keep" and stat.S_ISFIFO(fifo.lstat().st_mode)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["fifo.csv", "link.csv", "real.csv"]  # no temporary left
+
+
+def test_a_folder_that_can_be_written_but_not_entered_is_refused(tmp_path):
+    folder = tmp_path / "noexec"
+    folder.mkdir()
+    folder.chmod(0o600)  # writable, not searchable
+    try:
+        if os.access(folder / ".", os.X_OK):
+            pytest.skip("running with the permission to enter any folder (root)")
+        with pytest.raises(ValueError, match="not writable"):
+            check_output_path(folder / "out.png")
+    finally:
+        folder.chmod(0o700)
 
 
 @pytest.mark.parametrize("seed", [0, -5, MAX_SEED + 1, 10**20, 1.5, True, "3", None])

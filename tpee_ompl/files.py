@@ -34,21 +34,32 @@ def check_output_path(path: str | os.PathLike, *, force: bool = False, what: str
     OutputExistsError
         The file exists and ``force`` is False.
     ValueError
-        ``path`` is a folder, or a parent is a file.
+        ``path`` is a folder, a symbolic link or not a regular file (a device), a parent is a file, or
+        its folder cannot be written to.
     """
     p = Path(path)
     if p.is_dir():
         raise ValueError(f"{what} {p} is a folder; give a file name")
+    _check_replaceable(p, what)
     for parent in p.parents:
         if parent.exists():
             if not parent.is_dir():
                 raise ValueError(f"{what} {p}: {parent} is a file, not a folder")
-            if not os.access(parent, os.W_OK):
+            if not os.access(parent, os.W_OK | os.X_OK):
                 raise ValueError(f"{what} {p}: folder {parent} is not writable")
             break
     if p.exists() and not force:
         raise OutputExistsError(f"{what} {p} exists; pass --force to replace it")
     return p
+
+
+def _check_replaceable(p: Path, what: str) -> None:
+    """Refuse a target that replacing would destroy rather than write: a symbolic link (the link itself would
+    be replaced, not the file it points to) or anything but a regular file (a device, a pipe, a socket)."""
+    if p.is_symlink():
+        raise ValueError(f"{what} {p} is a symbolic link; give the path of the file itself ({p.resolve()})")
+    if p.exists() and not p.is_file():
+        raise ValueError(f"{what} {p} is not a regular file (a device, pipe or socket); give a file name")
 
 
 def _umask() -> int:
@@ -70,6 +81,7 @@ def atomic_path(path: str | os.PathLike, *, force: bool = True, suffix_last: boo
     target = Path(path)
     if target.exists() and not force:
         raise OutputExistsError(f"{target} exists; pass --force to replace it")
+    _check_replaceable(target, "output file")
     target.parent.mkdir(parents=True, exist_ok=True)
     suffix = ".part" + target.suffix if suffix_last else target.suffix + ".part"
     tmp: Path | None = None

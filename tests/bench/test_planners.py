@@ -127,3 +127,17 @@ def test_dimension_rrt_variants_are_the_problems_dimension_rrt_with_one_setting_
     assert other.settings()[setting] == value and plain.settings()[setting] == default
     assert {k: v for k, v in other.settings().items() if k != setting} == \
         {k: v for k, v in plain.settings().items() if k != setting}
+
+
+def test_the_planners_refused_at_a_sample_cap_are_those_whose_bindings_count_no_iterations():
+    """``NOT_ITERATION_CAPPED`` is checked against the bindings: a native planner is there iff it has no
+    ``numIterations()`` (an AORRTC in the sample ladder killed every worker with SIGSEGV)."""
+    from ompl import geometric as og
+
+    from tpee_ompl.bench.config import KNOWN_PLANNERS, NOT_ITERATION_CAPPED
+
+    for name in KNOWN_PLANNERS:
+        native = getattr(og, name, None)
+        if native is not None:
+            assert (name in NOT_ITERATION_CAPPED) == (not hasattr(native, "numIterations")), name
+    assert "RRTConnectSimplify" in NOT_ITERATION_CAPPED

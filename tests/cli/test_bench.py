@@ -23,11 +23,11 @@ def test_command_line_defaults_are_the_config_defaults():
 def test_options_reach_the_config():
     args = build_parser().parse_args(["--queries", "some/set.json", "--samples", "10", "20", "--anytime",
                                       "--checkers", "discrete", "--alt-checker-samples", "10", "--workers", "3",
-                                      "--seed", "9", "--planners", "RRTstar", "RRTConnect"])
+                                      "--seed", "9", "--planners", "RRTstar", "InformedRRTstar"])
     cfg = config_from_args(args)
     assert cfg.name == "set" and cfg.sample_caps == (10, 20) and cfg.anytime_budgets == ()
     assert cfg.checkers == ("discrete",) and cfg.alt_checker_caps == (10,)
-    assert cfg.workers == 3 and cfg.seed == 9 and cfg.iteration_planners == ("RRTstar", "RRTConnect")
+    assert cfg.workers == 3 and cfg.seed == 9 and cfg.iteration_planners == ("RRTstar", "InformedRRTstar")
 
 
 def test_register_adds_the_bench_subcommand_with_an_example(capsys):

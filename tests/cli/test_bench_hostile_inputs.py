@@ -1,6 +1,7 @@
 """``tpee-ompl bench`` refuses every bad input before anything is created: a table of hostile and careless inputs.
 
-Each case runs the real command line as a subprocess and checks: exit 2 (usage) or 1 (runtime), one line
+Each case runs the real command line as a subprocess and checks: exit 2 (usage) or 1 (runtime: a damaged
+query file, as in ``plan``), one line
 on stderr naming the option or file, no traceback, no file or folder left behind, existing files unchanged.
 Refusals happen before any planning, so each case takes well under a second or two.
 """
@@ -45,6 +46,12 @@ def inputs(tmp_path_factory, robot) -> Path:
     (d / "bad_campaign" / "campaign.json").write_text('{"config": ')
     (d / "list_campaign").mkdir()
     (d / "list_campaign" / "campaign.json").write_text("[]")
+    meta = {"config": {"queries": None}, "query_set": "good", "expected_experiments": 1,
+            "query_data": [{"start": [0.0] * 4, "goal": [0.0] * 4}]}  # no id
+    (d / "bad_query_data").mkdir()
+    (d / "bad_query_data" / "campaign.json").write_text(json.dumps(meta))
+    (d / "config_list").mkdir()
+    (d / "config_list" / "campaign.json").write_text(json.dumps({**meta, "config": [1, 2]}))
     return d
 
 
@@ -72,14 +79,14 @@ CASES = [
     ("planner-module-missing", ["--planners", "no_such_module_xyz:make"], 2, ["--planners", "no_such_module_xyz"]),
     ("planner-function-missing", ["--planners", "helpers.bench_standins:no_such_factory"], 2, ["--planners", "no_such_factory"]),
     ("queries-missing", ["--queries", "{in}/missing.json"], 2, ["--queries", "missing.json"]),
-    ("queries-truncated", ["--queries", "{in}/truncated.json"], 2, ["--queries", "truncated.json", "not a JSON query set"]),
-    ("queries-format-version", ["--queries", "{in}/version.json"], 2, ["--queries", "format_version"]),
-    ("queries-other-model", ["--queries", "{in}/other_model.json"], 2, ["--queries", "model_hash"]),
-    ("queries-not-a-set", ["--queries", "{in}/not_a_set.json"], 2, ["--queries", "JSON object"]),
-    ("queries-string-start", ["--queries", "{in}/string_start.json"], 2, ["--queries", "field 'start'"]),
-    ("queries-start-outside-limits", ["--queries", "{in}/outside_limits.json"], 2,
+    ("queries-truncated", ["--queries", "{in}/truncated.json"], 1, ["--queries", "truncated.json", "not a JSON query set"]),
+    ("queries-format-version", ["--queries", "{in}/version.json"], 1, ["--queries", "format_version"]),
+    ("queries-other-model", ["--queries", "{in}/other_model.json"], 1, ["--queries", "model_hash"]),
+    ("queries-not-a-set", ["--queries", "{in}/not_a_set.json"], 1, ["--queries", "JSON object"]),
+    ("queries-string-start", ["--queries", "{in}/string_start.json"], 1, ["--queries", "field 'start'"]),
+    ("queries-start-outside-limits", ["--queries", "{in}/outside_limits.json"], 1,
      ["--queries", "outside_limits.json", "joint limits"]),
-    ("queries-start-and-goal-swapped", ["--queries", "{in}/swapped.json"], 2, ["--queries", "swapped.json", "Table-1 preset"]),
+    ("queries-start-and-goal-swapped", ["--queries", "{in}/swapped.json"], 1, ["--queries", "swapped.json", "Table-1 preset"]),
     ("max-time-beyond-a-day", ["--max-time", "1e300"], 2, ["--max-time", "86400"]),
     ("anytime-beyond-a-day", ["--anytime", "1e10"], 2, ["--anytime", "86400"]),
     ("queries-a-folder", ["--queries", "{in}/not_a_campaign"], 2, ["--queries", "not_a_campaign"]),
@@ -107,12 +114,19 @@ CASES = [
     ("dask-workers-zero", ["--dask-workers", "0"], 2, ["--dask-workers"]),
     ("retries-negative", ["--retries", "-1"], 2, ["--retries"]),
     ("unknown-option", ["--frobnicate"], 2, ["--frobnicate"]),
+    ("planner-counts-no-iterations", ["--planners", "AORRTC", "RRTstar"], 2, ["--planners", "AORRTC"]),
+    ("checker-twice", ["--checkers", "dense", "dense"], 2, ["--checkers", "twice"]),
+    ("resume-empty", ["--resume", ""], 2, ["--resume", "empty"]),
+    ("queries-empty", ["--queries", ""], 2, ["--queries", "empty"]),
+    ("name-too-long", ["--name", "x" * 300], 2, ["--name", "200 bytes"]),
+    ("resume-bad-query-data", ["--resume", "{in}/bad_query_data"], 2, ["--resume", "query_data", "entry 0"]),
+    ("resume-config-a-list", ["--resume", "{in}/config_list"], 2, ["--resume", "config"]),
 ]
 
 
 def _args(args: list[str], inputs: Path, out: Path) -> list[str]:
     base = ["bench", "--queries", str(inputs / "good.json"), "--samples", "20", "--anytime",
-            "--planners", "RRTstar", "RRTConnect", "--workers", "1", "--out", str(out), "--no-progress"]
+            "--planners", "RRTstar", "InformedRRTstar", "--workers", "1", "--out", str(out), "--no-progress"]
     return base + [a.format(**{"in": inputs}) for a in args]
 
 

@@ -9,6 +9,7 @@ planning, so each case takes about the interpreter's start-up time.
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import pytest
@@ -31,7 +32,7 @@ SG = ["--start", *map(str, START), "--goal", *map(str, GOAL)]
 IN_COLLISION = ["-0.085", "0.299", "-0.799", "-1.202"]
 """A configuration inside the wearer."""
 ISSUE_LIBRARY_DEFECTS = ("meta-is-a-list", "unknown-dmp-option", "pairs-is-5", "1-d-waypoints", "nan-weights",
-                         "n-candidates-negative")
+                         "n-candidates-negative", "huge-waypoints", "huge-weights")
 ISSUE_QUERY_DEFECTS = ("start-strings", "from-sector-true")
 
 # (case id, arguments, exit code, names the one stderr line must contain).  "{in}" is the folder of
@@ -129,6 +130,21 @@ USAGE = [
     ("library-stats-library-a-folder", ["library", "stats", "--library", "adir"], "--library"),
     ("library-stats-library-missing", ["library", "stats", "--library", "missing.npz"], "make library"),
     ("no-command", [], "COMMAND"),
+    # found by a helper's probe (2026-11-26): planners that count no iterations, empty names, files that are
+    # not regular files, duplicate or unbounded build settings, a target the sector's arm cannot aim at
+    ("plan-samples-for-a-planner-without-iterations", ["plan", "--from", "1", "--to", "4", "--planner", "aorrtc",
+                                                       "--samples", "50"], "--samples"),
+    ("animate-samples-for-a-planner-without-iterations", ["animate", "--from", "1", "--to", "4", "--planner",
+                                                          "aorrtc", "--samples", "50", "-o", "m.gif"], "--samples"),
+    ("track-output-empty", ["track", "--duration", "1", "-o", ""], "--output"),
+    ("animate-path-empty-name", ["animate", "--path", "", "-o", "m.gif"], "--path"),
+    ("aim-urdf-empty", ["aim", "--target", "5", "2", "1.5", "--urdf", ""], "--urdf"),
+    ("track-output-a-symlink", ["track", "--duration", "1", "-o", "link.csv", "--force"], "symbolic link"),
+    ("track-output-a-fifo", ["track", "--duration", "1", "-o", "fifo.csv", "--force"], "not a regular file"),
+    ("aim-target-too-close-for-the-arm", ["aim", "--target", "-0.3", "0", "1.8"], "--target"),
+    ("library-build-pair-twice", ["library", "build", "--pairs", "1-2", "1-2", "--library", "new.npz"], "--pairs"),
+    ("library-build-per-pair-huge", ["library", "build", "--per-pair", "100000000", "--library", "new.npz"],
+     "--per-pair"),
 ]
 RUNTIME = [
     *((f"library-stats-{d}", ["library", "stats", "--library", f"{{in}}/lib_{d}.npz"], f"lib_{d}.npz")
@@ -151,6 +167,7 @@ RUNTIME = [
     ("animate-path-of-strings", ["animate", "--path", "{in}/path_strings.json", "-o", "m.gif"], "waypoint 0"),
     ("animate-path-three-values", ["animate", "--path", "{in}/path_short.json", "-o", "m.gif"], "waypoint 1"),
     ("animate-path-not-json", ["animate", "--path", "{in}/path_not_json.json", "-o", "m.gif"], "--path"),
+    ("animate-path-outside-the-joint-limits", ["animate", "--path", "{in}/path_huge.json", "-o", "m.gif"], "waypoint 1"),
     ("plan-queries-nested-too-deep", ["plan", "--from", "1", "--to", "4", "--queries", "{in}/deep.json"],
      "deep.json"),
     ("plan-urdf-malformed", ["plan", "--from", "1", "--to", "4", *SG, "--urdf", "{in}/bad.urdf"], "bad.urdf"),
@@ -172,6 +189,7 @@ def inputs(tmp_path_factory) -> Path:
     write_path_file(d / "path_empty.json", [])
     write_path_file(d / "path_strings.json", [[str(v) for v in START], GOAL])
     write_path_file(d / "path_short.json", [START, GOAL[:3]])
+    write_path_file(d / "path_huge.json", [START, [1e300, 0.0, 0.0, 0.0]])
     (d / "path_not_json.json").write_text("{not json")
     (d / "deep.json").write_text("[" * 100_000 + "]" * 100_000)
     (d / "bad.urdf").write_text("<robot name='x'><link name=")
@@ -187,6 +205,8 @@ def workdir(tmp_path: Path) -> Path:
     write_library_file(tmp_path / "existing.npz")
     (tmp_path / "adir").mkdir()
     (tmp_path / "adir" / "keep.txt").write_text("keep")
+    (tmp_path / "link.csv").symlink_to(tmp_path / "existing.csv")  # --force must not replace the link itself
+    os.mkfifo(tmp_path / "fifo.csv")  # nor a pipe (or a device) with a file
     return tmp_path
 
 

@@ -64,10 +64,18 @@ def test_query_without_a_query_names_the_missing_options(small_file: str) -> Non
         _run(["library", "query", "--library", small_file, "--from", "1", "--to", "2"])
 
 
-@pytest.mark.parametrize("extra, match", [(["--workers", "0"], "--workers"), (["--demo-margins", "nan"], "--demo-margins")])
+@pytest.mark.parametrize("extra, match", [(["--demo-margins", "nan"], "--demo-margins"), (["--pairs", "1-2", "1-2"], "--pairs")])
 def test_bad_build_options_name_the_option(extra: list[str], match: str, tmp_path) -> None:
     with pytest.raises(CliError, match=match):
         _run(["library", "build", "--pairs", "1-2", "--library", str(tmp_path / "x.npz"), *extra])
+
+
+@pytest.mark.parametrize("option, value", [("--workers", "0"), ("--per-pair", "100000000"), ("--max-attempts", "1e3"),
+                                           ("--max-samples", "-1")])
+def test_build_counts_are_positive_integers_up_to_ten_million(option: str, value: str, capsys) -> None:
+    with pytest.raises(SystemExit):
+        build_parser().parse_args(["library", "build", "--library", "x.npz", option, value])
+    assert option in capsys.readouterr().err
 
 
 def test_bad_sector_pair_is_a_usage_error(capsys) -> None:

@@ -73,3 +73,31 @@ def test_verbose_adds_the_traceback_of_an_unexpected_error(monkeypatch, capsys):
     assert main(["-v", "aim", "--target", "5", "2", "1.5"]) == 1
     err = capsys.readouterr().err
     assert "Traceback" in err and err.strip().splitlines()[-1].endswith("(run with -v for the traceback)")
+
+
+def test_sigterm_ends_any_command_as_ctrl_c_does(monkeypatch, capsys):
+    """``kill`` (or a scheduler) gets the cleanup of Ctrl-C in every command, not only in ``bench``: exit 130."""
+    import os
+    import signal
+
+    import tpee_ompl.cli.plan as plan
+
+    def killed(args):
+        os.kill(os.getpid(), signal.SIGTERM)
+        for _ in range(10_000):  # the handler runs between bytecodes
+            pass
+        raise AssertionError("SIGTERM did not interrupt")
+
+    before = signal.getsignal(signal.SIGTERM)
+    monkeypatch.setattr(plan, "cmd_aim", killed)
+    assert main(["aim", "--target", "5", "2", "1.5"]) == 130
+    assert "interrupted" in capsys.readouterr().err
+    assert signal.getsignal(signal.SIGTERM) == before
+
+
+@pytest.mark.parametrize("value", ["-1e6", "-1.5E+2", "-.5e-1", "-3"])
+def test_negative_numbers_in_any_notation_are_values_not_options(value):
+    from tpee_ompl.cli.main import get_argument_parser
+
+    args = get_argument_parser().parse_args(["aim", "--target", "5", value, "1.5"])
+    assert args.target[1] == float(value)

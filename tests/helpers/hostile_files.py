@@ -48,6 +48,15 @@ def _nan_weights(a: dict) -> None:
     a[PAIR + "fwd_weights"] = w
 
 
+def _scaled(name: str, value: float) -> Callable[[dict], None]:
+    """A change setting one value of pair (1, 2)'s array ``name`` to ``value`` (finite, but out of any range)."""
+    def change(a: dict) -> None:
+        x = a[PAIR + name].copy()
+        x.flat[0] = value
+        a[PAIR + name] = x
+    return change
+
+
 LIBRARY_DEFECTS: dict[str, tuple[Callable[[dict], None], str]] = {
     # name: (change, what the refusal must name)
     "meta-is-a-list": (lambda a: _set(a, "meta", json.dumps([1, 2, 3])), "meta"),
@@ -59,6 +68,8 @@ LIBRARY_DEFECTS: dict[str, tuple[Callable[[dict], None], str]] = {
     "pair-not-cross-sector": (lambda a: _set(a["meta"], "pairs", [[1, 1]]), "pairs"),
     "1-d-waypoints": (lambda a: _set(a, PAIR + "waypoints", a[PAIR + "waypoints"].ravel()), "p12_waypoints"),
     "nan-weights": (_nan_weights, "p12_fwd_weights"),
+    "huge-waypoints": (_scaled("waypoints", 1e300), "p12_waypoints"),
+    "huge-weights": (_scaled("fwd_weights", 1e300), "p12_fwd_weights"),
     "n-candidates-negative": (lambda a: _set(a["meta"], "n_candidates", -5), "n_candidates"),
     "n-candidates-a-string": (lambda a: _set(a["meta"], "n_candidates", "3"), "n_candidates"),
     "per-step-huge": (lambda a: _set(a["meta"], "per_step", 10**12), "per_step"),

@@ -24,6 +24,7 @@ import contextlib
 import dataclasses
 import json
 import logging
+import math
 import os
 import socket
 import sys
@@ -149,8 +150,11 @@ def prepare_campaign(config: CampaignConfig) -> CampaignPlan:
     except ImportError as exc:  # a robot-checker problem whose model this install lacks
         raise ValueError(str(exc)) from None
     except (OSError, ValueError) as exc:  # missing, unreadable, not a query set, made for another model
+        from ..model.queries import QuerySetError
+
         msg = str(exc).removeprefix(f"{what}: ")
-        raise ValueError(msg if msg.startswith("queries") else f"queries {what}: {msg}") from None
+        kind = QuerySetError if isinstance(exc, QuerySetError) else ValueError  # damaged: a runtime error to the CLI
+        raise kind(msg if msg.startswith("queries") else f"queries {what}: {msg}") from None
     queries = stratified_subset(queries, config.max_queries)
     if not queries:
         raise ValueError(f"query set {what!r} has no queries")
@@ -241,12 +245,37 @@ def load_campaign(directory: str | os.PathLike) -> dict:
         raise ValueError(f"resume {directory}: campaign.json is not a campaign's (no config/query_set)")
     if "query_data" not in meta:
         raise ValueError(f"resume {directory}: written by an older version (no query_data): cannot resume")
+    if not isinstance(meta["config"], dict):
+        raise ValueError(f"resume {directory}: campaign.json has a bad config (not an object)")
     meta["config"].setdefault("problem", "wearer")  # written before campaigns had problems
     try:
-        CampaignConfig(**{k: tuple(v) if isinstance(v, list) else v for k, v in meta["config"].items()})
+        config = CampaignConfig(**{k: tuple(v) if isinstance(v, list) else v for k, v in meta["config"].items()})
     except (TypeError, ValueError) as exc:
         raise ValueError(f"resume {directory}: campaign.json has a bad config ({exc})") from None
+    from .problems import get_problem
+
+    bad = _bad_query_data(meta["query_data"], get_problem(config.problem).dimension)
+    if bad:
+        raise ValueError(f"resume {directory}: campaign.json has bad query_data ({bad})")
     return meta
+
+
+def _bad_query_data(rows: object, n: int) -> str | None:
+    """What is wrong with a campaign's ``query_data`` (a list of queries, each with an ``id`` and a finite
+    ``start`` and ``goal`` of the problem's dimension ``n``), or None."""
+    if not isinstance(rows, list) or not rows:
+        return "not a non-empty list"
+    for k, q in enumerate(rows):
+        if not isinstance(q, dict):
+            return f"entry {k} is not an object"
+        if not isinstance(q.get("id"), (int, str)) or isinstance(q.get("id"), bool):
+            return f"entry {k} has no id"
+        for end in ("start", "goal"):
+            v = q.get(end)
+            if (not isinstance(v, list) or len(v) != n
+                    or not all(isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) for x in v)):
+                return f"entry {k}: {end} is not {n} finite numbers"
+    return None
 
 
 def resume_campaign(

@@ -48,8 +48,11 @@ KNOWN_PLANNERS: tuple[str, ...] = (*ANYTIME_PLANNERS, "DimensionRRTReleased", "D
 ``DimensionRRTReleased`` (named on demand, not in a default comparison) is dimension-RRT with
 ``release_after=RELEASE_AFTER``: prescribed rows planned too once the path converged on them;
 ``DimensionRRTNoShortcuts`` (also on demand) improves by the paper's rule alone (``shortcuts=False``)."""
-NOT_ITERATION_CAPPED: tuple[str, ...] = ("RRTConnectSimplify",)
-"""Planners that cannot be stopped at a sample count, so they never join the iteration-matched comparison."""
+NOT_ITERATION_CAPPED: tuple[str, ...] = ("RRTConnect", "RRTConnectSimplify", "AORRTC", "RRT", "PRMstar")
+"""Planners that cannot be stopped at a sample count (their ompl 2.0.1 bindings have no ``numIterations()``), so they
+never join the iteration-matched comparison; refused there before a campaign starts."""
+MAX_NAME_BYTES = 200
+"""Longest campaign name: ``<UTC time>_<name>`` must fit a file name (255 bytes on most file systems)."""
 CHECKERS = ("batched", "discrete", "certified", "dense")
 """Motion validators: batched Pinocchio calls screened by clearance balls, OMPL's DiscreteMotionValidator,
 clearance certificates (a few Coal distances per motion), or the batched one checking every state
@@ -142,6 +145,9 @@ class CampaignConfig:
         from .problems import get_problem
 
         check_name("name", self.name)
+        if len(self.name.encode()) > MAX_NAME_BYTES:  # it is part of the results folder's name
+            raise ValueError(f"name must be at most {MAX_NAME_BYTES} bytes (it names the results folder), got "
+                             f"{len(self.name.encode())}")
         problem = get_problem(self.problem)
         if self.queries is not None:
             check_name("queries", self.queries)
@@ -165,12 +171,14 @@ class CampaignConfig:
                     raise ValueError(f"{field_name}: {exc}") from None
         for n in self.iteration_planners:
             if n in NOT_ITERATION_CAPPED:
-                raise ValueError(f"iteration_planners: {n} cannot be stopped at a sample count (RRTConnect counts no "
+                raise ValueError(f"iteration_planners: {n} cannot be stopped at a sample count (it counts no "
                                  "iterations); compare it in the anytime comparison")
         if caps and not self.iteration_planners:
             raise ValueError("iteration_planners: give at least one planner for the sample caps")
         if budgets and not self.anytime_planners:
             raise ValueError("anytime_planners: give at least one planner for the anytime budgets")
+        if len(set(self.checkers)) != len(self.checkers):
+            raise ValueError(f"checkers names a motion validator twice: {list(self.checkers)}")
         for c in self.checkers:
             if c not in CHECKERS:
                 raise ValueError(f"unknown motion validator {c!r}: choose from {CHECKERS}")

@@ -16,6 +16,7 @@ import argparse
 import contextlib
 import inspect
 import math
+import re
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, NoReturn
@@ -42,6 +43,7 @@ __all__ = [
     "finite",
     "index",
     "load_robot",
+    "nonempty",
     "numpy_seed",
     "on_postures",
     "positive_float",
@@ -82,6 +84,11 @@ class Parser(argparse.ArgumentParser):
     should see only what was wrong.  Subparsers made from it are of this class too.
     """
 
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        # negative numbers in exponent notation (``--target 0 0 -1e6``) are values, not options
+        self._negative_number_matcher = re.compile(r"^-(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?$")
+
     def error(self, message: str) -> NoReturn:  # noqa: D102 (argparse override)
         self.exit(2, f"{self.prog}: error: {message} (see --help)\n")
 
@@ -96,6 +103,14 @@ def finite(text: str) -> float:
     if not math.isfinite(v):
         raise argparse.ArgumentTypeError(f"not a finite number: {text}")
     return v
+
+
+def nonempty(text: str) -> str:
+    """argparse type: a file name or other text that is not empty (``--resume ""`` from an unset shell variable
+    must not mean "not given")."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("must not be empty")
+    return text
 
 
 def _int(text: str) -> int:
@@ -241,8 +256,8 @@ def on_postures(start: Any, goal: Any, from_sector: int, to_sector: int) -> tupl
 
 def add_model_args(p: argparse.ArgumentParser) -> None:
     """``--urdf`` / ``--srdf``: another wearer + arm model than the packaged one."""
-    p.add_argument("--urdf", default=None, help="URDF file (default: the packaged wearer + arm)")
-    p.add_argument("--srdf", default=None, help="SRDF file with disabled collision pairs (with --urdf)")
+    p.add_argument("--urdf", type=nonempty, default=None, help="URDF file (default: the packaged wearer + arm)")
+    p.add_argument("--srdf", type=nonempty, default=None, help="SRDF file with disabled collision pairs (with --urdf)")
 
 
 def check_model_args(args: argparse.Namespace) -> None:

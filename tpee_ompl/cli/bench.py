@@ -13,12 +13,13 @@ import dataclasses
 import logging
 import re
 import sys
+import traceback
 from collections.abc import Sequence
 from pathlib import Path
 
 from ..bench.config import CHECKERS, CampaignConfig, check_planner_name
 from ..bench.problems import DEFAULT_PROBLEM, get_problem
-from ._common import Parser, positive_int, seconds, seed
+from ._common import Parser, nonempty, positive_int, seconds, seed
 
 __all__ = ["DESCRIPTION", "EXAMPLE", "add_arguments", "build_parser", "config_from_args", "list_problems", "main",
            "register", "run"]
@@ -86,10 +87,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--problem", type=_problem, default=_default("problem"),
                    help="benchmark problem (default: %(default)s; --list-problems lists them)")
     p.add_argument("--list-problems", action="store_true", help="list the problems (name, dimension, queries) and exit")
-    p.add_argument("--queries", default=_default("queries"),
+    p.add_argument("--queries", type=nonempty, default=_default("queries"),
                    help="query-set name or JSON file, for problems that read query sets (default: the problem's "
                         "own, for the wearer planning_necessary)")
-    p.add_argument("--name", default=None, help="results folder suffix (default: the query-set name)")
+    p.add_argument("--name", type=nonempty, default=None, help="results folder suffix (default: the query-set name)")
     p.add_argument("--samples", type=positive_int, nargs="*", default=_default("sample_caps"),
                    help="sample/iteration caps of the Table-4 comparison (default: %(default)s); none to skip")
     p.add_argument("--anytime", type=seconds, nargs="*", default=_default("anytime_budgets"),
@@ -115,17 +116,17 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--seed", type=seed, default=_default("seed"),
                    help="campaign seed in [1, 2**32-1]; query k's process uses seed + k (default: %(default)s)")
     p.add_argument("--max-time", type=seconds, default=_default("max_time"), help="safety limit per iteration-capped run, s")
-    p.add_argument("--out", default=_default("out"), help="parent folder of the timestamped results folder")
+    p.add_argument("--out", type=nonempty, default=_default("out"), help="parent folder of the timestamped results folder")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     g = p.add_argument_group("executor (default: local process pool of --workers)")
-    g.add_argument("--dask", metavar="local|tcp://HOST:PORT", default=None,
+    g.add_argument("--dask", metavar="local|tcp://HOST:PORT", type=nonempty, default=None,
                    help="run the queries as Dask tasks: 'local' starts a LocalCluster here, an address uses that "
                         "scheduler (needs the dask extra: pip install 'tpee_ompl[dask]')")
-    g.add_argument("--scheduler", metavar="tcp://HOST:PORT", default=None, help="same as --dask tcp://HOST:PORT")
+    g.add_argument("--scheduler", metavar="tcp://HOST:PORT", type=nonempty, default=None, help="same as --dask tcp://HOST:PORT")
     g.add_argument("--dask-workers", type=positive_int, default=2, help="workers of --dask local (default: %(default)s)")
     g.add_argument("--retries", type=_count, default=2, help="Dask retries of a task that raises (default: %(default)s)")
     p.set_defaults(bench_prog=p.prog)
-    p.add_argument("--resume", metavar="DIR", default=None,
+    p.add_argument("--resume", metavar="DIR", type=nonempty, default=None,
                    help="finish an interrupted campaign in DIR: run only its missing experiments (configuration "
                         "from DIR/campaign.json; the other campaign options are ignored)")
 
@@ -200,6 +201,7 @@ def run(args: argparse.Namespace) -> int:
     """
     from ..bench.campaign import load_campaign, prepare_campaign, resume_campaign, run_campaign
     from ..bench.executors import make_executor
+    from ..model.queries import QuerySetError
 
     if getattr(args, "list_problems", False):
         return list_problems()
@@ -216,7 +218,7 @@ def run(args: argparse.Namespace) -> int:
                                  retries=args.retries)
     except (ValueError, FileNotFoundError, ImportError) as exc:
         print(f"{prog}: error: {_user_message(exc)}", file=sys.stderr)
-        return 2
+        return 1 if isinstance(exc, QuerySetError) else 2  # a damaged query file is a runtime error, as in ``plan``
     try:
         if args.resume:
             result = resume_campaign(args.resume, executor=executor, workers=args.workers,
@@ -227,7 +229,9 @@ def run(args: argparse.Namespace) -> int:
         where = getattr(exc, "directory", None) or args.resume or "DIR"
         print(f"{prog}: interrupted; finished logs are kept: finish the campaign with --resume {where}", file=sys.stderr)
         return 130
-    except Exception as exc:  # noqa: BLE001 (a runtime failure: one line, no traceback)
+    except Exception as exc:  # noqa: BLE001 (a runtime failure: one line, no traceback unless -v)
+        if getattr(args, "verbose", False):
+            traceback.print_exc()
         print(f"{prog}: error: {type(exc).__name__}: {_user_message(exc)}", file=sys.stderr)
         return 1
     _print_result(result)

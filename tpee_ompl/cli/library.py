@@ -31,8 +31,10 @@ from ._common import (
     check_output,
     finite,
     index,
+    nonempty,
     numpy_seed,
     on_postures,
+    positive_int,
     sector,
 )
 
@@ -203,7 +205,7 @@ def register(subparsers: argparse._SubParsersAction, formatter_class: type = arg
     b.add_argument("--library", type=Path, required=True, metavar="FILE",
                    help=f"the library file (.npz) to write (the packaged one, read by default elsewhere: {DEFAULT_LIBRARY})")
     d = _BUILD_DEFAULTS
-    b.add_argument("--per-pair", type=int, default=d.per_pair,
+    b.add_argument("--per-pair", type=positive_int, default=d.per_pair,
                    help=f"demonstrations per ordered sector pair (default {d.per_pair})")
     b.add_argument("--seed", type=numpy_seed, default=d.seed,
                    help=f"seed of the sampler and the planner, 0..2^32-1 (default {d.seed})")
@@ -212,16 +214,16 @@ def register(subparsers: argparse._SubParsersAction, formatter_class: type = arg
     b.add_argument("--min-difference", type=finite, default=d.min_difference,
                    help="new demo kept only if its DOF3/DOF4 (start, goal) differs by this many rad "
                         f"(default {d.min_difference:g})")
-    b.add_argument("--max-attempts", type=int, default=d.max_attempts,
+    b.add_argument("--max-attempts", type=positive_int, default=d.max_attempts,
                    help="draws per pair before giving up on per-pair (default 3 x per-pair)")
-    b.add_argument("--max-samples", type=int, default=d.max_samples,
+    b.add_argument("--max-samples", type=positive_int, default=d.max_samples,
                    help=f"dimension-RRT samples per demo (default {d.max_samples})")
     b.add_argument("--timeout", type=finite, default=d.timeout,
                    help=f"dimension-RRT time limit per demo, s (default {d.timeout:g})")
     b.add_argument("--demo-margins", type=float, nargs="*", default=list(d.demo_margins), metavar="M",
                    help="margins (m) around the pointing system tried, widest first, before the robot's own "
                         f"when planning a demo (default {' '.join(map(str, d.demo_margins))}; none: robot's margin only)")
-    b.add_argument("--workers", type=int, default=d.workers,
+    b.add_argument("--workers", type=positive_int, default=d.workers,
                    help=f"processes building the pairs in parallel (default {d.workers})")
     b.add_argument("--dmp-scaling", choices=("none", "amplitude"), default=d.dmp_options.scaling,
                    help="DMP forcing: 'amplitude' = eq. 13's x(g - y0), 'none' = absolute "
@@ -231,7 +233,7 @@ def register(subparsers: argparse._SubParsersAction, formatter_class: type = arg
 
     q = sub.add_parser("query", help="answer one query", epilog=_QUERY_EXAMPLE, formatter_class=formatter_class)
     common(q)
-    q.add_argument("--query-set", metavar="NAME", help="take the query from a named set (e.g. planning_necessary)")
+    q.add_argument("--query-set", metavar="NAME", type=nonempty, help="take the query from a named set (e.g. planning_necessary)")
     q.add_argument("--index", type=index, default=0, help="index in --query-set, from 0 (default 0)")
     q.add_argument("--from", dest="from_sector", type=sector, help="start sector (1-4)")
     q.add_argument("--to", dest="to_sector", type=sector, help="goal sector (1-4)")

@@ -6,7 +6,7 @@ the bench group.  Every subcommand is one function.  Errors are one line on stde
 traceback (``-v`` adds it): exit code 2 for a usage error (argparse's, or a
 :class:`~tpee_ompl.cli._common.CliError` from the argument checks that run before any work), 1 for
 an error at run time (a damaged input file, a model mismatch, a failure, anything unexpected),
-130 when interrupted.
+130 when interrupted (Ctrl-C, or SIGTERM, which every command handles as Ctrl-C).
 """
 
 from __future__ import annotations
@@ -18,6 +18,7 @@ import sys
 import traceback
 from collections.abc import Sequence
 
+from ..signals import sigterm_as_keyboard_interrupt
 from ._common import CliError, Parser
 from .bench import register as register_bench
 from .library import register as register_library
@@ -45,7 +46,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
                         format="%(levelname)s %(name)s: %(message)s")
     try:
-        return int(args.func(args) or 0)
+        with sigterm_as_keyboard_interrupt():  # kill / a scheduler: the same cleanup as Ctrl-C (temporary files, workers)
+            return int(args.func(args) or 0)
     except Exception as exc:  # noqa: BLE001 (the last resort: one line, never a traceback without -v)
         if args.verbose:
             traceback.print_exc()

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -19,10 +20,14 @@ from ._common import (
     default_of,
     finite,
     load_robot,
+    nonempty,
     numpy_seed,
     positive_int,
 )
 from .plan import add_plan_args, check_plan_args, plan_motion
+
+if TYPE_CHECKING:
+    from ..model.wearer_arm import WearerArm
 
 __all__ = ["ANIMATION_SUFFIXES", "DEFAULT_SCENE_Q", "DEFAULT_SCENE_TARGET", "MAX_FRAMES", "cmd_animate", "cmd_show",
            "cmd_view", "cmd_workspace", "register"]
@@ -31,6 +36,8 @@ ANIMATION_SUFFIXES = (".gif", ".mp4")
 """What ``animate -o`` writes: a GIF (Pillow) or an MP4 (ffmpeg)."""
 MAX_FRAMES = 2000
 """Most frames ``animate --frames`` accepts (every frame is kept in memory until the file is written)."""
+_LIMIT_TOL = 1e-6
+"""Radians a ``--path`` waypoint may lie beyond a joint limit (the decimals ``plan --json`` prints)."""
 
 DEFAULT_SCENE_Q = (50.0, 20.0, 17.0, -37.0)
 """Degrees: the sector 4 preset aiming forward-left-up (``show`` and ``view`` without ``--q``)."""
@@ -58,9 +65,10 @@ def cmd_show(args: argparse.Namespace) -> int:
     return 0
 
 
-def _read_path(file: str, nq: int) -> np.ndarray:
-    """The 'path' list of waypoints in a JSON file (e.g. from ``plan --json``): at least one waypoint of
-    ``nq`` finite numbers (JSON numbers, not strings or booleans); ValueError naming the file otherwise."""
+def _read_path(file: str, robot: WearerArm) -> np.ndarray:
+    """The 'path' list of waypoints in a JSON file (e.g. from ``plan --json``): at least one waypoint of the
+    robot's ``nq`` finite numbers (JSON numbers, not strings or booleans) within its joint limits; ValueError
+    naming the file and the waypoint otherwise."""
     try:
         with open(file, encoding="utf-8") as fh:
             doc = json.load(fh)
@@ -69,11 +77,21 @@ def _read_path(file: str, nq: int) -> np.ndarray:
     W = doc.get("path") if isinstance(doc, dict) else None
     if not isinstance(W, list) or not W:
         raise ValueError(f"--path {file}: expected a JSON object with a non-empty 'path' list of waypoints")
+    nq = robot.nq
     for k, w in enumerate(W):
-        if (not isinstance(w, list) or len(w) != nq
-                or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in w)
-                or not np.all(np.isfinite(np.asarray(w, dtype=float)))):
+        try:
+            ok = (isinstance(w, list) and len(w) == nq
+                  and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in w)
+                  and bool(np.all(np.isfinite(np.asarray(w, dtype=float)))))
+        except OverflowError:  # an integer too large for a float
+            ok = False
+        if not ok:
             raise ValueError(f"--path {file}: waypoint {k} must be {nq} finite numbers, got {w!r}"[:300])
+        out = np.flatnonzero((np.asarray(w) < robot.lower - _LIMIT_TOL) | (np.asarray(w) > robot.upper + _LIMIT_TOL))
+        if len(out):
+            d = int(out[0])
+            raise ValueError(f"--path {file}: waypoint {k} is outside the joint limits (DOF{d + 1} = {w[d]:g} rad, "
+                             f"limits [{robot.lower[d]:g}, {robot.upper[d]:g}])")
     return np.asarray(W, dtype=float)
 
 
@@ -92,12 +110,12 @@ def cmd_animate(args: argparse.Namespace) -> int:
         check_input_file(args.path, "--path", "path file")
         check_model_args(args)
         robot = load_robot(args)
-        W = _read_path(args.path, robot.nq)
+        W = _read_path(args.path, robot)
     else:
         check_plan_args(args)
         result, robot = plan_motion(args)
         if not result["exact"]:
-            raise CliError(f"{args.planner} found no exact path ({result['status']}); nothing to animate")
+            raise RuntimeError(f"{args.planner} found no exact path ({result['status']}); nothing to animate")
         W = np.asarray(result["path"])
     (pa, ua), (pb, ub) = robot.muzzle(W[0]), robot.muzzle(W[-1])
     out = animate_path(robot, W, args.output, target_a=pa + 3 * ua, target_b=pb + 3 * ub, frames=args.frames)
@@ -144,7 +162,7 @@ def register(sub: argparse._SubParsersAction, fmt: type) -> None:
     p.add_argument("--q", type=finite, nargs=4, metavar="Q", help="DOF1..DOF4 in radians (default: a sector-4 scene)")
     p.add_argument("--target", type=finite, nargs=3, metavar=("X", "Y", "Z"), help="target point (m, world frame)")
     p.add_argument("--sectors", action="store_true", help="overlay the posture sectors")
-    p.add_argument("-o", "--output", default="scene.png", help="image file (.png, .pdf, .svg, ...; default scene.png)")
+    p.add_argument("-o", "--output", type=nonempty, default="scene.png", help="image file (.png, .pdf, .svg, ...; default scene.png)")
     add_force_arg(p)
     add_model_args(p)
     p.set_defaults(func=cmd_show)
@@ -155,10 +173,10 @@ def register(sub: argparse._SubParsersAction, fmt: type) -> None:
                                    "  tpee-ompl plan --from 2 --to 3 --json > p.json && "
                                    "tpee-ompl animate --path p.json -o m.gif")
     add_plan_args(p)
-    p.add_argument("--path", help="JSON file with a 'path' list of waypoints (e.g. from plan --json)")
+    p.add_argument("--path", type=nonempty, help="JSON file with a 'path' list of waypoints (e.g. from plan --json)")
     p.add_argument("--frames", type=positive_int, default=default_of(animate_path, "frames"),
                    help=f"frames, 2..{MAX_FRAMES} (default %(default)s)")
-    p.add_argument("-o", "--output", default="motion.gif", help="a .gif or .mp4 file (default motion.gif)")
+    p.add_argument("-o", "--output", type=nonempty, default="motion.gif", help="a .gif or .mp4 file (default motion.gif)")
     add_force_arg(p)
     p.set_defaults(func=cmd_animate)
 
@@ -167,7 +185,7 @@ def register(sub: argparse._SubParsersAction, fmt: type) -> None:
                                    "example:\n  tpee-ompl workspace --samples 4000 -o workspace.png")
     p.add_argument("--samples", type=positive_int, default=4000)
     p.add_argument("--seed", type=numpy_seed, default=0, help="sampling seed, 0..2^32-1 (default 0)")
-    p.add_argument("-o", "--output", default="workspace.png", help="image file (default workspace.png)")
+    p.add_argument("-o", "--output", type=nonempty, default="workspace.png", help="image file (default workspace.png)")
     add_force_arg(p)
     add_model_args(p)
     p.set_defaults(func=cmd_workspace)

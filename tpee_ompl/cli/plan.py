@@ -26,6 +26,7 @@ from ._common import (
     finite,
     index,
     load_robot,
+    nonempty,
     on_postures,
     positive_float,
     positive_int,
@@ -57,8 +58,12 @@ def _make_planner(name: str, si: Any, from_sector: int, to_sector: int, samples:
     termination-condition factory for a sample cap, if any."""
     from ompl import base as ob
 
+    from ..bench.config import NOT_ITERATION_CAPPED
     from ..bench.planners import PlannerContext, planner_factory
 
+    if samples is not None and PLANNERS[name] in NOT_ITERATION_CAPPED:  # said before the planner is built (an
+        # AORRTC freed unsolved crashed the process)
+        raise CliError(f"--samples needs a planner that counts iterations; {name} does not (use --time)")
     capped_by_samples = name in ("dimension-rrt", "library")  # our planners take the cap themselves
     ctx = PlannerContext(query={"from_sector": from_sector, "to_sector": to_sector},
                          max_samples=samples if capped_by_samples else None, seed=seed, stall_samples=stall or None)
@@ -186,7 +191,7 @@ def add_plan_args(p: argparse.ArgumentParser, required: bool = False) -> None:
                    help="library / dimension-rrt: stop after this many samples without a shorter path, before --time "
                         f"(0: use the whole --time; default {DEFAULT_STALL})")
     p.add_argument("--seed", type=seed, default=1, help="OMPL / planner seed, 1..2^32-1 (default 1)")
-    p.add_argument("--queries", default="planning_necessary",
+    p.add_argument("--queries", type=nonempty, default="planning_necessary",
                    help="query set name or JSON file (made for the loaded model: its model_hash must match)")
     p.add_argument("--query-index", type=index, default=0, help="which query of that pair, from 0 (default 0)")
     p.add_argument("--start", type=finite, nargs=4, default=None, metavar="Q", help="start DOF1..DOF4 (rad)")
@@ -203,8 +208,8 @@ def cmd_aim(args: argparse.Namespace) -> int:
     robot = load_robot(args)
     with argument("--target"):
         target = check_target(np.array(args.target), robot)
-    sector_ = args.sector if args.sector is not None else select_sector(target)
-    q = aim(target, sector_, pan_reference=args.pan_reference)
+        sector_ = args.sector if args.sector is not None else select_sector(target)
+        q = aim(target, sector_, pan_reference=args.pan_reference)  # a target the sector's arm cannot aim at
     perp, _, ang = aim_errors(robot, q, target)
     result = {"target": target.tolist(), "sector": sector_, "q_rad": q.round(9).tolist(),
               "q_deg": np.degrees(q).round(4).tolist(), "collision_free": robot.is_valid(q),
@@ -319,7 +324,7 @@ def register(sub: argparse._SubParsersAction, fmt: type) -> None:
     p.add_argument("--planner", choices=("default", "dimension-rrt", "library"), default="default",
                    help="cross-sector planner: default (LibraryDimensionRRT for 0.05 s, then Table 3's straight "
                         "motion, else RRTConnect), dimension-rrt, library (PathLibrary.query alone)")
-    p.add_argument("--library", default=str(default_library_path()),
+    p.add_argument("--library", type=nonempty, default=str(default_library_path()),
                    help="path library file (default and library planners; default: the packaged one)")
     p.add_argument("--samples", type=positive_int, default=default_of(dimension_rrt_planner, "max_samples"),
                    help="dimension-RRT sample cap")
@@ -327,7 +332,7 @@ def register(sub: argparse._SubParsersAction, fmt: type) -> None:
     p.add_argument("--rate", type=positive_float, default=10.0, help="target samples per second")
     p.add_argument("--seed", type=seed, default=1, help="OMPL / planner seed, 1..2^32-1 (default 1)")
     p.add_argument("--json", action="store_true")
-    p.add_argument("-o", "--output", help="write the trajectory as CSV (a new file; --force to replace one)")
+    p.add_argument("-o", "--output", type=nonempty, help="write the trajectory as CSV (a new file; --force to replace one)")
     add_force_arg(p)
     add_model_args(p)
     p.set_defaults(func=cmd_track)

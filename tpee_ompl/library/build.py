@@ -140,6 +140,9 @@ def _check_pairs(pairs: Sequence[tuple[int, int]]) -> tuple[tuple[int, int], ...
     for i, j in out:
         if i == j:
             raise ValueError(f"pair ({i}, {j}) is not a cross-sector motion")
+    twice = sorted({p for p in out if out.count(p) > 1})
+    if twice:
+        raise ValueError(f"pairs names {', '.join(f'{i}-{j}' for i, j in twice)} more than once")
     return out
 
 

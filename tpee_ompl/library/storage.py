@@ -126,6 +126,12 @@ def _check_meta(meta: Any, path: Path) -> dict[str, Any]:
             "build_params": meta.get("build_params"), "pairs": [tuple(p) for p in pairs]}
 
 
+_ANGLES = ("starts", "goals", "waypoints")
+_MAX_ABS = {**dict.fromkeys(_ANGLES, 100.0), "fwd_weights": 1e9, "rev_weights": 1e9}
+"""Largest magnitude a library array may hold: far beyond any joint angle (rad) or DMP weight a build gives
+(the packaged library: 3.3 rad, weights 2.1e4), short of what overflows the DMP's arithmetic."""
+
+
 def _pair_arrays(arrays: dict[str, np.ndarray], i: int, j: int, n_basis: int, path: Path) -> dict[str, np.ndarray]:
     """Pair (i, j)'s arrays, shapes, dtypes and values checked; LibraryFileError naming the array."""
     p = f"p{i}{j}_"
@@ -148,6 +154,9 @@ def _pair_arrays(arrays: dict[str, np.ndarray], i: int, j: int, n_basis: int, pa
             raise LibraryFileError(f"path library {path}: array {p + name!r} must be floats, got {x.dtype}")
         if name != "margins" and not np.all(np.isfinite(x)):
             raise LibraryFileError(f"path library {path}: array {p + name!r} holds NaN or inf")
+        if name in _MAX_ABS and x.size and float(np.abs(x).max()) > _MAX_ABS[name]:
+            raise LibraryFileError(f"path library {path}: array {p + name!r} holds {float(np.abs(x).max()):g}, beyond "
+                                   f"+/-{_MAX_ABS[name]:g} ({'joint angles, rad' if name in _ANGLES else 'DMP weights'})")
     return a
 
 
