@@ -139,6 +139,18 @@ def test_bad_input_gives_one_line_errors(tmp_path):
         RobotChecker(urdf, locked={"j1": 99.0})
 
 
+@pytest.mark.parametrize("attribute", ['<sphere radius="nan"/>', '<sphere radius="1e999"/>', '<box size="0.1 x 0.1"/>'])
+def test_a_urdf_number_that_is_not_finite_is_named_before_urdfdom_prints_its_own_errors(tmp_path, capfd, attribute):
+    urdf = tmp_path / "bad.urdf"
+    urdf.write_text(f"""<robot name="s"><link name="base"/><link name="arm">
+      <collision><geometry>{attribute}</geometry></collision></link>
+      <joint name="rot" type="revolute"><parent link="base"/><child link="arm"/><axis xyz="0 0 1"/>
+        <limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>""")
+    with pytest.raises(ValueError, match=r"link 'arm': <(sphere|box) .*is not a list of finite numbers"):
+        RobotChecker(urdf)
+    assert capfd.readouterr().err == ""  # urdfdom's C++ errors (28 lines for one NaN) never come
+
+
 def test_an_obstacle_beside_the_wearer_blocks_the_arm_there():
     plain = WearerArm()
     rng = np.random.default_rng(6)

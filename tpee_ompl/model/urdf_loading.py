@@ -129,11 +129,33 @@ def _read_robot_xml(path: Path, kind: str) -> ET.Element:
     return root
 
 
+_NUMBERS = {"sphere": ("radius",), "cylinder": ("radius", "length"), "box": ("size",), "origin": ("xyz", "rpy"),
+            "axis": ("xyz",), "limit": ("lower", "upper", "effort", "velocity"), "mass": ("value",),
+            "inertia": ("ixx", "ixy", "ixz", "iyy", "iyz", "izz"), "mesh": ("scale",)}
+"""Numeric attributes of URDF elements, checked before urdfdom reads them (it prints a C++ error per bad one)."""
+
+
 def _parse_urdf(urdf: Path) -> ET.Element:
     root = _read_robot_xml(urdf, "URDF")
     if any(c.tag == "capsule" for c in root.iter()):
         raise ValueError(f"URDF {urdf} uses <capsule>, which urdfdom drops silently; use <cylinder> (loaded as capsules)")
+    for owner in (*root.iter("link"), *root.iter("joint")):
+        for el in owner.iter():
+            for attr in _NUMBERS.get(el.tag, ()):
+                text = el.get(attr)
+                if text is not None and not _finite_numbers(text):
+                    raise ValueError(f"URDF {urdf}: {owner.tag} {owner.get('name')!r}: <{el.tag} {attr}=\"{text}\"> "
+                                     "is not a list of finite numbers")
     return root
+
+
+def _finite_numbers(text: str) -> bool:
+    """Whether ``text`` is one or more whitespace-separated finite numbers."""
+    try:
+        values = [float(v) for v in text.split()]
+    except ValueError:
+        return False
+    return bool(values) and all(math.isfinite(v) for v in values)
 
 
 def load_urdf_model(
