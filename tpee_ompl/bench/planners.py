@@ -134,7 +134,8 @@ imported instead (so worker processes can build planners defined elsewhere, e.g.
 SINGLE_USE_PLANNERS: tuple[str, ...] = ("AORRTC",)
 """Native planners that crash when solved again after ``clear()``: ompl 2.0.1's AORRTC segfaults in the second
 run of a benchmark experiment (``--runs 2``; setup, solve, clear, solve).  :class:`RecordingPlanner` is given
-a fresh one for each run after the first (``renew``)."""
+a fresh one for each run after the first (``renew``).  An AORRTC freed without ever being set up segfaults too
+(``og.AORRTC(si)`` then ``del``; ``clear()`` does not help): check everything before one is built."""
 
 
 def planner_factory(name: str) -> PlannerFactory:
