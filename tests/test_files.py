@@ -56,21 +56,27 @@ def test_output_path_that_is_a_folder_or_under_a_file_is_refused_naming_it(tmp_p
     assert not (tmp_path / "new").exists()  # checking creates nothing
 
 
-def test_a_symlink_or_a_pipe_is_refused_even_with_force_and_left_as_it_was(tmp_path):
-    """Replacing would destroy them (``--force`` once turned /dev-like nodes and links into plain files)."""
-    real = tmp_path / "real.csv"
-    real.write_text("keep")
-    link = tmp_path / "link.csv"
-    link.symlink_to(real)
+def test_a_pipe_is_refused_even_with_force_and_a_symlink_is_written_through(tmp_path):
+    """Replacing a pipe or device with a file would destroy it (``--force`` once did, and replaced links too)."""
     fifo = tmp_path / "fifo.csv"
     os.mkfifo(fifo)
-    for target, words in ((link, "symbolic link"), (fifo, "not a regular file")):
-        with pytest.raises(ValueError, match=words):
+    to_fifo = tmp_path / "to_fifo.csv"
+    to_fifo.symlink_to(fifo)
+    for target in (fifo, to_fifo):
+        with pytest.raises(ValueError, match="not a regular file"):
             check_output_path(target, force=True)
-        with pytest.raises(ValueError, match=words):
+        with pytest.raises(ValueError, match="not a regular file"):
             atomic_write_text(target, "new", force=True)
-    assert link.is_symlink() and real.read_text() == "keep" and stat.S_ISFIFO(fifo.lstat().st_mode)
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["fifo.csv", "link.csv", "real.csv"]  # no temporary left
+    assert stat.S_ISFIFO(fifo.lstat().st_mode) and to_fifo.is_symlink()
+    real = tmp_path / "sub" / "real.csv"
+    real.parent.mkdir()
+    real.write_text("old")
+    link = tmp_path / "link.csv"
+    link.symlink_to(real)
+    assert check_output_path(link, force=True) == link
+    atomic_write_text(link, "new", force=True)
+    assert link.is_symlink() and real.read_text() == "new"  # the file it points to, replaced; the link kept
+    assert sorted(p.name for p in tmp_path.rglob("*")) == ["fifo.csv", "link.csv", "real.csv", "sub", "to_fifo.csv"]
 
 
 def test_a_folder_that_can_be_written_but_not_entered_is_refused(tmp_path):

@@ -34,14 +34,14 @@ def check_output_path(path: str | os.PathLike, *, force: bool = False, what: str
     OutputExistsError
         The file exists and ``force`` is False.
     ValueError
-        ``path`` is a folder, a symbolic link or not a regular file (a device), a parent is a file, or
-        its folder cannot be written to.
+        ``path`` is a folder or not a regular file (a device, a pipe), a parent is a file, or its folder
+        cannot be written to.
     """
     p = Path(path)
     if p.is_dir():
         raise ValueError(f"{what} {p} is a folder; give a file name")
     _check_replaceable(p, what)
-    for parent in p.parents:
+    for parent in (Path(os.path.realpath(p)) if p.is_symlink() else p).parents:  # a link: where the file is written
         if parent.exists():
             if not parent.is_dir():
                 raise ValueError(f"{what} {p}: {parent} is a file, not a folder")
@@ -54,10 +54,9 @@ def check_output_path(path: str | os.PathLike, *, force: bool = False, what: str
 
 
 def _check_replaceable(p: Path, what: str) -> None:
-    """Refuse a target that replacing would destroy rather than write: a symbolic link (the link itself would
-    be replaced, not the file it points to) or anything but a regular file (a device, a pipe, a socket)."""
-    if p.is_symlink():
-        raise ValueError(f"{what} {p} is a symbolic link; give the path of the file itself ({p.resolve()})")
+    """Refuse a target that replacing would destroy rather than write: anything but a regular file (a device,
+    a pipe, a socket; also when a symbolic link points to one).  A link to a file is written through
+    (:func:`atomic_path` replaces the file it points to and keeps the link)."""
     if p.exists() and not p.is_file():
         raise ValueError(f"{what} {p} is not a regular file (a device, pipe or socket); give a file name")
 
@@ -76,12 +75,16 @@ def atomic_path(path: str | os.PathLike, *, force: bool = True, suffix_last: boo
     The file gets the mode a plain ``open`` would give (0666 less the umask), not ``mkstemp``'s 0600.
     ``suffix_last`` ends the temporary name with ``path``'s suffix (``.m.gif.XXXX.part.gif``) for
     writers that choose the format by the file name and cannot be told otherwise (Pillow, ffmpeg).
-    With ``force=False`` an existing ``path`` raises :class:`OutputExistsError` before anything is written.
+    With ``force=False`` an existing ``path`` raises :class:`OutputExistsError` before anything is written.  A
+    ``path`` that is a symbolic link is written through: the file it points to is replaced, the link stays;
+    a device, pipe or socket is refused (ValueError), never replaced by a file.
     """
     target = Path(path)
     if target.exists() and not force:
         raise OutputExistsError(f"{target} exists; pass --force to replace it")
     _check_replaceable(target, "output file")
+    if target.is_symlink():  # the file it points to is replaced, the link stays
+        target = Path(os.path.realpath(target))
     target.parent.mkdir(parents=True, exist_ok=True)
     suffix = ".part" + target.suffix if suffix_last else target.suffix + ".part"
     tmp: Path | None = None

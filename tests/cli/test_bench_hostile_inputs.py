@@ -118,7 +118,7 @@ CASES = [
     ("checker-twice", ["--checkers", "dense", "dense"], 2, ["--checkers", "twice"]),
     ("resume-empty", ["--resume", ""], 2, ["--resume", "empty"]),
     ("queries-empty", ["--queries", ""], 2, ["--queries", "empty"]),
-    ("name-too-long", ["--name", "x" * 300], 2, ["--name", "200 bytes"]),
+    ("name-too-long", ["--name", "x" * 300], 2, ["--name", "234 bytes"]),
     ("resume-bad-query-data", ["--resume", "{in}/bad_query_data"], 2, ["--resume", "query_data", "entry 0"]),
     ("resume-config-a-list", ["--resume", "{in}/config_list"], 2, ["--resume", "config"]),
 ]

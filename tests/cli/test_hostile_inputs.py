@@ -139,7 +139,7 @@ USAGE = [
     ("track-output-empty", ["track", "--duration", "1", "-o", ""], "--output"),
     ("animate-path-empty-name", ["animate", "--path", "", "-o", "m.gif"], "--path"),
     ("aim-urdf-empty", ["aim", "--target", "5", "2", "1.5", "--urdf", ""], "--urdf"),
-    ("track-output-a-symlink", ["track", "--duration", "1", "-o", "link.csv", "--force"], "symbolic link"),
+    ("track-output-a-link-to-a-fifo", ["track", "--duration", "1", "-o", "link.csv", "--force"], "not a regular file"),
     ("track-output-a-fifo", ["track", "--duration", "1", "-o", "fifo.csv", "--force"], "not a regular file"),
     ("aim-target-too-close-for-the-arm", ["aim", "--target", "-0.3", "0", "1.8"], "--target"),
     ("library-build-pair-twice", ["library", "build", "--pairs", "1-2", "1-2", "--library", "new.npz"], "--pairs"),
@@ -205,8 +205,8 @@ def workdir(tmp_path: Path) -> Path:
     write_library_file(tmp_path / "existing.npz")
     (tmp_path / "adir").mkdir()
     (tmp_path / "adir" / "keep.txt").write_text("keep")
-    (tmp_path / "link.csv").symlink_to(tmp_path / "existing.csv")  # --force must not replace the link itself
-    os.mkfifo(tmp_path / "fifo.csv")  # nor a pipe (or a device) with a file
+    os.mkfifo(tmp_path / "fifo.csv")  # --force must not replace a pipe (or a device) with a file,
+    (tmp_path / "link.csv").symlink_to(tmp_path / "fifo.csv")  # nor one a link points to
     return tmp_path
 
 

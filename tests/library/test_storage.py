@@ -106,3 +106,18 @@ def test_an_interrupted_save_leaves_the_old_file_and_no_temporary(library: PathL
     with pytest.raises(KeyboardInterrupt):
         library.save(f)
     assert f.read_bytes() == before and [p.name for p in tmp_path.iterdir()] == ["lib.npz"]
+
+
+def test_a_library_its_loader_would_refuse_is_not_saved(robot: WearerArm, library: PathLibrary, tmp_path) -> None:
+    """Weights beyond the loader's limit (a DMP with a huge alpha_x gives them) are refused when saving too."""
+    (i, j), pd = next(iter(library.pairs.items()))
+    dmp = pd.forward[0]
+    kept = dmp.weights.copy()
+    try:
+        dmp.weights[...] = 0.0
+        dmp.weights.flat[0] = 1e12
+        with pytest.raises(ValueError, match=r"fwd_weights.*beyond .*not saved"):
+            library.save(tmp_path / "lib.npz")
+    finally:
+        dmp.weights[...] = kept
+    assert not (tmp_path / "lib.npz").exists() and not list(tmp_path.iterdir())

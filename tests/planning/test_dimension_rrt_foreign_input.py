@@ -103,7 +103,9 @@ def test_sample_checkpoints_must_be_a_sequence_of_counts() -> None:
         planner.set_sample_checkpoints(5)
     with pytest.raises(ValueError, match="sample checkpoint"):
         planner.set_sample_checkpoints([0])
-    planner.set_sample_checkpoints([500, 100])
+    for counts in ([500, 100], np.array([100, 500]), {500, 100}, (c for c in (100, 500))):
+        planner.set_sample_checkpoints(counts)
+        assert planner._sample_checkpoints == (100, 500)
 
 
 def test_the_goal_states_searches_are_built_only_while_the_termination_condition_allows() -> None:
@@ -152,3 +154,15 @@ def test_the_wearer_factory_refuses_groups_that_do_not_start_with_dof1_dof2_and_
         tpee_dimension_rrt(si, q.from_sector, q.to_sector, h=5)
     planner = tpee_dimension_rrt(si, q.from_sector, q.to_sector, groups=[[0, 1], [3], [2]])
     assert planner.groups == [[0, 1], [3], [2]] and list(planner.prescribed) == [0]
+
+
+def test_a_prescribed_so2_row_is_wrapped_into_the_circle_not_refused() -> None:
+    space = ob.CompoundStateSpace()
+    space.addSubspace(ob.SO2StateSpace(), 1.0)
+    space.addSubspace(ob.SO2StateSpace(), 1.0)
+    si = ob.SpaceInformation(space)
+    row = [3.0, 3.1, 3.2, 3.3, 3.4, 3.5, 3.6]  # past pi: the same angles as 3.2 - 2 pi, ...
+    planner = DimensionRRT(si, groups=[[0], [1]], prescribed={0: row})
+    got = planner.prescribed[0][:, 0]
+    assert np.all((got >= -np.pi) & (got < np.pi))
+    np.testing.assert_allclose(np.mod(got - np.array(row) + np.pi, 2 * np.pi) - np.pi, 0.0, atol=1e-12)

@@ -51,8 +51,9 @@ KNOWN_PLANNERS: tuple[str, ...] = (*ANYTIME_PLANNERS, "DimensionRRTReleased", "D
 NOT_ITERATION_CAPPED: tuple[str, ...] = ("RRTConnect", "RRTConnectSimplify", "AORRTC", "RRT", "PRMstar")
 """Planners that cannot be stopped at a sample count (their ompl 2.0.1 bindings have no ``numIterations()``), so they
 never join the iteration-matched comparison; refused there before a campaign starts."""
-MAX_NAME_BYTES = 200
-"""Longest campaign name: ``<UTC time>_<name>`` must fit a file name (255 bytes on most file systems)."""
+MAX_NAME_BYTES = 234
+"""Longest campaign name: ``<UTC time>_<name>`` (and a ``_999`` that tells two campaigns of one second apart) must
+fit a file name, 255 bytes on most file systems."""
 CHECKERS = ("batched", "discrete", "certified", "dense")
 """Motion validators: batched Pinocchio calls screened by clearance balls, OMPL's DiscreteMotionValidator,
 clearance certificates (a few Coal distances per motion), or the batched one checking every state
@@ -146,8 +147,8 @@ class CampaignConfig:
 
         check_name("name", self.name)
         if len(self.name.encode()) > MAX_NAME_BYTES:  # it is part of the results folder's name
-            raise ValueError(f"name must be at most {MAX_NAME_BYTES} bytes (it names the results folder), got "
-                             f"{len(self.name.encode())}")
+            raise ValueError(f"name must be at most {MAX_NAME_BYTES} bytes (it names the results folder; without "
+                             f"--name, the query set's file name does), got {len(self.name.encode())}")
         problem = get_problem(self.problem)
         if self.queries is not None:
             check_name("queries", self.queries)

@@ -208,6 +208,7 @@ def cmd_aim(args: argparse.Namespace) -> int:
     robot = load_robot(args)
     with argument("--target"):
         target = check_target(np.array(args.target), robot)
+    with argument("--target" if args.sector is None else f"--target with --sector {args.sector}"):
         sector_ = args.sector if args.sector is not None else select_sector(target)
         q = aim(target, sector_, pan_reference=args.pan_reference)  # a target the sector's arm cannot aim at
     perp, _, ang = aim_errors(robot, q, target)

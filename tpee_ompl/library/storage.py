@@ -78,6 +78,10 @@ def write_library(library: PathLibrary, path: str | Path, *, force: bool = True)
         for name, dmps in (("fwd", pd.forward), ("rev", pd.reverse)):
             arrays[p + name + "_weights"] = np.array([d.weights for d in dmps]).reshape(len(dmps), 2, n_basis)
             arrays[p + name + "_scaled"] = np.array([d.scaled for d in dmps], dtype=bool).reshape(len(dmps), 2)
+    for key, x in arrays.items():  # what read_library would refuse is not written
+        too_big = _beyond_limit(key.partition("_")[2], x)
+        if too_big:
+            raise ValueError(f"path library {path}: array {key!r} {too_big}: not saved (its loader would refuse it)")
     with atomic_path(path, force=force) as tmp, open(tmp, "wb") as fh:
         np.savez_compressed(fh, **arrays)
     return path
@@ -154,10 +158,21 @@ def _pair_arrays(arrays: dict[str, np.ndarray], i: int, j: int, n_basis: int, pa
             raise LibraryFileError(f"path library {path}: array {p + name!r} must be floats, got {x.dtype}")
         if name != "margins" and not np.all(np.isfinite(x)):
             raise LibraryFileError(f"path library {path}: array {p + name!r} holds NaN or inf")
-        if name in _MAX_ABS and x.size and float(np.abs(x).max()) > _MAX_ABS[name]:
-            raise LibraryFileError(f"path library {path}: array {p + name!r} holds {float(np.abs(x).max()):g}, beyond "
-                                   f"+/-{_MAX_ABS[name]:g} ({'joint angles, rad' if name in _ANGLES else 'DMP weights'})")
+        too_big = _beyond_limit(name, x)
+        if too_big:
+            raise LibraryFileError(f"path library {path}: array {p + name!r} {too_big}")
     return a
+
+
+def _beyond_limit(name: str, x: np.ndarray) -> str | None:
+    """What is wrong when the library array ``name`` (``waypoints``, ``fwd_weights``, ...) holds a value beyond
+    :data:`_MAX_ABS`, else None."""
+    if name not in _MAX_ABS or not x.size:
+        return None
+    m = float(np.nanmax(np.abs(x)))
+    if m <= _MAX_ABS[name]:
+        return None
+    return f"holds {m:g}, beyond +/-{_MAX_ABS[name]:g} ({'joint angles, rad' if name in _ANGLES else 'DMP weights'})"
 
 
 def read_library(path: str | Path, robot: WearerArm) -> tuple[dict[tuple[int, int], PairDemos], dict[str, Any]]:

@@ -106,7 +106,7 @@ import logging
 import math
 import time
 import weakref
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping
 from typing import Any
 
 import numpy as np
@@ -281,13 +281,13 @@ class DimensionRRT(PythonPlanner):
         if callback is not None:
             _WITH_CALLBACKS.add(self)
 
-    def set_sample_checkpoints(self, counts: Sequence[int]) -> None:
+    def set_sample_checkpoints(self, counts: Iterable[int]) -> None:
         """Make the termination condition be asked exactly when the run has drawn each of ``counts``
         samples (the loop otherwise asks it once per batch of samples the cost test rejects, see
         :meth:`Search.iterate <tpee_ompl.planning.dimension_search.Search.iterate>`); a condition that
         reads :meth:`samples_drawn` then sees the search as a run capped there would end.  The path
         found does not depend on it."""
-        if isinstance(counts, (str, bytes)) or not isinstance(counts, Sequence):
+        if isinstance(counts, (str, bytes, Mapping)) or not isinstance(counts, Iterable):
             raise ValueError(f"counts must be a sequence of sample counts, got {counts!r}")
         self._sample_checkpoints = tuple(sorted({check_int("sample checkpoint", c, minimum=1) for c in counts}))
 

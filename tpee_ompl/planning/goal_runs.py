@@ -26,7 +26,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from ompl import base as ob
 
-from .planner_base import planner_status
+from .planner_base import finite_state, planner_status
 
 if TYPE_CHECKING:  # pragma: no cover
     from .dimension_search import Search
@@ -99,7 +99,7 @@ def goal_states(planner: PythonPlanner, ptc: ob.PlannerTerminationCondition, max
                   "got %s", planner.getName(), type(goal).__name__)
         return planner_status(ob.PlannerStatus.UNRECOGNIZED_GOAL_TYPE)
     want = min(goal.maxSampleCount(), MAX_GOAL_STATES) if isinstance(goal, ob.GoalStates) else max_goals
-    pis = planner.getPlannerInputStates()
+    pis, si = planner.getPlannerInputStates(), planner.getSpaceInformation()
     if pis.getSampledGoalsCount() > 0:  # solve() again without clear(): the goal states were drawn already
         pis.restart()
     states: dict[bytes, np.ndarray] = {}  # distinct values, in the order drawn
@@ -107,15 +107,13 @@ def goal_states(planner: PythonPlanner, ptc: ob.PlannerTerminationCondition, max
     while len(states) < want and pis.haveMoreGoalStates() and tries < _GOAL_TRIES * want and not (tries and ptc()):
         tries += 1
         state = pis.nextGoal()
-        if state is not None:
+        if state is not None and finite_state(si, state):  # OMPL's bounds check lets NaN through
             q = read(state)
-            if np.isfinite(q).all():  # OMPL's bounds check lets NaN through
-                states.setdefault(q.tobytes(), q)
+            states.setdefault(q.tobytes(), q)
     if not states and isinstance(goal, ob.GoalLazySamples):
         state = pis.nextGoal(ptc)  # a sampler thread may need time for its first goal: waited for until ptc
-        q = None if state is None else read(state)
-        if q is not None and np.isfinite(q).all():
-            states[b""] = q
+        if state is not None and finite_state(si, state):
+            states[b""] = read(state)
     if not states:
         log.error("%s: no valid goal state could be drawn from the goal region", planner.getName())
         return planner_status(ob.PlannerStatus.INVALID_GOAL)

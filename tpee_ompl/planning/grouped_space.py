@@ -117,10 +117,11 @@ def validate_groups(groups: Sequence[Sequence[int]], n: int) -> list[list[int]]:
 
 def validate_prescribed(
     prescribed: Mapping[int, np.ndarray] | None, groups: Sequence[Sequence[int]], h: int,
-    lower: np.ndarray | None = None, upper: np.ndarray | None = None,
+    layout: RealVectorLayout | None = None,
 ) -> dict[int, np.ndarray]:
-    """Check prescribed group trajectories: keys are group indices, values arrays (h, k_i), finite, and
-    within the bounds ``lower`` / ``upper`` (n,) when given (a path along them must stay in the space)."""
+    """Check prescribed group trajectories: keys are group indices, values arrays (h, k_i), finite, and with
+    ``layout`` within the space's bounds (a path along them must stay in the space; SO2 values are wrapped
+    into [-pi, pi) first, as the space itself would)."""
     if prescribed is None:
         return {}
     if not isinstance(prescribed, Mapping):
@@ -141,8 +142,12 @@ def validate_prescribed(
         if not np.all(np.isfinite(arr)):
             bad = arr[~np.isfinite(arr)][0]
             raise ValueError(f"prescribed trajectory of group {int(key)} contains {bad} (NaN or inf)")
-        if lower is not None and upper is not None:
+        if layout is not None:
             dims = list(groups[int(key)])
+            full = np.zeros((h, layout.n))
+            full[:, dims] = arr
+            arr = layout.wrap(full)[:, dims]
+            lower, upper = layout.lower, layout.upper
             out_of = (arr < lower[dims] - _BOUND_TOL) | (arr > upper[dims] + _BOUND_TOL)
             if out_of.any():
                 t, j = (int(v) for v in np.argwhere(out_of)[0])
@@ -350,7 +355,7 @@ class GroupedSpace:
         n = self.layout.n
         self.h = check_int("h (fake-time steps incl. start and goal)", h, minimum=3, maximum=MAX_H)
         self.groups = validate_groups(default_groups(n) if groups is None else groups, n)
-        self.prescribed = validate_prescribed(prescribed, self.groups, self.h, self.layout.lower, self.layout.upper)
+        self.prescribed = validate_prescribed(prescribed, self.groups, self.h, self.layout)
         self.planned = [g for g in range(len(self.groups)) if g not in self.prescribed]
         """Indices of the groups to plan, in planning order."""
 
