@@ -119,3 +119,10 @@ def test_write_new_file_never_overwrites(tmp_path):
     assert write_new_file(target, "first")
     assert not write_new_file(target, "second")
     assert target.read_text() == "first" and [p.name for p in tmp_path.iterdir()] == ["a.log"]
+
+
+def test_writing_to_a_folder_says_it_is_a_folder(tmp_path):
+    with pytest.raises(ValueError, match="is a folder"):
+        atomic_write_text(tmp_path, "x", force=True)
+    with pytest.raises(ValueError, match="is a folder"):
+        atomic_write_text(tmp_path, "x", force=False)

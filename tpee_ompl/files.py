@@ -38,8 +38,6 @@ def check_output_path(path: str | os.PathLike, *, force: bool = False, what: str
         cannot be written to.
     """
     p = Path(path)
-    if p.is_dir():
-        raise ValueError(f"{what} {p} is a folder; give a file name")
     _check_replaceable(p, what)
     for parent in (Path(os.path.realpath(p)) if p.is_symlink() else p).parents:  # a link: where the file is written
         if parent.exists():
@@ -54,9 +52,11 @@ def check_output_path(path: str | os.PathLike, *, force: bool = False, what: str
 
 
 def _check_replaceable(p: Path, what: str) -> None:
-    """Refuse a target that replacing would destroy rather than write: anything but a regular file (a device,
-    a pipe, a socket; also when a symbolic link points to one).  A link to a file is written through
+    """Refuse a target that replacing would destroy rather than write: anything but a regular file (a folder, a
+    device, a pipe, a socket; also when a symbolic link points to one).  A link to a file is written through
     (:func:`atomic_path` replaces the file it points to and keeps the link)."""
+    if p.is_dir():
+        raise ValueError(f"{what} {p} is a folder; give a file name")
     if p.exists() and not p.is_file():
         raise ValueError(f"{what} {p} is not a regular file (a device, pipe or socket); give a file name")
 
@@ -80,9 +80,9 @@ def atomic_path(path: str | os.PathLike, *, force: bool = True, suffix_last: boo
     a device, pipe or socket is refused (ValueError), never replaced by a file.
     """
     target = Path(path)
+    _check_replaceable(target, "output file")
     if target.exists() and not force:
         raise OutputExistsError(f"{target} exists; pass --force to replace it")
-    _check_replaceable(target, "output file")
     if target.is_symlink():  # the file it points to is replaced, the link stays
         target = Path(os.path.realpath(target))
     target.parent.mkdir(parents=True, exist_ok=True)

@@ -123,6 +123,7 @@ QUERY_DEFECTS: dict[str, tuple[Callable[[dict], None], str]] = {
     "same-sectors": (lambda d: _first(d, "to_sector", d["queries"][0]["from_sector"]), "from_sector"),
     "duplicate-id": (lambda d: d["queries"][1].update(id=d["queries"][0]["id"]), "twice"),
     "query-not-an-object": (lambda d: d["queries"].__setitem__(0, [1, 2]), "object"),
+    "target-integer-too-big": (lambda d: _first(d, "target_a", [10**400, 0, 0]), "target_a"),  # no float holds it
 }
 
 

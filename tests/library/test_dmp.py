@@ -115,6 +115,30 @@ def test_bad_inputs_raise_with_a_message() -> None:
         generate(dmp, np.zeros(2), np.zeros(2))
 
 
+@pytest.mark.parametrize("options, match", [
+    ({"alpha_y": 2000.0}, "diverges"), ({"beta_y": 1e6}, "diverges"),  # explicit Euler blows up to NaN
+    ({"alpha_x": 1e3}, "closer than a float resolves"),
+])
+def test_options_whose_rollout_or_basis_breaks_down_are_refused_not_turned_into_nan(options, match) -> None:
+    t = np.linspace(0.0, 1.0, 601)
+    demo = np.stack([np.sin(3 * t), t**2], axis=1)
+    with np.errstate(over="raise", invalid="raise", divide="raise"):  # and no numpy warning on the way
+        with pytest.raises(ValueError, match=match):
+            learn_dmp(demo, DMPOptions(**options))
+
+
+@pytest.mark.parametrize("options, match", [({"alpha_y": "48"}, "alpha_y"), ({"alpha_y": None}, "alpha_y"),
+                                            ({"n_basis": 10**12}, "n_basis"), ({"beta_y": -1.0}, "beta_y")])
+def test_bad_option_values_are_value_errors_naming_the_option(options, match) -> None:
+    with pytest.raises(ValueError, match=match):
+        DMPOptions(**options)
+
+
+def test_a_grid_too_large_to_hold_is_refused_before_it_is_allocated() -> None:
+    with pytest.raises(ValueError, match="DMP grid of 2001 samples x 10000 basis functions"):
+        learn_dmp(np.linspace(0, 1, 2001)[:, None], DMPOptions(n_basis=10_000))
+
+
 def test_generation_is_closed_form_and_batched(rng: np.random.Generator, monkeypatch) -> None:
     """Generating a path never steps the dynamics (no call of integrate) and a batch equals one call per query."""
     import tpee_ompl.library.dmp as dmp_module

@@ -240,3 +240,38 @@ def test_generate_refuses_a_pair_without_demonstrations_a_bad_index_or_a_non_fin
     bad[2] = np.nan
     with pytest.raises(ValueError, match="NaN"):  # it returned a path of NaN
         library.generate(bad, goal, i, j, 0)
+
+
+@pytest.mark.parametrize("step", [1e-7, 0.0, float("inf"), float("nan"), "0.01"])
+def test_query_refuses_a_check_step_that_would_hang_or_skip_the_check(library, step) -> None:
+    (i, j), pd = next(iter(library.pairs.items()))
+    with pytest.raises(ValueError, match="step"):
+        library.query(pd.starts[0], pd.goals[0], i, j, step=step)
+
+
+def test_a_coarse_check_step_is_capped_at_the_robots_motion_step(robot, library, monkeypatch) -> None:
+    from tpee_ompl.library import path_library
+
+    seen = []
+    monkeypatch.setattr(path_library, "motion_is_valid", lambda r, p, step: seen.append(step) or True)
+    (i, j), pd = next(iter(library.pairs.items()))
+    library.query(pd.starts[0], pd.goals[0], i, j, step=1.0)
+    assert seen == [robot.max_joint_step()]
+
+
+@pytest.mark.parametrize("answer, match", [(lambda s, g: np.array([s, s * np.nan, g]), "not finite"),
+                                           (lambda s, g: np.zeros((0, 4)), "shape"),
+                                           (lambda s, g: np.array([s[:3], g[:3]]), "shape")])
+def test_a_fallback_planner_answer_that_is_no_path_is_named(robot, library, answer, match) -> None:
+    lib = PathLibrary(robot, library.pairs, library.per_step, library.options, plan=lambda s, g, i, j: answer(s, g))
+    lib.n_candidates = 0  # straight to the fallback
+    (i, j), pd = next(iter(library.pairs.items()))
+    with pytest.raises(ValueError, match=f"the fallback planner returned .*{match}"):
+        lib.query(pd.starts[0], pd.goals[0], i, j)
+
+
+@pytest.mark.parametrize("stride", [0, -1, 1.5, "3", float("nan")])
+def test_generate_refuses_a_stride_that_is_not_a_positive_integer(library, stride) -> None:
+    (i, j), pd = next(iter(library.pairs.items()))
+    with pytest.raises(ValueError, match="stride"):
+        library.generate(pd.starts[0], pd.goals[0], i, j, 0, stride=stride)

@@ -149,6 +149,35 @@ def test_tracker_rejects_a_colliding_planner_path(robot):
         tracker.step(0.0, sector_origin() + 6.0 * _direction(-100.0, -10.0))
 
 
+@pytest.mark.parametrize("answer, match", [
+    (lambda s, g: np.array([s, s + 1e5, g]), "leaves the joint limits"),  # was 4.8 GB of motion states, 13 s
+    (lambda s, g: np.array([s, s * np.nan, g]), "not finite"),
+    (lambda s, g: {"path": [s, g]}, "returned dict"),
+    (lambda s, g: np.array([s[:3], g[:3]]), "shape"),
+])
+def test_tracker_refuses_a_planner_answer_that_is_no_valid_path_at_once(robot, monkeypatch, answer, match):
+    from tpee_ompl.planning import paths
+
+    densified = []
+    monkeypatch.setattr(paths, "polyline_motion_states",
+                        lambda *a: densified.append(a) or pytest.fail("a bad waypoint must be refused before densifying"))
+    tracker = Tracker(robot, lambda s, g, i, j: answer(s, g), initial_sector=3)
+    with pytest.raises(ValueError, match=match):
+        tracker.step(0.0, sector_origin() + 6.0 * _direction(-100.0, -10.0))
+    assert not densified
+
+
+def test_tracker_times_and_joint_speeds_are_held_to_what_time_stamps_resolve(robot, planner):
+    from tpee_ompl.library.tracker import TrackerOptions
+
+    with pytest.raises(ValueError, match="joint_speed"):
+        TrackerOptions(joint_speed=5e-324)  # a motion would take inf seconds
+    tracker = Tracker(robot, planner, initial_sector=3)
+    with pytest.raises(ValueError, match="time t"):
+        tracker.step(1e17, np.array([5.0, 2.0, 1.5]))  # time increments vanish in rounding there
+    tracker.step(1.7e9, np.array([5.0, 2.0, 1.5]))  # a Unix time is fine
+
+
 def test_tracker_rejects_a_planner_path_with_wrong_ends(robot):
     tracker = Tracker(robot, lambda s, g, i, j: np.array([s, s]), initial_sector=3)
     with pytest.raises(ValueError, match="does not start"):
@@ -192,3 +221,10 @@ def test_an_initial_configuration_off_its_sectors_preset_is_refused_and_the_chec
     coarse = Tracker(robot, planner, options=TrackerOptions(check_step=10.0))
     assert coarse.check_step == robot.max_joint_step()  # never coarser than the robot's guarantee (10 rad was used)
     assert Tracker(robot, planner).check_step == min(0.01, robot.max_joint_step())
+
+
+@pytest.mark.parametrize("kw", [{"timeout": 1e10}, {"timeout": float("nan")}, {"library_time": -1.0}])
+def test_default_planner_refuses_a_time_limit_ompl_cannot_keep(robot, kw):
+    """OMPL's timed condition overflows beyond ~1e10 s and is true at once: a limit beyond a day is refused."""
+    with pytest.raises(ValueError, match=next(iter(kw))):
+        make_default_planner(robot, library=None, **kw)

@@ -156,3 +156,9 @@ def test_targets_inside_the_body_or_at_the_pivot_are_refused(robot):
     with pytest.raises(UnreachableTargetError, match="inside link1"):
         check_target(sector_origin(), robot)
     np.testing.assert_array_equal(check_target([5.0, 0.0, 1.0], robot), [5.0, 0.0, 1.0])
+
+
+@pytest.mark.parametrize("kw, match", [({"strict": "no"}, "strict"), ({"geometry": "x"}, "geometry")])
+def test_aim_batch_refuses_a_flag_or_geometry_of_the_wrong_type(kw, match):
+    with pytest.raises(ValueError, match=match):
+        aim_batch(np.array([[5.0, 2.0, 1.5]]), 3, **kw)

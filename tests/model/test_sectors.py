@@ -177,3 +177,17 @@ def test_length_bound_refuses_a_start_off_the_row():
         cross_sector_length_bound(start, goal, 1, 2)
     with pytest.raises(ValueError, match="same size"):
         cross_sector_length_bound(goal, goal[:3], 1, 2)
+
+
+@pytest.mark.parametrize("bad", [float("nan"), float("inf"), 1e308])
+def test_the_length_bound_refuses_joint_values_that_are_no_angles(bad):
+    start = np.r_[posture_preset(1), bad, 0.0]
+    goal = np.r_[posture_preset(2), 0.0, 0.0]
+    with pytest.raises(ValueError, match="finite joint angles"):
+        cross_sector_length_bound(start, goal, 1, 2)
+
+
+@pytest.mark.parametrize("target", [np.array([[5.0, 2.0, 1.5]]), np.array([5.0, 2.0]), np.zeros((2, 3))])
+def test_select_sector_takes_one_target_and_names_another_shape(target):
+    with pytest.raises(ValueError, match=r"one point of shape \(3,\)"):
+        select_sector(target, current=3)

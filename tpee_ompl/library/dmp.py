@@ -44,6 +44,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..validation import check_int, check_number
+
 __all__ = [
     "DMP",
     "DMPOptions",
@@ -57,6 +59,11 @@ __all__ = [
     "learn_dmp",
 ]
 
+MAX_N_BASIS = 10_000
+"""Most basis functions a DMP may have (eq. 14)."""
+MAX_GRID_ENTRIES = 20_000_000
+"""Most numbers in one DMP grid's basis matrix (samples x basis functions; 160 MB): a larger one is refused,
+not allocated (a library file asking for 60001 x 30000 would take 13 GiB).  The packaged library: 601 x 300."""
 _MAX_FREE_RESPONSE_AT_END = 1e-6
 """Largest allowed a(T): the spring-damper must have settled by the end of the path."""
 
@@ -95,14 +102,10 @@ class DMPOptions:
     min_amplitude_ratio: float = 0.5
 
     def __post_init__(self) -> None:
-        if self.n_basis is not None and (not isinstance(self.n_basis, (int, np.integer)) or self.n_basis < 2):
-            raise ValueError(f"n_basis must be an int >= 2 or None, got {self.n_basis!r}")
+        check_int("n_basis", self.n_basis, minimum=2, maximum=MAX_N_BASIS, optional=True)
         for name in ("alpha_y", "alpha_x", "width"):
-            value = getattr(self, name)
-            if not (np.isfinite(value) and value > 0):
-                raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
-        if self.beta_y is not None and not (np.isfinite(self.beta_y) and self.beta_y > 0):
-            raise ValueError(f"beta_y must be a finite number > 0 or None, got {self.beta_y!r}")
+            check_number(name, getattr(self, name), low=0.0, low_open=True)
+        check_number("beta_y", self.beta_y, low=0.0, low_open=True, optional=True)
         if self.scaling not in ("amplitude", "none"):
             raise ValueError(f"scaling must be 'amplitude' or 'none', got {self.scaling!r}")
         if not (0.0 < self.min_amplitude_ratio <= 1.0):
@@ -190,8 +193,12 @@ def _grid(n_steps: int, options: DMPOptions) -> tuple[np.ndarray, np.ndarray, np
     Loading a library rebuilds hundreds of DMPs on one grid; with these a rebuild is a convolution
     instead of a rollout loop.  The arrays are read-only (shared by the cache).
     """
+    n_basis = options.basis_count(n_steps)
+    if n_steps * n_basis > MAX_GRID_ENTRIES:
+        raise ValueError(f"a DMP grid of {n_steps} samples x {n_basis} basis functions is more than {MAX_GRID_ENTRIES:.0e} "
+                         "numbers: fewer samples or basis functions")
     x = canonical_phase(n_steps, options.alpha_x)
-    phi = basis_functions(x, options.basis_count(n_steps), options.alpha_x, options.width, normalized=True)
+    phi = basis_functions(x, n_basis, options.alpha_x, options.width, normalized=True)
     free = _free_response(n_steps, options)
     unit = np.zeros((n_steps, 1))
     unit[0] = 1.0
@@ -217,7 +224,11 @@ def basis_functions(x: np.ndarray, n_basis: int, alpha_x: float, width: float = 
     c = np.exp(-alpha_x * np.linspace(0.0, 1.0, n_basis))
     gap = np.abs(np.diff(c))
     gap = np.append(gap, gap[-1])
-    h = 1.0 / (2.0 * (width * gap) ** 2)
+    with np.errstate(divide="ignore", over="ignore"):
+        h = 1.0 / (2.0 * (width * gap) ** 2)
+    if not np.isfinite(h).all():  # the last centres coincide in floating point: no basis can tell them apart
+        raise ValueError(f"alpha_x = {alpha_x:g} with {n_basis} basis functions puts centres closer than a float "
+                         "resolves (width * gap underflows): lower alpha_x, width or the number of basis functions")
     psi = np.exp(-h * (np.asarray(x, dtype=float)[:, None] - c) ** 2)
     if normalized:
         psi = psi / np.maximum(psi.sum(axis=1, keepdims=True), np.finfo(float).tiny)
@@ -261,7 +272,11 @@ def integrate(y0: np.ndarray, g: np.ndarray, forcing: np.ndarray, options: DMPOp
 
 
 def _free_response(n_steps: int, options: DMPOptions) -> np.ndarray:
-    a = integrate(np.ones(1), np.zeros(1), np.zeros((n_steps, 1)), options)[:, 0]
+    with np.errstate(over="ignore", invalid="ignore"):  # a stiff spring-damper diverges: said below, not warned
+        a = integrate(np.ones(1), np.zeros(1), np.zeros((n_steps, 1)), options)[:, 0]
+    if not np.isfinite(a).all():
+        raise ValueError(f"the spring-damper's integration diverges on {n_steps} samples (alpha_y = {options.alpha_y}, "
+                         f"beta_y = {options.beta}): lower alpha_y / beta_y or use more samples")
     if abs(a[-1]) > _MAX_FREE_RESPONSE_AT_END:
         raise ValueError(
             f"the spring-damper has not settled by the end of the path (a(T) = {a[-1]:.1e} > "

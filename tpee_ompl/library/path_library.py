@@ -29,7 +29,8 @@ import numpy as np
 
 from ..model.sectors import check_sector, cross_sector_trajectory
 from ..model.wearer_arm import WearerArm
-from ..planning.paths import motion_is_valid, resample_waypoints
+from ..planning.paths import motion_is_valid, motion_step, planned_waypoints, resample_waypoints
+from ..validation import check_int
 from .build import LIBRARY_DMP_OPTIONS, LibraryBuildOptions, collect_default_demos, default_build_params, learn_demos
 from .demos import N_FAKE_TIME_STEPS, PairDemos, Plan, SampleQuery, collect_pair, dimension_rrt_planner
 from .dmp import DMPOptions, generate_blended
@@ -210,10 +211,11 @@ class PathLibrary:
 
         Shape (P, 4) with P = (N_FAKE_TIME_STEPS - 1) per_step + 1; with ``stride`` > 1 only every
         ``stride``-th sample and the last one are kept.  Raises ValueError for a start or goal that is not
-        a finite configuration, a pair the library has no demonstrations for, or a
-        ``demo_index`` out of range.
+        a finite configuration, a pair the library has no demonstrations for, a ``demo_index`` out of range,
+        or a ``stride`` that is not an integer >= 1.
         """
         start, goal = self.robot.check_config(start), self.robot.check_config(goal)
+        stride = check_int("stride", stride, minimum=1)
         pd = self.pairs.get((check_sector(from_sector), check_sector(to_sector)))
         if pd is None:
             raise ValueError(f"the library has no demonstrations for {from_sector}->{to_sector} (pairs: {sorted(self.pairs)})")
@@ -222,7 +224,7 @@ class PathLibrary:
         dof34 = generate_blended(pd.forward[demo_index], pd.reverse[demo_index], start[2:], goal[2:])
         path = np.hstack([self._dof12(start, goal, from_sector, to_sector), dof34])
         if stride > 1:
-            keep = np.arange(0, len(path), int(stride))
+            keep = np.arange(0, len(path), stride)
             if keep[-1] != len(path) - 1:
                 keep = np.append(keep, len(path) - 1)
             path = path[keep]
@@ -237,10 +239,12 @@ class PathLibrary:
         Tries the blended DMP paths of the ``n_candidates`` closest demonstrations (closest in the
         DOF3/DOF4 start/goal 4-vector), then the planner; counts each outcome (:meth:`stats`).
         Every segment of the returned path passes the check of ``si.checkMotion`` at resolution
-        ``step`` (default ``robot.max_joint_step()``, the setups' resolution).
+        ``step`` (default ``robot.max_joint_step()``, the setups' resolution, also the largest taken;
+        :func:`~tpee_ompl.planning.paths.motion_step`).  ValueError for a step below ``MIN_JOINT_STEP`` or a
+        fallback planner whose answer is not a path (K >= 2, 4) of finite numbers.
         """
         t0 = time.perf_counter()
-        step = self.robot.max_joint_step() if step is None else float(step)
+        step = motion_step(self.robot, step)
         start, goal = self.robot.check_config(start), self.robot.check_config(goal)
         i, j = check_sector(from_sector), check_sector(to_sector)
         if i == j:
@@ -266,7 +270,7 @@ class PathLibrary:
                 self._counts["fallback_seeded"] += 1
             W = self.plan(start, goal, i, j, **kw)
             if W is not None:
-                path = np.array(W, dtype=float)
+                path = planned_waypoints(W, self.robot.nq, "the fallback planner")
                 if np.allclose(path[0], start, atol=1e-9) and np.allclose(path[-1], goal, atol=1e-9):
                     path[0], path[-1] = start, goal
                     if motion_is_valid(self.robot, path, step):
@@ -307,7 +311,7 @@ class PathLibrary:
         around an obstacle) have no demonstrations: they go to ``same_sector``, by default
         :func:`tpee_ompl.library.tracker.make_default_planner`.
         """
-        step = min(self.robot.max_joint_step(), 0.01) if step is None else float(step)
+        step = motion_step(self.robot, 0.01 if step is None else step)
         fallback = same_sector
 
         def plan(start: np.ndarray, goal: np.ndarray, i: int, j: int) -> np.ndarray:

@@ -25,8 +25,8 @@ import numpy as np
 from ..model.pointing import AimingError, PointingGeometry, aim_batch, check_target
 from ..model.sectors import SECTORS, check_sector, in_pointing_sector, infer_sector, posture_preset, posture_sector
 from ..model.wearer_arm import WearerArm
-from ..planning.paths import MIN_JOINT_STEP, motion_is_valid, motion_states
-from ..validation import as_float_array, check_number, check_seed
+from ..planning.paths import MIN_JOINT_STEP, motion_is_valid, motion_states, planned_waypoints
+from ..validation import MAX_SECONDS, as_float_array, check_number, check_seed
 from .path_library import PathLibrary
 
 __all__ = [
@@ -39,6 +39,11 @@ __all__ = [
 ]
 
 log = logging.getLogger(__name__)
+
+MIN_JOINT_SPEED = 1e-6
+"""rad/s. Slowest ``joint_speed`` accepted (a slower one made a motion's duration overflow to inf)."""
+MAX_TIME = 1e10
+"""Seconds. Largest |t| of a target sample: Unix times fit, and time steps of a few microseconds are still resolved."""
 
 Planner = Callable[[np.ndarray, np.ndarray, int, int], np.ndarray]
 """planner(start_q (4,), goal_q (4,), from_sector, to_sector) -> waypoints (K, 4), radians."""
@@ -63,7 +68,7 @@ class TrackerOptions:
 
     def __post_init__(self) -> None:
         set_ = lambda field_, value: object.__setattr__(self, field_, value)  # noqa: E731 (frozen dataclass)
-        set_("joint_speed", check_number("joint_speed", self.joint_speed, low=0.0, low_open=True))
+        set_("joint_speed", check_number("joint_speed", self.joint_speed, low=MIN_JOINT_SPEED))
         set_("check_step", check_number("check_step", self.check_step, low=MIN_JOINT_STEP))
 
 
@@ -192,14 +197,13 @@ class Tracker:
         if found is None:
             self._no_path.append(f"{self.sector}->{k}: the planner found no path")
             return None
-        waypoints = np.asarray(found, dtype=float)
-        if waypoints.ndim != 2 or waypoints.shape[1] != 4 or len(waypoints) < 2:
-            raise ValueError(f"planner returned waypoints of shape {waypoints.shape}, expected (K >= 2, 4)")
+        waypoints = planned_waypoints(found, self.robot.nq)
         if not (np.allclose(waypoints[0], self.q, atol=1e-6) and np.allclose(waypoints[-1], goal, atol=1e-6)):
             raise ValueError("planner path does not start at the current configuration and end at the goal")
         waypoints[0], waypoints[-1] = self.q, goal
         if not motion_is_valid(self.robot, waypoints, self.check_step):
-            raise ValueError(f"planner path {self.sector}->{k} collides (checked every {self.check_step:g} rad)")
+            raise ValueError(f"planner path {self.sector}->{k} collides or leaves the joint limits (checked every "
+                             f"{self.check_step:g} rad)")
         self.events.append(TrackEvent(t, "cross-sector", k, f"{self.sector}->{k}: {why}, {len(waypoints)} waypoints"))
         clock = t
         for i in range(1, len(waypoints)):
@@ -221,9 +225,9 @@ class Tracker:
         Raises
         ------
         ValueError
-            If t is not a finite number or target is not 3 numbers.
+            If t is not a finite number within +/-``MAX_TIME`` or target is not 3 numbers.
         """
-        t = check_number("time t (seconds)", t)
+        t = check_number("time t (seconds)", t, low=-MAX_TIME, high=MAX_TIME)
         raw = as_float_array(target, "target")
         if raw.shape != (3,):
             raise ValueError(f"target must have shape (3,); got {raw.shape}")
@@ -318,6 +322,8 @@ def make_default_planner(
     from ..planning.setup import make_simple_setup
     from .planner import LibraryDimensionRRT
 
+    timeout = check_number("timeout (seconds)", timeout, low=0.0, low_open=True, high=MAX_SECONDS)
+    library_time = check_number("library_time (seconds)", library_time, low=0.0, low_open=True, high=MAX_SECONDS)
     ou.setLogLevel(ou.LOG_WARN)
     if seed is not None:
         ou.RNG.setSeed(check_seed("seed", seed))  # once per process: later calls only warn

@@ -43,7 +43,7 @@ import coal
 import numpy as np
 import pinocchio as pin
 
-from ..validation import as_float_array
+from ..validation import as_float_array, check_bool
 from .wearer_arm import MAX_TARGET_DISTANCE, MUZZLE_FRAME, WearerArm, default_robot
 from .sectors import posture_preset
 
@@ -256,6 +256,9 @@ def aim_batch(
     BlindAreaError, UnreachableTargetError (both ValueError)
     """
     g = geometry or default_geometry()
+    if not isinstance(g, PointingGeometry):
+        raise ValueError(f"geometry must be a PointingGeometry, got {type(g).__name__}")
+    strict = check_bool("strict", strict)
     t = _as_targets(targets)
     n = len(t)
     dof12 = _as_dof12(posture, n)

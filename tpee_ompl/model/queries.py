@@ -80,8 +80,8 @@ class Query:
         for name, n in (("target_a", 3), ("target_b", 3), ("start", 4), ("goal", 4)):
             try:
                 a = np.array(getattr(self, name), dtype=float)
-            except (TypeError, ValueError) as exc:
-                raise ValueError(f"query {self.id}: {name} must be {n} finite numbers, got {getattr(self, name)!r}") from exc
+            except (TypeError, ValueError, OverflowError) as exc:  # (an integer too large for a float)
+                raise ValueError(f"query {self.id}: {name} must be {n} finite numbers, got {getattr(self, name)!r}"[:300]) from exc
             if a.shape != (n,) or not np.all(np.isfinite(a)):
                 raise ValueError(f"query {self.id}: {name} must be {n} finite numbers, got {a!r}")
             a.setflags(write=False)

@@ -101,6 +101,10 @@ def cross_sector_trajectory(i: int, j: int) -> np.ndarray:
     return CROSS_SECTOR_TRAJECTORIES[(i, j)].copy()
 
 
+MAX_ANGLE = 1e3
+"""Radians: joint values beyond this are no joint angles (and their differences would overflow)."""
+
+
 def cross_sector_length_bound(start: np.ndarray, goal: np.ndarray, i: int, j: int) -> float:
     """Shortest joint-space length (rad) any path from ``start`` to ``goal`` can have while DOF1/DOF2 follow
     the Table 3 row from sector i to j: ``hypot(P, S)``, P the row's polyline length, S the straight
@@ -116,6 +120,9 @@ def cross_sector_length_bound(start: np.ndarray, goal: np.ndarray, i: int, j: in
     if start.ndim != 1 or start.shape != goal.shape or start.size < 2:
         raise ValueError(f"start and goal must be configurations of the same size >= 2, got shapes "
                          f"{start.shape} and {goal.shape}")
+    if not (np.all(np.abs(start) <= MAX_ANGLE) and np.all(np.abs(goal) <= MAX_ANGLE)):  # NaN fails too
+        raise ValueError(f"start and goal must be finite joint angles within +/-{MAX_ANGLE:g} rad, got "
+                         f"{start.tolist()} and {goal.tolist()}")
     for name, q, end in (("start", start, row[0]), ("goal", goal, row[-1])):
         if not np.allclose(q[:2], end, rtol=0.0, atol=1e-6):
             raise ValueError(f"{name}'s DOF1/DOF2 {q[:2].tolist()} are not the Table 3 row's end {end.tolist()} "
@@ -251,7 +258,10 @@ def select_sector(target: np.ndarray, current: int | None = None, origin: np.nda
     Keep ``current`` while the target stays in its pointing sector; otherwise (or with no current
     sector) return the target's posture sector.  Because every pointing sector contains its posture
     sector with a margin, a target moving along a posture-sector boundary causes at most one switch.
+    One target (3,); ValueError for another shape (a batch has no single current sector).
     """
+    if np.shape(target) != (3,):
+        raise ValueError(f"target must be one point of shape (3,), got shape {np.shape(target)}")
     if current is not None:
         current = check_sector(current)
         if in_pointing_sector(target, current, origin):

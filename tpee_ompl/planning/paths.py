@@ -25,9 +25,11 @@ __all__ = [
     "motion_interior_states",
     "motion_is_valid",
     "motion_states",
+    "motion_step",
     "path_length",
     "path_passes_motion_checks",
     "path_to_array",
+    "planned_waypoints",
     "polyline_motion_states",
     "resample_waypoints",
     "set_state",
@@ -248,6 +250,8 @@ def polyline_motion_states(path: np.ndarray, step: float) -> np.ndarray:
     path = np.asarray(path, dtype=float)
     if path.ndim != 2 or len(path) < 1:
         raise ValueError(f"path must have shape (K >= 1, n); got {path.shape}")
+    if not np.isfinite(path).all():
+        raise ValueError("path contains NaN or inf")
     if not step > 0:
         raise ValueError(f"step must be > 0, got {step!r}")
     delta = np.diff(path, axis=0)
@@ -276,15 +280,45 @@ def resample_waypoints(waypoints: np.ndarray, per_step: int = 100) -> np.ndarray
     return np.vstack([seg.reshape(-1, W.shape[1]), W[-1:]])
 
 
+def motion_step(robot: WearerArm, step: float | None = None) -> float:
+    """The joint-space step a motion of ``robot`` is checked at: ``step``, at most ``robot.max_joint_step()`` (the
+    step the collision guarantee holds for; the default) and at least :data:`MIN_JOINT_STEP`.  ValueError otherwise."""
+    if step is None:
+        return robot.max_joint_step()
+    from ..validation import check_number
+
+    return min(check_number("step (radians)", step, low=MIN_JOINT_STEP), robot.max_joint_step())
+
+
 def motion_is_valid(robot: WearerArm, path: np.ndarray, step: float | None = None) -> bool:
     """True if the first state and every straight segment of ``path`` (K, 4) pass the motion check.
 
     Checks the states of :func:`~tpee_ompl.planning.paths.polyline_motion_states` (those ``si.checkMotion`` checks in a
-    :func:`~tpee_ompl.planning.setup.make_simple_setup` setup at resolution ``step``, default
-    ``robot.max_joint_step()``) in ONE batched ``robot.are_valid`` call.
+    :func:`~tpee_ompl.planning.setup.make_simple_setup` setup at resolution :func:`motion_step` ``(robot, step)``)
+    in ONE batched ``robot.are_valid`` call, after the waypoints alone: a path with a waypoint that is not finite
+    or outside the joint limits is invalid at once (densifying a segment 1e6 rad long would fill the memory).
     """
-    step = robot.max_joint_step() if step is None else float(step)
+    step = motion_step(robot, step)
+    path = np.asarray(path, dtype=float)
+    if path.ndim != 2 or len(path) < 1 or path.shape[1] != robot.nq:
+        raise ValueError(f"path must have shape (K >= 1, {robot.nq}); got {path.shape}")
+    if not np.isfinite(path).all() or not robot.are_valid(path).all():
+        return False
     return bool(robot.are_valid(polyline_motion_states(path, step)).all())
+
+
+def planned_waypoints(W: object, nq: int, who: str = "the planner") -> np.ndarray:
+    """A planner callable's answer as a (K >= 2, nq) float array of finite numbers (a copy), else ValueError
+    saying what ``who`` returned (the tracker's and the library's fallback planners are user code)."""
+    try:
+        path = np.array(W, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"{who} returned {type(W).__name__}, not an array of waypoints") from None
+    if path.ndim != 2 or path.shape[1] != nq or len(path) < 2:
+        raise ValueError(f"{who} returned waypoints of shape {path.shape}, expected (K >= 2, {nq})")
+    if not np.isfinite(path).all():
+        raise ValueError(f"{who} returned waypoints that are not finite")
+    return path
 
 
 def path_length(path: np.ndarray) -> float:
