@@ -355,3 +355,44 @@ def test_a_robot_with_nothing_to_check_or_plan_is_refused_naming_the_file(tmp_pa
     fixed = _two_joint_urdf(tmp_path / "fixed.urdf", f'type="revolute">{_J2}{limits}')
     with pytest.raises(ValueError, match="fixed.urdf: no joint left to plan"):
         RobotChecker(fixed, locked={"j1": 0.0, "j2": 0.0})
+
+
+def _one_joint_urdf(tmp_path, joint: str = 'type="revolute"', axis: str = "0 0 1", limits: str = 'lower="-1" upper="1"'):
+    urdf = tmp_path / "one.urdf"
+    urdf.write_text(f"""<robot name="s"><link name="base"/><link name="arm">
+      <collision><origin xyz="0.5 0 0"/><geometry><sphere radius="0.05"/></geometry></collision></link>
+      <joint name="j" {joint}><parent link="base"/><child link="arm"/><axis xyz="{axis}"/>
+        <limit {limits} effort="1" velocity="1"/></joint></robot>""")
+    return urdf
+
+
+@pytest.mark.parametrize("kw, match", [
+    ({"axis": "0 0 0"}, "zero axis"),  # Pinocchio would scale the child instead of turning it
+    ({"joint": 'type="prismatic"', "axis": "0 0 0"}, "zero axis"),
+    ({"limits": 'lower="-1e10" upper="1e10"'}, "beyond"),  # a sampled motion was densified into 311 GiB
+])
+def test_a_urdf_joint_that_cannot_be_checked_state_by_state_is_refused_naming_it(tmp_path, kw, match):
+    with pytest.raises(ValueError, match=f"joint 'j'.*{match}"):
+        RobotChecker(_one_joint_urdf(tmp_path, **kw))
+
+
+@pytest.mark.parametrize("size, shape, match", [((1e6, 1e6, 1e6), "box", "sizes must lie in"),
+                                                ((1e-9,), "sphere", "sizes must lie in"),
+                                                (["box"], ["box"], "shape must be one of")])
+def test_obstacles_beyond_what_coal_answers_accurately_are_refused(size, shape, match):
+    with pytest.raises(ValueError, match=match):
+        Obstacle("o", shape, size)
+
+
+def test_lookups_by_an_unknown_name_are_value_errors_naming_it(robot):
+    q = 0.5 * (robot.lower + robot.upper)
+    with pytest.raises(ValueError, match="unknown joint 'nope'"):
+        robot.joint_placement(q, "nope")
+    with pytest.raises(ValueError, match="unknown joint 'nope'"):
+        robot.geometry_names("nope")
+    with pytest.raises(ValueError, match="unknown frame 3"):
+        robot.frame_placement(q, 3)
+    with pytest.raises(ValueError, match="package_dirs"):
+        RobotChecker(robot.files.urdf, package_dirs=3)
+    with pytest.raises(ValueError, match="displacement"):
+        robot.max_joint_step("x")

@@ -151,3 +151,33 @@ def test_bad_validator_settings_raise_naming_the_setting(robot):
     with pytest.raises(ValueError, match="batched_motion_validator"):
         make_simple_setup(robot, batched_motion_validator="yes")
     assert type(make_simple_setup(robot, motion_validator="discrete").getSpaceInformation().getMotionValidator()) is ob.MotionValidator
+
+
+def test_an_uncertified_stretch_shorter_than_a_step_is_checked_and_counted_as_a_fallback(tmp_path):
+    """Both ends certify only near themselves and no dense grid state falls between the fronts: the gap's
+    midpoint is checked (it used to pass unchecked, counted as certified: a 2-mm dip below the margin)."""
+    from ompl import util as ou
+
+    from tpee_ompl.model.obstacles import Obstacle
+    from tpee_ompl.model.robot_checker import RobotChecker
+    from tpee_ompl.planning.paths import set_state
+    from tpee_ompl.planning.setup import make_simple_setup
+
+    ou.setLogLevel(ou.LOG_WARN)
+    urdf = tmp_path / "arm1.urdf"
+    urdf.write_text("""<robot name="r"><link name="base"/>
+      <link name="l1"><collision><origin xyz="1 0 0"/><geometry><sphere radius="0.001"/></geometry></collision></link>
+      <joint name="j1" type="revolute"><parent link="base"/><child link="l1"/><axis xyz="0 0 1"/>
+        <limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>""")
+    r = RobotChecker(urdf, obstacles=[Obstacle("pin", "sphere", (0.001,), (1.02, 0.0, 0.0))])
+    si = make_simple_setup(r, motion_validator="certified").getSpaceInformation()
+    mv = si.getMotionValidator()
+    h = 0.4995 * r.max_joint_step()  # the motion is one step long: its only grid state is its end
+    x, y = si.allocState(), si.allocState()
+    set_state(x, [-h])
+    set_state(y, [h])
+    v = mv.certify(np.array([-h]), np.array([h]))
+    assert isinstance(v, np.ndarray) and len(v) == 1 and abs(float(v[0, 0])) < h  # the gap's midpoint
+    before = mv.fallbacks
+    si.checkMotion(x, y)
+    assert mv.fallbacks == before + 1

@@ -200,3 +200,44 @@ def test_motion_counts_are_the_validators_own_and_a_fraction_needs_a_counted_mot
         assert (valid, checked) == (sum(ok), 2), validator  # OMPL's own counters stay at 0 for the batched one
         assert valid_motion_fraction(before, motion_counts(mv)) == sum(ok) / 2
     assert valid_motion_fraction((3, 5), (3, 5)) is None and valid_motion_fraction(None, (1, 1)) is None
+
+
+@pytest.mark.parametrize("factor, steps", [(1, 1.2), (4, 1.2), (4, 2.7), (3, 0.4)])
+def test_the_batched_validator_checks_as_many_states_as_ompls_at_any_segment_count_factor(robot, factor, steps):
+    """OMPL's DiscreteMotionValidator checks ``f * ceil(d / step)`` states (``ot.Benchmark``'s strict check
+    sets f = 4); the batched one used ``ceil(f * d / step)`` (5 instead of 8 states for 1.2 steps)."""
+    start = robot.lower + 0.5 * (robot.upper - robot.lower)
+    counts = {}
+    for kind in ("dense", "discrete"):
+        si = make_simple_setup(robot, motion_validator=kind).getSpaceInformation()
+        si.getStateSpace().setValidSegmentCountFactor(factor)
+        step = robot.max_joint_step()
+        a, b = si.allocState(), si.allocState()
+        set_state(a, start)
+        set_state(b, start + np.r_[steps * step, 0.0, 0.0, 0.0])
+        before = robot.collision_checks
+        si.checkMotion(a, b)
+        counts[kind] = robot.collision_checks - before
+    assert counts["dense"] == counts["discrete"] == factor * int(np.ceil(steps))
+
+
+def test_a_margin_so_small_that_its_motion_step_is_below_the_floor_is_refused_not_densified():
+    """A 1e-9-m margin made one 1-rad motion check allocate 12 GiB; a zero margin names the margin."""
+    tiny = WearerArm(security_margin=1e-9)
+    with pytest.raises(ValueError, match="below MIN_JOINT_STEP"):
+        make_simple_setup(tiny)
+    make_simple_setup(tiny, joint_step=0.01)  # a step given explicitly is the caller's choice
+    with pytest.raises(ValueError, match="security_margin is 0"):
+        WearerArm(security_margin=0.0).max_joint_step()
+
+
+def test_setup_arguments_are_named_in_their_errors(robot):
+    good = robot.lower + 0.5 * (robot.upper - robot.lower)
+    with pytest.raises(ValueError, match="^start: "):
+        make_simple_setup(robot, [0.0, 0.0], good)
+    with pytest.raises(ValueError, match="^goal: "):
+        make_simple_setup(robot, good, [float("nan")] * 4)
+    with pytest.raises(ValueError, match="check_endpoints"):
+        make_simple_setup(robot, check_endpoints=None)
+    with pytest.raises(ValueError, match="contradicts"):
+        make_simple_setup(robot, batched_motion_validator=True, motion_validator="discrete")

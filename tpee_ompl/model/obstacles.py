@@ -16,8 +16,13 @@ import pinocchio as pin
 
 from ..validation import as_float_array, check_name
 
-__all__ = ["OBSTACLE_SHAPES", "Obstacle", "box"]
+__all__ = ["MAX_SIZE", "MIN_SIZE", "OBSTACLE_SHAPES", "Obstacle", "box"]
 
+MIN_SIZE, MAX_SIZE = 1e-6, 1e4
+"""Metres: obstacle sizes accepted.  Beyond 1e4 m Coal's distances to a small link lose accuracy (a 1e6-m box
+gave false collisions 2 cm away)."""
+MIN_MESH_SCALE, MAX_MESH_SCALE = 1e-6, 1e4
+"""Mesh scale factors accepted (a scale of 1e-20 gave negative clearances for a valid state)."""
 OBSTACLE_SHAPES = {"box": 3, "sphere": 1, "capsule": 2, "cylinder": 2, "mesh": 3}
 """Shape -> number of size values: box (x, y, z lengths), sphere (radius), capsule and cylinder
 (radius, length along local z), mesh (x, y, z scale of the file's vertices)."""
@@ -35,7 +40,10 @@ class Obstacle:
         A cylinder stays a Coal cylinder (URDF cylinders may become capsules; obstacles do not).
     size : sequence of floats, metres (see :data:`OBSTACLE_SHAPES`)
     placement : pin.SE3, 4x4 homogeneous matrix or 3 numbers (a translation), world frame
-    mesh : path of a mesh file Coal can read (shape "mesh" only)
+    mesh : path of a mesh file Coal can read (shape "mesh" only).  Coal checks a mesh as its surface: a link
+        entirely inside a closed mesh is not in collision with it (a motion cannot cross the surface, so a
+        path from a state outside never gets in; a start or goal inside is not refused).  Give a solid
+        obstacle as a box, sphere, capsule or cylinder where one fits.
     """
 
     name: str
@@ -46,12 +54,16 @@ class Obstacle:
 
     def __post_init__(self) -> None:
         check_name("obstacle name", self.name)
-        if self.shape not in OBSTACLE_SHAPES:
+        if not isinstance(self.shape, str) or self.shape not in OBSTACLE_SHAPES:
             raise ValueError(f"obstacle {self.name!r}: shape must be one of {sorted(OBSTACLE_SHAPES)}, got {self.shape!r}")
         n = OBSTACLE_SHAPES[self.shape]
         size = as_float_array(self.size, f"obstacle {self.name!r} size")
         if size.shape != (n,) or not np.all(np.isfinite(size)) or not np.all(size > 0):
             raise ValueError(f"obstacle {self.name!r}: a {self.shape} needs {n} finite sizes > 0 (metres), got {self.size!r}")
+        lo, hi = (MIN_MESH_SCALE, MAX_MESH_SCALE) if self.shape == "mesh" else (MIN_SIZE, MAX_SIZE)
+        if np.any(size < lo) or np.any(size > hi):  # Coal's GJK loses its accuracy beyond (false collisions)
+            raise ValueError(f"obstacle {self.name!r}: {'mesh scale' if self.shape == 'mesh' else 'sizes'} must lie in "
+                             f"[{lo:g}, {hi:g}], got {self.size!r}")
         object.__setattr__(self, "size", tuple(float(v) for v in size))
         object.__setattr__(self, "placement", _as_placement(self.placement, self.name))
         if (self.shape == "mesh") != (self.mesh is not None):

@@ -119,6 +119,8 @@ class RobotChecker:
             raise ValueError(f"obstacles must be a sequence of Obstacle, got {obstacles!r}")
         if isinstance(package_dirs, (str, os.PathLike)):
             package_dirs = (package_dirs,)
+        if not isinstance(package_dirs, (list, tuple)) or not all(isinstance(d, (str, os.PathLike)) for d in package_dirs):
+            raise ValueError(f"package_dirs must be a path or a list of paths, got {package_dirs!r}")
         self._options = {"package_dirs": tuple(package_dirs), "locked": dict(locked or {}), "obstacles": tuple(obstacles),
                          "cylinders_as_capsules": check_bool("cylinders_as_capsules", cylinders_as_capsules)}
         self._setup(ModelFiles(Path(urdf_path), Path(srdf_path) if srdf_path is not None else None),
@@ -263,8 +265,16 @@ class RobotChecker:
 
     def geometry_names(self, joint: str | int = 0) -> list[str]:
         """Names of the geometries attached to a joint (0 = the static world: fixed base and obstacles)."""
-        jid = joint if isinstance(joint, int) else self.model.getJointId(joint)
+        jid = self._joint_id(joint) if not isinstance(joint, int) or isinstance(joint, bool) else joint
+        if not 0 <= jid < self.model.njoints:
+            raise ValueError(f"joint index {joint} is out of range 0..{self.model.njoints - 1}")
         return [go.name for go in self.gmodel.geometryObjects if go.parentJoint == jid]
+
+    def _joint_id(self, joint: str) -> int:
+        """The model's index of the joint named ``joint``; ValueError naming it when there is none."""
+        if not isinstance(joint, str) or not self.model.existJointName(joint):
+            raise ValueError(f"unknown joint {joint!r} (joints: {list(self.model.names)[1:]})")
+        return int(self.model.getJointId(joint))
 
     def lever_arms(self) -> np.ndarray:
         """Per joint, how far a unit step of it can move any robot point: metres per radian for a
@@ -304,9 +314,13 @@ class RobotChecker:
         A step dq moves any point at most sum_i |dq_i| r_i <= ||dq||_2 ||r||_2 (Cauchy-Schwarz),
         with r the lever arms.  Default displacement: the security margin.
         """
-        d = self.security_margin if displacement is None else float(displacement)
-        if not d > 0:
-            raise ValueError("displacement must be > 0 (a zero security margin gives no motion-check guarantee)")
+        if displacement is None:
+            if not self.security_margin > 0:
+                raise ValueError("security_margin is 0: a zero margin gives no motion-check guarantee (no step moves "
+                                 "nothing); give a margin > 0 or a joint_step")
+            d = self.security_margin
+        else:
+            d = check_number("displacement (metres)", displacement, low=0.0, low_open=True)
         return d / float(np.linalg.norm(self.lever_arms()))
 
     # ------------------------------------------------------------------ kinematics
@@ -327,17 +341,18 @@ class RobotChecker:
     def frame_placement(self, q: np.ndarray, frame: str) -> pin.SE3:
         """World placement of a named frame at configuration q."""
         q = self.check_config(q)
-        fid = self.model.getFrameId(frame)
-        if fid >= self.model.nframes:
+        if not isinstance(frame, str) or not self.model.existFrame(frame):
             raise ValueError(f"unknown frame {frame!r}")
+        fid = self.model.getFrameId(frame)
         pin.forwardKinematics(self.model, self.data, q)
         return pin.updateFramePlacement(self.model, self.data, fid)
 
     def joint_placement(self, q: np.ndarray, joint: str) -> pin.SE3:
         """World placement of a joint frame at configuration q."""
         q = self.check_config(q)
+        jid = self._joint_id(joint)
         pin.forwardKinematics(self.model, self.data, q)
-        return self.data.oMi[self.model.getJointId(joint)].copy()
+        return self.data.oMi[jid].copy()
 
     # ------------------------------------------------------------------ collision
     def is_valid(self, q: np.ndarray) -> bool:

@@ -139,6 +139,12 @@ def _parse_urdf(urdf: Path) -> ET.Element:
     root = _read_robot_xml(urdf, "URDF")
     if any(c.tag == "capsule" for c in root.iter()):
         raise ValueError(f"URDF {urdf} uses <capsule>, which urdfdom drops silently; use <cylinder> (loaded as capsules)")
+    for joint in root.iter("joint"):
+        axis = joint.find("axis")
+        if joint.get("type") in ("revolute", "prismatic", "continuous") and axis is not None \
+                and _finite_numbers(axis.get("xyz", "1 0 0")) and not any(float(v) for v in axis.get("xyz", "1 0 0").split()):
+            raise ValueError(f"URDF {urdf}: joint {joint.get('name')!r} has <axis xyz=\"{axis.get('xyz')}\">: a zero axis "
+                             "moves nothing (a revolute joint would scale its child instead of turning it)")
     for owner in (*root.iter("link"), *root.iter("joint")):
         for el in owner.iter():
             for attr in _NUMBERS.get(el.tag, ()):
@@ -286,6 +292,10 @@ def _lock_joints(model: pin.Model, gmodel: pin.GeometryModel, locked: Mapping[st
     return pin.buildReducedModel(model, gmodel, sorted(ids), q)
 
 
+MAX_JOINT_LIMIT = 1e3
+"""Largest |joint limit| accepted (rad, or m for a prismatic joint); "unlimited" placeholders such as 1e10 are refused."""
+
+
 def _check_joints(model: pin.Model, urdf: Path) -> None:
     """Every planned joint is 1-DOF (revolute or prismatic) with finite limits."""
     for jid in range(1, model.njoints):
@@ -299,6 +309,10 @@ def _check_joints(model: pin.Model, urdf: Path) -> None:
         lo, hi = model.lowerPositionLimit[j.idx_q], model.upperPositionLimit[j.idx_q]
         if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi):
             raise ValueError(f"URDF {urdf}: joint {name!r} has limits [{lo}, {hi}] (need finite lower < upper)")
+        if max(abs(lo), abs(hi)) > MAX_JOINT_LIMIT:
+            raise ValueError(f"URDF {urdf}: joint {name!r} has limits [{lo:g}, {hi:g}] beyond +/-{MAX_JOINT_LIMIT:g} "
+                             "(rad or m): no joint travels that far, and a motion across them could not be checked "
+                             "state by state; give its real limits")
 
 
 def _check_mimics(root: ET.Element, model: pin.Model, urdf: Path) -> None:

@@ -211,10 +211,14 @@ class CertifiedMotionValidator(BatchedMotionValidator):
         return True
 
     def _dense_between(self, a: np.ndarray, u: np.ndarray, lo: float, hi: float, step: float) -> np.ndarray:
-        """The dense states of a -> a + u whose parameter lies in [lo, hi] (the rest is certified)."""
+        """The dense states of a -> a + u whose parameter lies in [lo, hi] (the rest is certified); when no
+        grid state falls in that gap (it is shorter than a step), its midpoint: never an empty check, so a
+        motion with an uncertified stretch is always counted as a fallback."""
         n = max(1, int(np.ceil(float(np.linalg.norm(u)) / step)))
         t = np.arange(1, n + 1) / n
         t = t[(t >= lo - 1e-12) & (t <= hi + 1e-12)]
+        if not len(t):
+            t = np.array([0.5 * (lo + hi)])
         return a + t[:, None] * u
 
     def checkMotion(self, s1: ob.State, s2: ob.State) -> bool:  # noqa: N802 (OMPL override)

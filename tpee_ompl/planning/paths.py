@@ -188,17 +188,20 @@ def motion_states(a: np.ndarray, b: np.ndarray, step: float, include_start: bool
     return unchecked_motion_states(a, b, step, include_start)
 
 
-def unchecked_motion_states(a: np.ndarray, b: np.ndarray, step: float, include_start: bool = False) -> np.ndarray:
+def unchecked_motion_states(a: np.ndarray, b: np.ndarray, step: float, include_start: bool = False,
+                            factor: int = 1) -> np.ndarray:
     """:func:`motion_states` without its input checks, for inner loops whose ends are known finite
-    float vectors of one length (a motion validator's OMPL states)."""
+    float vectors of one length (a motion validator's OMPL states).  ``factor``: the space's
+    ``validSegmentCountFactor`` f, so ``f * ceil(|b - a| / step)`` segments, as OMPL counts them."""
     d = b - a
-    n = max(1, math.ceil(math.sqrt(float(d @ d)) / step))
+    n = factor * max(1, math.ceil(math.sqrt(float(d @ d)) / step))
     return a + (np.arange(0 if include_start else 1, n + 1) / n)[:, None] * d
 
 
-def batched_motion_states(A: np.ndarray, B: np.ndarray, step: float) -> tuple[np.ndarray, np.ndarray]:
+def batched_motion_states(A: np.ndarray, B: np.ndarray, step: float, factor: int = 1) -> tuple[np.ndarray, np.ndarray]:
     """:func:`motion_states` of the motions A[k] -> B[k] (K, n) at once: ``(states, counts)``, motion k's
-    ``counts[k]`` states after motion k - 1's, each the same float as :func:`motion_states` gives.
+    ``counts[k]`` states after motion k - 1's, each the same float as :func:`motion_states` gives
+    (``factor`` as in :func:`unchecked_motion_states`).
 
     Raises
     ------
@@ -213,7 +216,7 @@ def batched_motion_states(A: np.ndarray, B: np.ndarray, step: float) -> tuple[np
     _check_step(step)
     D = B - A
     # the segment counts as motion_states computes them (one dot product per motion: the same rounding)
-    n = np.array([max(1, math.ceil(math.sqrt(float(d @ d)) / step)) for d in D], dtype=np.int64)
+    n = np.array([factor * max(1, math.ceil(math.sqrt(float(d @ d)) / step)) for d in D], dtype=np.int64)
     idx = np.repeat(np.arange(len(A)), n)
     j = np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n) + 1
     return A[idx] + (j / n[idx])[:, None] * D[idx], n
@@ -283,11 +286,13 @@ def resample_waypoints(waypoints: np.ndarray, per_step: int = 100) -> np.ndarray
 def motion_step(robot: WearerArm, step: float | None = None) -> float:
     """The joint-space step a motion of ``robot`` is checked at: ``step``, at most ``robot.max_joint_step()`` (the
     step the collision guarantee holds for; the default) and at least :data:`MIN_JOINT_STEP`.  ValueError otherwise."""
-    if step is None:
-        return robot.max_joint_step()
     from ..validation import check_number
 
-    return min(check_number("step (radians)", step, low=MIN_JOINT_STEP), robot.max_joint_step())
+    own = robot.max_joint_step()
+    if own < MIN_JOINT_STEP:
+        raise ValueError(f"the robot's motion step {own:.3g} rad (security margin {robot.security_margin:g} m) is below "
+                         f"MIN_JOINT_STEP = {MIN_JOINT_STEP:g} rad: give a larger security_margin")
+    return own if step is None else min(check_number("step (radians)", step, low=MIN_JOINT_STEP), own)
 
 
 def motion_is_valid(robot: WearerArm, path: np.ndarray, step: float | None = None) -> bool:

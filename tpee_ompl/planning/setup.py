@@ -25,7 +25,7 @@ from ompl import geometric as og
 
 from ..model.clearance_balls import SCREEN_LEVELS, screened_all_valid, screened_lines_valid
 from ..model.robot_checker import RobotChecker
-from ..validation import check_number
+from ..validation import check_bool, check_number
 from .paths import MIN_JOINT_STEP, batched_motion_states, set_state, state_to_array, unchecked_motion_states
 
 if TYPE_CHECKING:
@@ -105,20 +105,25 @@ class BatchedMotionValidator(ob.MotionValidator):
                                    for h in screen_levels)
         robot.ball_screen().prepare(h * self.step for h in self.screen_levels)  # not in the first plan's time
 
+    def factor(self) -> int:
+        """The space's ``validSegmentCountFactor`` f now: a motion of length d gets ``f * ceil(d / step)``
+        segments, as OMPL's ``DiscreteMotionValidator`` counts them."""
+        return max(1, int(self._space.getValidSegmentCountFactor()))
+
     def effective_step(self) -> float:
-        """Step (radians) between checked states now: ``step / validSegmentCountFactor``."""
-        return self.step / max(1, int(self._space.getValidSegmentCountFactor()))
+        """Longest step (radians) between checked states now: ``step / validSegmentCountFactor``."""
+        return self.step / self.factor()
 
     def checkMotion(self, s1: ob.State, s2: ob.State) -> bool:  # noqa: N802 (OMPL override)
         """True if every state along s1 -> s2 (excluding s1) is valid."""
         a, b = state_to_array(s1, self._n), state_to_array(s2, self._n)
         self.motions_checked += 1
-        return self._tally(bool(self.all_valid([unchecked_motion_states(a, b, self.effective_step())])[0]))
+        return self._tally(bool(self.all_valid([unchecked_motion_states(a, b, self.step, factor=self.factor())])[0]))
 
     def check_motions(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
         """Validity of many motions A[k] -> B[k] (each excluding its start), batched together."""
         A, B = np.atleast_2d(A), np.atleast_2d(B)
-        S, counts = batched_motion_states(A, B, self.effective_step())
+        S, counts = batched_motion_states(A, B, self.step, factor=self.factor())
         self.motions_checked += len(counts)
         if len(counts) < 2 or not self.screen_levels:
             ok = self.all_valid(np.split(S, np.cumsum(counts)[:-1]) if len(counts) else [])
@@ -212,12 +217,17 @@ def make_simple_setup(
     ``getSpaceInformation()`` is fully set up on return; :func:`motion_check_step` gives back the
     joint step it checks motions at.
     """
+    check_endpoints = check_bool("check_endpoints", check_endpoints)
     space = make_space(robot)
     extent = float(space.getMaximumExtent())
     step = check_number("joint_step (radians, below the space's extent)", joint_step, low=MIN_JOINT_STEP, high=extent,
                         high_open=True, optional=True)
     if step is None:
         step = robot.max_joint_step()
+        if step < MIN_JOINT_STEP:  # a motion would take millions of states (a 1e-9 m margin: 12 GiB for one radian)
+            raise ValueError(f"the robot's motion step {step:.3g} rad (security margin {robot.security_margin:g} m over "
+                             f"its lever arms) is below MIN_JOINT_STEP = {MIN_JOINT_STEP:g} rad: give a larger "
+                             "security_margin, or a joint_step")
     ss = og.SimpleSetup(space)
     si = ss.getSpaceInformation()
     checker = RobotValidityChecker(si, robot)
@@ -238,7 +248,14 @@ def make_simple_setup(
     if start is not None or goal is not None:
         if start is None or goal is None:
             raise ValueError("give both start and goal, or neither")
-        q0, q1 = robot.check_config(start), robot.check_config(goal)
+        try:
+            q0 = robot.check_config(start)
+        except ValueError as exc:
+            raise ValueError(f"start: {exc}") from None
+        try:
+            q1 = robot.check_config(goal)
+        except ValueError as exc:
+            raise ValueError(f"goal: {exc}") from None
         if check_endpoints:
             for name, q in (("start", q0), ("goal", q1)):
                 if not robot.within_limits(q):
@@ -263,8 +280,8 @@ def _motion_validator_kind(name: str | None, batched: bool | None) -> str:
         return old or "batched"
     if name not in MOTION_VALIDATORS:
         raise ValueError(f"motion_validator must be one of {MOTION_VALIDATORS}, got {name!r}")
-    if old == "discrete" and name != "discrete":
-        raise ValueError(f"batched_motion_validator=False contradicts motion_validator={name!r}")
+    if (old == "discrete") != (name == "discrete") and old is not None:
+        raise ValueError(f"batched_motion_validator={batched} contradicts motion_validator={name!r}")
     return name
 
 
