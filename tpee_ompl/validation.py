@@ -47,7 +47,7 @@ def check_number(name: str, value: Any, *, low: float | None = None, high: float
 
 def check_bool(name: str, value: Any) -> bool:
     """``value`` if it is a bool (or numpy bool)."""
-    if not isinstance(value, (bool,)) and type(value).__name__ != "bool_":
+    if not isinstance(value, (bool, np.bool_)):
         raise ValueError(f"{name} must be True or False, got {value!r}")
     return bool(value)
 

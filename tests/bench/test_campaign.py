@@ -179,3 +179,20 @@ def test_bad_config_is_rejected():
 
 def test_default_workers_is_at_most_two():
     assert CampaignConfig().workers == default_workers() and 1 <= default_workers() <= 2
+
+
+def test_config_numbers_become_plain_python_values_and_duplicates_are_refused():
+    import numpy as np
+
+    from tpee_ompl.bench.config import KNOWN_PLANNERS, CampaignConfig
+
+    c = CampaignConfig(sample_caps=(np.int64(20),), anytime_budgets=(np.float32(0.02),), runs=np.int64(1),
+                       seed=np.int64(3), simplify=np.bool_(True))
+    assert [type(v) for v in (c.sample_caps[0], c.anytime_budgets[0], c.runs, c.seed, c.simplify)] == [int, float, int,
+                                                                                                       int, bool]
+    for kw, match in (({"sample_caps": (20, 20)}, "twice"), ({"anytime_budgets": (0.02, 0.0200000001)}, "twice"),
+                      ({"sample_caps": (), "anytime_queries": 0}, "nothing to run"),
+                      ({"sample_caps": (10**30,)}, "sample_caps"), ({"anytime_planners": ("PRMstar",)}, "PRMstar")):
+        with pytest.raises(ValueError, match=match):
+            CampaignConfig(**kw)
+    assert "PRMstar" not in KNOWN_PLANNERS  # deadlocks with a Python termination condition

@@ -108,3 +108,21 @@ def test_a_task_that_raises_is_a_failure_without_retry_and_the_others_finish():
     assert sorted(r["qpos"] for r in res) == list(range(5))  # each exactly once
     assert [r["qpos"] for r in res if r.get("failed")] == [2]
     assert len({r["pid"] for r in res if not r.get("failed")}) == 4  # a fresh process per task
+
+
+def test_in_process_a_task_that_raises_is_recorded_and_the_others_run():
+    from tpee_ompl.bench.executors import InProcessExecutor
+
+    out = list(InProcessExecutor().run(bench_tasks.boom, [{"qpos": 0}, {"qpos": 1}]))
+    assert [r.get("failed", "").startswith("ValueError: task") for r in out] == [True, True]
+
+
+def test_a_task_run_in_a_subprocess_is_killed_at_its_time_limit():
+    """The Dask executor's tasks: a hang used to hold the campaign for ever."""
+    from tpee_ompl.bench.executors import run_task_in_subprocess
+
+    tests_dir = str(Path(__file__).resolve().parents[1])
+    task = {"seconds": 30, "time_limit_s": 1.0, "sys_path": [tests_dir]}
+    with pytest.raises(RuntimeError, match="time limit"):
+        run_task_in_subprocess(task, "helpers.bench_tasks:sleep")
+    assert run_task_in_subprocess({**task, "seconds": 0}, "helpers.bench_tasks:sleep")["seconds"] == 0

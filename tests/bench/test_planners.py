@@ -141,3 +141,13 @@ def test_the_planners_refused_at_a_sample_cap_are_those_whose_bindings_count_no_
         if native is not None:
             assert (name in NOT_ITERATION_CAPPED) == (not hasattr(native, "numIterations")), name
     assert "RRTConnectSimplify" in NOT_ITERATION_CAPPED
+
+
+def test_a_python_planners_settings_are_one_line_each_in_the_log():
+    from tpee_ompl.bench.planners import planner_settings
+
+    class P:
+        def settings(self):
+            return {"note": "line one\nline two", "multi  word\tkey": 3}
+
+    assert planner_settings(P()) == {"note": "line one line two", "multi word key": "3"}

@@ -141,3 +141,30 @@ def test_report_has_the_anytime_quality_section_and_csv(tmp_path, monkeypatch):
     with open(out["anytime_quality"]) as f:
         rows = {r["planner"]: r for r in csv.DictReader(f)}
     assert float(rows["A"]["within_share"]) == pytest.approx(0.4) and rows["A"]["queries"] == "5"
+
+
+def test_a_capped_run_stopped_by_max_time_before_its_cap_is_a_failure():
+    """Its path came from fewer samples than the cap: compared as a run at the cap it made Table 4 wrong."""
+    base = {"comparison": "iterations", "sample_cap": 5000, "timelimit": 0.05, "solved": 1, "status": 6,
+            "reaches_goal": 1, "approximate_solution": 0, "correct_solution": 1, "path_valid_dense": 1,
+            "solution_length": 2.0}
+    assert report._success({**base, "iterations": 5000, "time": 0.03})
+    assert not report._success({**base, "iterations": 976, "time": 0.11})  # hit max_time
+    assert report._success({**base, "iterations": 976, "time": 0.01})  # stopped early for another reason
+    assert report._success({**base, "iterations": None, "time": 0.11})  # a planner that counts none
+
+
+@pytest.mark.parametrize("key, seen, want", [
+    ("pf:rrtstar_k20", ["RRTstar", "RRTstarK20"], "RRTstarK20"),  # was RRTstar: a substring
+    ("pf:rrtstar_k20", ["RRTstar"], "pf:rrtstar_k20"),  # no planner of that name: never another one
+    ("helpers.bench_standins:make_standin", ["StandIn", "RRTstar"], "StandIn"),
+    ("DimensionRRT", ["DimensionRRT", "DimensionRRTReleased"], "DimensionRRT"),
+])
+def test_planner_names_resolve_to_the_one_equal_name_only(key, seen, want):
+    assert report.resolve_planner_name(key, seen) == want
+
+
+def test_loading_a_missing_database_says_so_and_creates_nothing(tmp_path):
+    with pytest.raises(FileNotFoundError, match="benchmark database not found"):
+        report.load_runs(tmp_path / "none.db")
+    assert not list(tmp_path.iterdir())

@@ -28,3 +28,9 @@ def die(task: dict) -> dict:
 def boom(task: dict) -> dict:
     """Raise."""
     raise ValueError(f"task {task.get('qpos')} exploded")
+
+
+def sleep(task: dict) -> dict:
+    """Sleep ``task["seconds"]``, then echo."""
+    time.sleep(float(task["seconds"]))
+    return echo(task)

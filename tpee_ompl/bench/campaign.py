@@ -417,7 +417,8 @@ def _finish(directory: Path, meta: dict, executor, failed: list[dict], broken: l
         from . import report as rep
 
         result.report = rep.write_report(result.database, directory, expected=meta)
-        result.plots = plots.make_plots(result.database, directory / "plots")
+        result.plots = plots.make_plots(result.database, directory / "plots", result.report["planner"],
+                                        result.report["reference"])  # the planners the report compared
     return result
 
 

@@ -43,14 +43,19 @@ DimensionRRT, LibraryDimensionRRT (the DMP library refined by dimension-RRT) and
 The planners of :data:`ANYTIME_PLANNERS`, in the same order."""
 ANYTIME_PLANNERS: tuple[str, ...] = tuple(CLI_PLANNER_NAMES.values())
 """Planners of the time-matched comparison (every planner the command line knows)."""
-KNOWN_PLANNERS: tuple[str, ...] = (*ANYTIME_PLANNERS, "DimensionRRTReleased", "DimensionRRTNoShortcuts", "RRT", "PRMstar")
+KNOWN_PLANNERS: tuple[str, ...] = (*ANYTIME_PLANNERS, "DimensionRRTReleased", "DimensionRRTNoShortcuts", "RRT")
 """Every built-in planner name (:data:`tpee_ompl.bench.planners.PLANNER_FACTORIES`); ``module:function`` names a factory elsewhere.
 ``DimensionRRTReleased`` (named on demand, not in a default comparison) is dimension-RRT with
 ``release_after=RELEASE_AFTER``: prescribed rows planned too once the path converged on them;
-``DimensionRRTNoShortcuts`` (also on demand) improves by the paper's rule alone (``shortcuts=False``)."""
-NOT_ITERATION_CAPPED: tuple[str, ...] = ("RRTConnect", "RRTConnectSimplify", "AORRTC", "RRT", "PRMstar")
+``DimensionRRTNoShortcuts`` (also on demand) improves by the paper's rule alone (``shortcuts=False``).
+PRM* is not among them: its solve asks the termination condition from a thread of its own while the calling
+thread waits for it holding Python's lock, so with the benchmark's Python condition it deadlocked at random
+(and ignored SIGTERM); ``module:function`` can still name a factory for it."""
+NOT_ITERATION_CAPPED: tuple[str, ...] = ("RRTConnect", "RRTConnectSimplify", "AORRTC", "RRT")
 """Planners that cannot be stopped at a sample count (their ompl 2.0.1 bindings have no ``numIterations()``), so they
 never join the iteration-matched comparison; refused there before a campaign starts."""
+MAX_SAMPLE_CAP = 10_000_000
+"""Largest sample cap (RRT* iterations) a campaign takes, as the command line's counts."""
 MAX_NAME_BYTES = 234
 """Longest campaign name: ``<UTC time>_<name>`` (and a ``_999`` that tells two campaigns of one second apart) must
 fit a file name, 255 bytes on most file systems."""
@@ -155,10 +160,19 @@ class CampaignConfig:
             if not problem.query_sets:
                 raise ValueError(f"queries: problem {self.problem} has built-in queries (give no query set)")
         check_name("out", self.out)
-        caps = tuple(check_int("sample_caps", n, minimum=1) for n in self.sample_caps)
+        set_ = lambda field_, value: object.__setattr__(self, field_, value)  # noqa: E731 (frozen dataclass)
+        # plain ints and floats (numpy scalars passed the checks, then failed as JSON once the folder existed)
+        caps = tuple(check_int("sample_caps", n, minimum=1, maximum=MAX_SAMPLE_CAP) for n in self.sample_caps)
         budgets = tuple(check_number("anytime_budgets", b, low=0, low_open=True, high=MAX_SECONDS) for b in self.anytime_budgets)
+        set_("sample_caps", caps)
+        set_("anytime_budgets", budgets)
+        for field_name, values, text in (("sample_caps", caps, str), ("anytime_budgets", budgets, lambda b: f"{b:g}")):
+            if len({text(v) for v in values}) != len(values):  # one log name per value: a second would be dropped
+                raise ValueError(f"{field_name} names a value twice (as the logs name it): {list(values)}")
         if not caps and not budgets:
             raise ValueError("nothing to run: sample_caps and anytime_budgets are both empty")
+        if not caps and self.anytime_queries == 0:
+            raise ValueError("nothing to run: no sample_caps, and anytime_queries is 0")
         for field_name, names in (("iteration_planners", self.iteration_planners),
                                   ("anytime_planners", self.anytime_planners)):
             for n in names:
@@ -188,21 +202,20 @@ class CampaignConfig:
                                  f"{', '.join(problem.checkers)})")
         if caps and not self.checkers:
             raise ValueError("give at least one motion validator")
-        check_int("alt_checker_queries", self.alt_checker_queries, minimum=0, optional=True)
+        set_("alt_checker_queries", check_int("alt_checker_queries", self.alt_checker_queries, minimum=0, optional=True))
         if self.alt_checker_caps is not None:
             if not self.alt_checker_caps:
                 raise ValueError("alt_checker_caps must be None or at least one cap")
-            for n in self.alt_checker_caps:
-                check_int("alt_checker_caps", n, minimum=1)
-        check_int("anytime_queries", self.anytime_queries, minimum=0, optional=True)
-        check_int("max_queries", self.max_queries, minimum=1, optional=True)
-        check_int("runs", self.runs, minimum=1)
-        check_int("workers", self.workers, minimum=0)
-        check_seed("seed", self.seed)
-        check_number("max_time", self.max_time, low=0, low_open=True, high=MAX_SECONDS)
-        check_bool("simplify", self.simplify)
-        check_bool("one_run_per_ladder", self.one_run_per_ladder)
-        check_bool("one_run_per_anytime_ladder", self.one_run_per_anytime_ladder)
+            set_("alt_checker_caps", tuple(check_int("alt_checker_caps", n, minimum=1, maximum=MAX_SAMPLE_CAP)
+                                           for n in self.alt_checker_caps))
+        set_("anytime_queries", check_int("anytime_queries", self.anytime_queries, minimum=0, optional=True))
+        set_("max_queries", check_int("max_queries", self.max_queries, minimum=1, optional=True))
+        set_("runs", check_int("runs", self.runs, minimum=1))
+        set_("workers", check_int("workers", self.workers, minimum=0))
+        set_("seed", check_seed("seed", self.seed))
+        set_("max_time", check_number("max_time", self.max_time, low=0, low_open=True, high=MAX_SECONDS))
+        for flag in ("simplify", "one_run_per_ladder", "one_run_per_anytime_ladder"):
+            set_(flag, check_bool(flag, getattr(self, flag)))
 
 
 @dataclass

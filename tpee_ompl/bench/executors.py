@@ -81,7 +81,10 @@ class InProcessExecutor:
 
     def run(self, fn: TaskFn, tasks: Sequence[dict]) -> Iterator[dict]:  # noqa: D102
         for t in tasks:
-            yield fn(t)
+            try:
+                yield fn(t)
+            except Exception as exc:  # noqa: BLE001 (recorded as the pools record it; the other queries go on)
+                yield task_failure(t, f"{type(exc).__name__}: {exc}", 1)
 
     def shutdown(self, cancel: bool = False) -> None:  # noqa: D102
         pass
@@ -249,7 +252,8 @@ def run_task_in_subprocess(task: dict, fn_path: str = "tpee_ompl.bench.experimen
 
     ``task["sys_path"]`` entries that exist here are put on the child's ``sys.path`` (so planner
     factories given as ``module:function`` resolve as on the client).  Raises ``RuntimeError`` with
-    the child's stderr tail when it fails.
+    the child's stderr tail when it fails, or when it gives no result within ``task["time_limit_s"]`` (then
+    it is killed, as a local pool's worker is).
     """
     with tempfile.TemporaryDirectory(prefix="tpee_task_") as tmp:
         src, dst = Path(tmp) / "task.json", Path(tmp) / "result.json"
@@ -258,10 +262,15 @@ def run_task_in_subprocess(task: dict, fn_path: str = "tpee_ompl.bench.experimen
         extra = [p for p in task.get("sys_path", []) if p and os.path.isdir(p)]
         if extra:
             env["PYTHONPATH"] = os.pathsep.join(extra + [env.get("PYTHONPATH", "")]).rstrip(os.pathsep)
-        proc = subprocess.run(
-            [sys.executable, "-m", "tpee_ompl.bench.executors", fn_path, str(src), str(dst)],
-            env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, check=False,
-        )
+        limit = task.get("time_limit_s")
+        try:
+            proc = subprocess.run(
+                [sys.executable, "-m", "tpee_ompl.bench.executors", fn_path, str(src), str(dst)],
+                env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, check=False,
+                timeout=None if limit is None else float(limit),
+            )
+        except subprocess.TimeoutExpired:  # (subprocess.run kills the child) as the local pool does
+            raise RuntimeError(f"no result within its time limit ({float(limit):.0f} s): killed") from None
         if proc.returncode != 0 or not dst.is_file():
             tail = "\n".join(proc.stderr.splitlines()[-20:])
             raise RuntimeError(f"task subprocess exited with {proc.returncode}:\n{tail}")

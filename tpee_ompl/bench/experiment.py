@@ -258,6 +258,11 @@ def _run_experiment(cfg: dict, task: dict, spec: dict, ladder=None, only: list[s
                              problem=problem.name)
         factory = planner_factory(pname)
         inner = factory(si, ctx)
+        if not isinstance(inner, ob.Planner):
+            raise ValueError(f"planner factory {pname!r} returned {type(inner).__name__}, not an ompl.base.Planner")
+        if inner.getName() in {n.removeprefix("geometric_") for n in wrappers} | set(wrappers):
+            raise ValueError(f"planner factory {pname!r} makes a planner named {inner.getName()!r} like an earlier one "
+                             "of the experiment: the log keys runs by name (give it another name, setName)")
         read = None if layout.is_plain else layout.read
         renew = functools.partial(factory, si, ctx) if pname in SINGLE_USE_PLANNERS else None
         w = (RecordingPlanner(si, inner, max_iterations=cap, read=read, checker=checker, renew=renew, deadline=budget)

@@ -165,8 +165,8 @@ def _parse_settings(text: str) -> dict[str, str]:
 
 def planner_settings(p) -> dict[str, str]:
     """A planner's settings as text: its ``settings()`` (Python planners) or parsed ``printSettings()``."""
-    if hasattr(p, "settings"):
-        return {str(k): str(v) for k, v in p.settings().items()}
+    if hasattr(p, "settings"):  # one line each: a log holds one setting per line (a newline made a log unreadable)
+        return {" ".join(str(k).split()): " ".join(str(v).split()) for k, v in p.settings().items()}
     level = ou.getLogLevel()
     ou.setLogLevel(ou.LOG_ERROR)  # printSettings reads BIT*'s deprecated options, each getter warns; errors still show
     try:

@@ -62,20 +62,27 @@ def _columns(con: sqlite3.Connection, table: str) -> set[str]:
 
 
 def load_runs(db_path: str | Path) -> list[dict]:
-    """One dict per run: planner, experiment parameters and the run's measurements."""
-    con = sqlite3.connect(str(db_path))
+    """One dict per run: planner, experiment parameters and the run's measurements.
+
+    FileNotFoundError for a missing database (sqlite would create an empty one), ValueError naming the file
+    when it holds no benchmark runs."""
+    if not Path(db_path).is_file():
+        raise FileNotFoundError(f"benchmark database not found: {db_path}")
+    con = sqlite3.connect(f"file:{Path(db_path).resolve()}?mode=ro", uri=True)
     try:
         rcols, ecols = _columns(con, "runs"), _columns(con, "experiments")
         want_r = ["id", "time", "solved", "status", "approximate_solution", "correct_solution", "solution_length",
                   "simplified_solution_length", "best_cost", "iterations", "samples", "collision_checks",
                   "length_dof12", "length_dof34", "path_valid_dense", "reaches_goal", "first_solution_time", "planner_error"]
         want_e = ["comparison", "query_set", "query_id", "query_index", "from_sector", "to_sector", "sample_cap",
-                  "time_budget", "motion_validator", "straight_length"]
+                  "time_budget", "motion_validator", "straight_length", "timelimit"]
         sel = [f"runs.{c}" if c in rcols else f"NULL AS {c}" for c in want_r]
         sel += [f"experiments.{c}" if c in ecols else f"NULL AS {c}" for c in want_e]
         sql = (f"SELECT plannerConfigs.name AS planner, experiments.name AS experiment, {', '.join(sel)} "
                "FROM runs JOIN experiments ON runs.experimentid = experiments.id "
                "JOIN plannerConfigs ON runs.plannerid = plannerConfigs.id ORDER BY runs.id")
+        if not rcols or not ecols:
+            raise ValueError(f"{db_path}: not a benchmark database (no runs / experiments tables)")
         cur = con.execute(sql)
         names = [d[0] for d in cur.description]
         rows = [dict(zip(names, r)) for r in cur.fetchall()]
@@ -87,9 +94,19 @@ def load_runs(db_path: str | Path) -> list[dict]:
     return rows
 
 
+def _hit_max_time(r: dict) -> bool:
+    """A run of the sample-capped comparison that stopped at the safety time limit (``max_time``) before its cap:
+    not a run at that sample count, so a failure (its path would be compared with runs that drew the whole cap)."""
+    if r["comparison"] != "iterations" or r["iterations"] is None or r["sample_cap"] is None or r["timelimit"] is None:
+        return False
+    return (int(r["iterations"]) < int(r["sample_cap"]) and r["time"] is not None
+            and float(r["time"]) >= 0.99 * float(r["timelimit"]))
+
+
 def _success(r: dict) -> bool:
     return bool(
-        r["solved"] == 1
+        not _hit_max_time(r)
+        and r["solved"] == 1
         and r["status"] == 6  # exact solution
         and r["reaches_goal"] == 1
         and not r["approximate_solution"]
@@ -185,9 +202,10 @@ def _expected_queries(expected: dict) -> dict[tuple[str, str, str], int]:
 
 
 def _setting(r: dict) -> str:
+    """The run's cap or budget as text; "?" where a database not written by this package lacks it."""
     if r["comparison"] == "iterations":
-        return f"N={int(r['sample_cap'])}"
-    return f"T={float(r['time_budget']):g}s"
+        return f"N={int(r['sample_cap'])}" if r["sample_cap"] is not None else "N=?"
+    return f"T={float(r['time_budget']):g}s" if r["time_budget"] is not None else "T=?"
 
 
 def best_found(runs: list[dict]) -> dict:
@@ -216,7 +234,7 @@ def length_quality_table(runs: list[dict]) -> list[dict]:
         lb = summarize([float(r["solution_length"]) / float(r["straight_length"]) for r in ok
                         if r["straight_length"] and float(r["straight_length"]) > 0])
         bf = summarize([float(r["solution_length"]) / best[r["query_id"]] for r in ok if best.get(r["query_id"])])
-        tm = summarize([float(r["time"]) for r in ok])
+        tm = summarize([float(r["time"]) for r in ok if r["time"] is not None])
         out.append({"comparison": comp, "checker": chk, "setting": setting, "planner": planner,
                     "success": len(ok), "runs": len(rs),
                     "vs_straight_median": lb["median"], "vs_straight_q1": lb["q1"], "vs_straight_q3": lb["q3"],
@@ -421,11 +439,15 @@ def write_report(db_path: str | Path, directory: str | Path, expected: dict | No
 
 
 def resolve_planner_name(name: str, seen: Sequence[str]) -> str:
-    """Planner names in the DB come from getName(); map a factory key (or module:function) onto them."""
+    """Planner names in the DB come from getName(); map a factory key (``module:function``: its function name,
+    case, separators and a ``make_`` prefix aside) onto the one DB name equal to it, else the key itself (so a
+    report never compares another planner)."""
     if name in seen:
         return name
-    short = name.rsplit(":", 1)[-1]
-    for s in seen:
-        if s.lower() == short.lower() or short.lower().endswith(s.lower()) or s.lower() in short.lower():
-            return s
-    return name
+
+    def key(text: str) -> str:  # case and separators aside, and a factory's "make_" prefix
+        text = text.rsplit(":", 1)[-1].lower()
+        return "".join(c for c in text.removeprefix("make_") if c.isalnum())
+
+    same = [s for s in seen if key(s) == key(name)]  # equal, not contained: "rrtstar_k20" is not "RRTstar"
+    return same[0] if len(same) == 1 else name
