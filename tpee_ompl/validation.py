@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["MAX_SECONDS", "MAX_SEED", "as_float_array", "check_bool", "check_int", "check_name", "check_number", "check_seed", "sub_seed"]
+__all__ = ["MAX_COUNT", "MAX_JOINT_VALUE", "MAX_SECONDS", "MAX_SEED", "as_float_array", "check_bool", "check_int", "check_name", "check_number", "check_seed", "sub_seed"]
 
 
 def check_int(name: str, value: Any, *, minimum: int | None = None, maximum: int | None = None,
@@ -74,6 +74,12 @@ def as_float_array(x: object, what: str) -> np.ndarray:
         raise ValueError(f"{what} must be real numbers, got {x!r} ({exc})"[:400]) from exc
 
 
+MAX_COUNT = 10**7
+"""Largest count an argument may ask for (samples, frames, steps, sample caps): more is refused, not attempted
+(a typo must not allocate exabytes or run for a year)."""
+MAX_JOINT_VALUE = 1e3
+"""Largest |joint value| (rad, or m for a prismatic joint) taken anywhere: no joint travels further, and a motion
+across more could not be checked state by state."""
 MAX_SECONDS = 86_400.0
 """Longest time limit (s) a planning run may be given: a day.  OMPL turns a budget into a time point, and
 a far larger one (1e10 s) overflows it into the past: every run stopped at once as a TIMEOUT."""

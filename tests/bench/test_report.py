@@ -152,6 +152,10 @@ def test_a_capped_run_stopped_by_max_time_before_its_cap_is_a_failure():
     assert not report._success({**base, "iterations": 976, "time": 0.11})  # hit max_time
     assert report._success({**base, "iterations": 976, "time": 0.01})  # stopped early for another reason
     assert report._success({**base, "iterations": None, "time": 0.11})  # a planner that counts none
+    cut = {**base, "iterations": 976, "time": 0.11, "planner": "R", "query_id": "0", "motion_validator": "batched",
+           "time_budget": None}
+    counts = success_table([{**cut, "success": report._success(cut)}])[0]
+    assert (counts["success"], counts["invalid_path"], counts["unsolved"]) == (0, 0, 1)  # not at the cap, not invalid
 
 
 @pytest.mark.parametrize("key, seen, want", [
@@ -168,3 +172,13 @@ def test_loading_a_missing_database_says_so_and_creates_nothing(tmp_path):
     with pytest.raises(FileNotFoundError, match="benchmark database not found"):
         report.load_runs(tmp_path / "none.db")
     assert not list(tmp_path.iterdir())
+    odd = tmp_path / "run#2?x%41"  # a folder name a campaign may have (a URI would cut it)
+    odd.mkdir()
+    import sqlite3
+
+    con = sqlite3.connect(str(odd / "b.db"))
+    con.execute("CREATE TABLE x (a)")
+    con.close()
+    with pytest.raises(ValueError, match="not a benchmark database"):
+        report.load_runs(odd / "b.db")
+    assert sorted(p.name for p in odd.iterdir()) == ["b.db"]

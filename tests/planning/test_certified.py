@@ -179,5 +179,5 @@ def test_an_uncertified_stretch_shorter_than_a_step_is_checked_and_counted_as_a_
     v = mv.certify(np.array([-h]), np.array([h]))
     assert isinstance(v, np.ndarray) and len(v) == 1 and abs(float(v[0, 0])) < h  # the gap's midpoint
     before = mv.fallbacks
-    si.checkMotion(x, y)
+    assert not si.checkMotion(x, y)  # the midpoint keeps 18 mm where the margin is 20 mm
     assert mv.fallbacks == before + 1

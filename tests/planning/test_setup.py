@@ -227,8 +227,16 @@ def test_a_margin_so_small_that_its_motion_step_is_below_the_floor_is_refused_no
     with pytest.raises(ValueError, match="below MIN_JOINT_STEP"):
         make_simple_setup(tiny)
     make_simple_setup(tiny, joint_step=0.01)  # a step given explicitly is the caller's choice
+    zero = WearerArm(security_margin=0.0)
     with pytest.raises(ValueError, match="security_margin is 0"):
-        WearerArm(security_margin=0.0).max_joint_step()
+        zero.max_joint_step()
+    from tpee_ompl.planning.paths import motion_is_valid, motion_step
+
+    assert motion_step(zero, 0.01) == 0.01  # a step given: no cap at a zero margin
+    with pytest.raises(ValueError, match="security_margin is 0"):
+        motion_step(zero)
+    q = zero.lower + 0.5 * (zero.upper - zero.lower)
+    motion_is_valid(zero, np.stack([q, q + 0.01]), 0.01)
 
 
 def test_setup_arguments_are_named_in_their_errors(robot):

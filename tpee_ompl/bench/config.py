@@ -54,8 +54,6 @@ thread waits for it holding Python's lock, so with the benchmark's Python condit
 NOT_ITERATION_CAPPED: tuple[str, ...] = ("RRTConnect", "RRTConnectSimplify", "AORRTC", "RRT")
 """Planners that cannot be stopped at a sample count (their ompl 2.0.1 bindings have no ``numIterations()``), so they
 never join the iteration-matched comparison; refused there before a campaign starts."""
-MAX_SAMPLE_CAP = 10_000_000
-"""Largest sample cap (RRT* iterations) a campaign takes, as the command line's counts."""
 MAX_NAME_BYTES = 234
 """Longest campaign name: ``<UTC time>_<name>`` (and a ``_999`` that tells two campaigns of one second apart) must
 fit a file name, 255 bytes on most file systems."""
@@ -146,7 +144,7 @@ class CampaignConfig:
         return cls(problem=problem, **fields)
 
     def __post_init__(self) -> None:
-        from ..validation import MAX_SECONDS, check_bool, check_int, check_name, check_number, check_seed
+        from ..validation import MAX_COUNT, MAX_SECONDS, check_bool, check_int, check_name, check_number, check_seed
 
         from .problems import get_problem
 
@@ -162,7 +160,7 @@ class CampaignConfig:
         check_name("out", self.out)
         set_ = lambda field_, value: object.__setattr__(self, field_, value)  # noqa: E731 (frozen dataclass)
         # plain ints and floats (numpy scalars passed the checks, then failed as JSON once the folder existed)
-        caps = tuple(check_int("sample_caps", n, minimum=1, maximum=MAX_SAMPLE_CAP) for n in self.sample_caps)
+        caps = tuple(check_int("sample_caps", n, minimum=1, maximum=MAX_COUNT) for n in self.sample_caps)
         budgets = tuple(check_number("anytime_budgets", b, low=0, low_open=True, high=MAX_SECONDS) for b in self.anytime_budgets)
         set_("sample_caps", caps)
         set_("anytime_budgets", budgets)
@@ -206,7 +204,7 @@ class CampaignConfig:
         if self.alt_checker_caps is not None:
             if not self.alt_checker_caps:
                 raise ValueError("alt_checker_caps must be None or at least one cap")
-            set_("alt_checker_caps", tuple(check_int("alt_checker_caps", n, minimum=1, maximum=MAX_SAMPLE_CAP)
+            set_("alt_checker_caps", tuple(check_int("alt_checker_caps", n, minimum=1, maximum=MAX_COUNT)
                                            for n in self.alt_checker_caps))
         set_("anytime_queries", check_int("anytime_queries", self.anytime_queries, minimum=0, optional=True))
         set_("max_queries", check_int("max_queries", self.max_queries, minimum=1, optional=True))

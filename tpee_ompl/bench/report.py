@@ -68,7 +68,7 @@ def load_runs(db_path: str | Path) -> list[dict]:
     when it holds no benchmark runs."""
     if not Path(db_path).is_file():
         raise FileNotFoundError(f"benchmark database not found: {db_path}")
-    con = sqlite3.connect(f"file:{Path(db_path).resolve()}?mode=ro", uri=True)
+    con = sqlite3.connect(str(db_path))
     try:
         rcols, ecols = _columns(con, "runs"), _columns(con, "experiments")
         want_r = ["id", "time", "solved", "status", "approximate_solution", "correct_solution", "solution_length",
@@ -97,10 +97,10 @@ def load_runs(db_path: str | Path) -> list[dict]:
 def _hit_max_time(r: dict) -> bool:
     """A run of the sample-capped comparison that stopped at the safety time limit (``max_time``) before its cap:
     not a run at that sample count, so a failure (its path would be compared with runs that drew the whole cap)."""
-    if r["comparison"] != "iterations" or r["iterations"] is None or r["sample_cap"] is None or r["timelimit"] is None:
+    it, cap, limit, t = (r.get(k) for k in ("iterations", "sample_cap", "timelimit", "time"))
+    if r.get("comparison") != "iterations" or None in (it, cap, limit, t):
         return False
-    return (int(r["iterations"]) < int(r["sample_cap"]) and r["time"] is not None
-            and float(r["time"]) >= 0.99 * float(r["timelimit"]))
+    return int(it) < int(cap) and float(t) >= 0.99 * float(limit)
 
 
 def _success(r: dict) -> bool:
@@ -174,8 +174,8 @@ def success_table(runs: list[dict], expected: dict | None = None) -> list[dict]:
         ids = {r["query_id"] for r in rs}
         row = {"comparison": comp, "checker": chk, "setting": setting, "planner": planner, "runs": len(rs),
                "success": sum(r["success"] for r in rs),
-               "invalid_path": sum(1 for r in rs if r["solved"] == 1 and not r["success"]),
-               "unsolved": sum(1 for r in rs if r["solved"] != 1),
+               "invalid_path": sum(1 for r in rs if r["solved"] == 1 and not r["success"] and not _hit_max_time(r)),
+               "unsolved": sum(1 for r in rs if r["solved"] != 1 or _hit_max_time(r)),  # max_time: not at the cap
                "queries": len(ids), "missing_queries": None}
         if wanted is not None:
             row["missing_queries"] = wanted.get((comp, chk, setting), 0) - len(ids)

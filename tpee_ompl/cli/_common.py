@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING, Any, NoReturn
 if TYPE_CHECKING:
     from ..model.wearer_arm import WearerArm
 
-from ..validation import MAX_SECONDS
+from ..validation import MAX_COUNT, MAX_SECONDS
 
 __all__ = [
     "MAX_COUNT",
@@ -56,11 +56,6 @@ __all__ = [
 POSTURE_SNAP = 1e-3
 """Radians. A ``--start``/``--goal`` whose DOF1/DOF2 lie this close to its sector's Table 1 posture is taken as at
 it (the values ``plan`` prints, 4 decimals, are 5e-5 rad off; the planners want the posture to 1e-6)."""
-
-MAX_COUNT = 10**7
-"""Largest count an argument may ask for (samples, frames, steps): more is refused as a usage error,
-not attempted (a typo must not allocate exabytes or run for a year)."""
-
 
 class CliError(Exception):
     """A usage error: printed as one line, exit code 2 (the argument or file named in the message)."""

@@ -31,6 +31,7 @@ from ..planning.paths import resample_waypoints
 from ..validation import check_bool, check_int, check_number
 from .demos import (
     DEMO_MARGINS,
+    MAX_PER_STEP,
     POINTING_LINKS,
     DemoPlanner,
     PairDemos,
@@ -108,7 +109,7 @@ class LibraryBuildOptions:
         set_("pairs", _check_pairs(self.pairs))
         set_("min_difference", check_number("min_difference", self.min_difference, low=0.0))
         set_("max_attempts", check_int("max_attempts", self.max_attempts, minimum=1, optional=True))
-        set_("per_step", check_int("per_step", self.per_step, minimum=1))
+        set_("per_step", check_int("per_step", self.per_step, minimum=1, maximum=MAX_PER_STEP))
         set_("max_samples", check_int("max_samples", self.max_samples, minimum=1))
         set_("timeout", check_number("timeout", self.timeout, low=0.0, low_open=True))
         set_("require_planning", check_bool("require_planning", self.require_planning))

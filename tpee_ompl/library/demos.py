@@ -28,6 +28,7 @@ from .dmp import DMP
 
 __all__ = [
     "DEMO_MARGINS",
+    "MAX_PER_STEP",
     "N_FAKE_TIME_STEPS",
     "POINTING_LINKS",
     "DemoPlanner",
@@ -44,6 +45,9 @@ log = logging.getLogger(__name__)
 
 N_FAKE_TIME_STEPS = 7
 """Fake-time steps of every planned path (section 4.1.2)."""
+MAX_PER_STEP = 1000
+"""Most samples per fake-time step a library takes: its DMPs' grid (6 x per_step + 1 samples, half as many basis
+functions by default) must stay within ``dmp.MAX_GRID_ENTRIES`` (1000: 6001 x 3000).  The packaged library: 100."""
 POINTING_LINKS: tuple[str, ...] = ("link3", "link4")
 """Links moved by DOF3/DOF4, the DOFs the DMPs generate (DOF1/DOF2 follow Table 3 for every query)."""
 DEMO_MARGINS: tuple[float, ...] = (0.05, 0.04, 0.03, 0.025)

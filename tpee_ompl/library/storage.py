@@ -22,7 +22,7 @@ from ..files import OutputExistsError, atomic_path
 from ..model.sectors import SECTOR_PAIRS
 from ..model.wearer_arm import WearerArm
 from ..validation import check_int
-from .demos import N_FAKE_TIME_STEPS, PairDemos
+from .demos import MAX_PER_STEP, N_FAKE_TIME_STEPS, PairDemos
 from .dmp import DMP, DMPOptions
 
 if TYPE_CHECKING:
@@ -39,8 +39,6 @@ class LibraryFileError(ValueError):
     field or array (the message names it)."""
 
 
-MAX_PER_STEP = 10_000
-"""Largest ``per_step`` a file may give (the DMPs' time grid has 6 x per_step + 1 steps)."""
 MAX_CANDIDATES = 10_000
 """Largest ``n_candidates`` a file may give."""
 _META_KEYS = frozenset({"format_version", "model_hash", "per_step", "n_candidates", "options", "pairs", "build_stats",

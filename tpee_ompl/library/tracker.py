@@ -25,7 +25,7 @@ import numpy as np
 from ..model.pointing import AimingError, PointingGeometry, aim_batch, check_target
 from ..model.sectors import SECTORS, check_sector, in_pointing_sector, infer_sector, posture_preset, posture_sector
 from ..model.wearer_arm import WearerArm
-from ..planning.paths import MIN_JOINT_STEP, motion_is_valid, motion_states, planned_waypoints
+from ..planning.paths import MIN_JOINT_STEP, motion_is_valid, motion_states, motion_step, planned_waypoints
 from ..validation import MAX_SECONDS, as_float_array, check_number, check_seed
 from .path_library import PathLibrary
 
@@ -144,7 +144,7 @@ class Tracker:
             raise ValueError(f"initial configuration's DOF1/DOF2 {np.round(q0[:2], 4).tolist()} is not sector "
                              f"{self.sector}'s Table-1 preset {np.round(posture_preset(self.sector), 4).tolist()} "
                              "(initial_sector)")
-        self.check_step = min(self.options.check_step, robot.max_joint_step())
+        self.check_step = motion_step(robot, self.options.check_step)
         """The step the tracker checks its motions at: ``check_step``, at most the robot's ``max_joint_step()``."""
         if not robot.within_limits(q0):
             raise ValueError(f"initial configuration {np.round(q0, 4).tolist()} is outside the joint limits")
@@ -327,7 +327,7 @@ def make_default_planner(
     ou.setLogLevel(ou.LOG_WARN)
     if seed is not None:
         ou.RNG.setSeed(check_seed("seed", seed))  # once per process: later calls only warn
-    step = min(0.01, robot.max_joint_step())
+    step = motion_step(robot, 0.01)
     lib: PathLibrary | None = None
     if isinstance(library, PathLibrary):
         lib = library

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..validation import as_float_array
+from ..validation import MAX_JOINT_VALUE, as_float_array
 
 __all__ = [
     "CROSS_SECTOR_TRAJECTORIES",
@@ -101,10 +101,6 @@ def cross_sector_trajectory(i: int, j: int) -> np.ndarray:
     return CROSS_SECTOR_TRAJECTORIES[(i, j)].copy()
 
 
-MAX_ANGLE = 1e3
-"""Radians: joint values beyond this are no joint angles (and their differences would overflow)."""
-
-
 def cross_sector_length_bound(start: np.ndarray, goal: np.ndarray, i: int, j: int) -> float:
     """Shortest joint-space length (rad) any path from ``start`` to ``goal`` can have while DOF1/DOF2 follow
     the Table 3 row from sector i to j: ``hypot(P, S)``, P the row's polyline length, S the straight
@@ -120,8 +116,8 @@ def cross_sector_length_bound(start: np.ndarray, goal: np.ndarray, i: int, j: in
     if start.ndim != 1 or start.shape != goal.shape or start.size < 2:
         raise ValueError(f"start and goal must be configurations of the same size >= 2, got shapes "
                          f"{start.shape} and {goal.shape}")
-    if not (np.all(np.abs(start) <= MAX_ANGLE) and np.all(np.abs(goal) <= MAX_ANGLE)):  # NaN fails too
-        raise ValueError(f"start and goal must be finite joint angles within +/-{MAX_ANGLE:g} rad, got "
+    if not (np.all(np.abs(start) <= MAX_JOINT_VALUE) and np.all(np.abs(goal) <= MAX_JOINT_VALUE)):  # NaN fails too
+        raise ValueError(f"start and goal must be finite joint angles within +/-{MAX_JOINT_VALUE:g} rad, got "
                          f"{start.tolist()} and {goal.tolist()}")
     for name, q, end in (("start", start, row[0]), ("goal", goal, row[-1])):
         if not np.allclose(q[:2], end, rtol=0.0, atol=1e-6):

@@ -20,6 +20,7 @@ import coal
 import numpy as np
 import pinocchio as pin
 
+from ..validation import MAX_JOINT_VALUE
 from .obstacles import Obstacle
 
 __all__ = [
@@ -292,10 +293,6 @@ def _lock_joints(model: pin.Model, gmodel: pin.GeometryModel, locked: Mapping[st
     return pin.buildReducedModel(model, gmodel, sorted(ids), q)
 
 
-MAX_JOINT_LIMIT = 1e3
-"""Largest |joint limit| accepted (rad, or m for a prismatic joint); "unlimited" placeholders such as 1e10 are refused."""
-
-
 def _check_joints(model: pin.Model, urdf: Path) -> None:
     """Every planned joint is 1-DOF (revolute or prismatic) with finite limits."""
     for jid in range(1, model.njoints):
@@ -309,8 +306,8 @@ def _check_joints(model: pin.Model, urdf: Path) -> None:
         lo, hi = model.lowerPositionLimit[j.idx_q], model.upperPositionLimit[j.idx_q]
         if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi):
             raise ValueError(f"URDF {urdf}: joint {name!r} has limits [{lo}, {hi}] (need finite lower < upper)")
-        if max(abs(lo), abs(hi)) > MAX_JOINT_LIMIT:
-            raise ValueError(f"URDF {urdf}: joint {name!r} has limits [{lo:g}, {hi:g}] beyond +/-{MAX_JOINT_LIMIT:g} "
+        if max(abs(lo), abs(hi)) > MAX_JOINT_VALUE:
+            raise ValueError(f"URDF {urdf}: joint {name!r} has limits [{lo:g}, {hi:g}] beyond +/-{MAX_JOINT_VALUE:g} "
                              "(rad or m): no joint travels that far, and a motion across them could not be checked "
                              "state by state; give its real limits")
 

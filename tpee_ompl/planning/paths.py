@@ -285,14 +285,18 @@ def resample_waypoints(waypoints: np.ndarray, per_step: int = 100) -> np.ndarray
 
 def motion_step(robot: WearerArm, step: float | None = None) -> float:
     """The joint-space step a motion of ``robot`` is checked at: ``step``, at most ``robot.max_joint_step()`` (the
-    step the collision guarantee holds for; the default) and at least :data:`MIN_JOINT_STEP`.  ValueError otherwise."""
+    step the collision guarantee holds for; the default; no cap at a zero margin) and at least :data:`MIN_JOINT_STEP`.
+    ValueError otherwise."""
     from ..validation import check_number
 
-    own = robot.max_joint_step()
-    if own < MIN_JOINT_STEP:
-        raise ValueError(f"the robot's motion step {own:.3g} rad (security margin {robot.security_margin:g} m) is below "
+    own = robot.max_joint_step() if robot.security_margin > 0 else math.inf  # margin 0: no step is guaranteed
+    if step is None and not math.isfinite(own):
+        raise ValueError("security_margin is 0: the robot has no motion step of its own; give a step")
+    step = own if step is None else min(check_number("step (radians)", step, low=MIN_JOINT_STEP), own)
+    if step < MIN_JOINT_STEP:
+        raise ValueError(f"the robot's motion step {step:.3g} rad (security margin {robot.security_margin:g} m) is below "
                          f"MIN_JOINT_STEP = {MIN_JOINT_STEP:g} rad: give a larger security_margin")
-    return own if step is None else min(check_number("step (radians)", step, low=MIN_JOINT_STEP), own)
+    return step
 
 
 def motion_is_valid(robot: WearerArm, path: np.ndarray, step: float | None = None) -> bool:
@@ -307,8 +311,8 @@ def motion_is_valid(robot: WearerArm, path: np.ndarray, step: float | None = Non
     path = np.asarray(path, dtype=float)
     if path.ndim != 2 or len(path) < 1 or path.shape[1] != robot.nq:
         raise ValueError(f"path must have shape (K >= 1, {robot.nq}); got {path.shape}")
-    if not np.isfinite(path).all() or not robot.are_valid(path).all():
-        return False
+    if not np.isfinite(path).all() or not ((path >= robot.lower) & (path <= robot.upper)).all():
+        return False  # (the waypoints' collision checks come with the motion's states)
     return bool(robot.are_valid(polyline_motion_states(path, step)).all())
 
 
