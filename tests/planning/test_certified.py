@@ -181,3 +181,16 @@ def test_an_uncertified_stretch_shorter_than_a_step_is_checked_and_counted_as_a_
     before = mv.fallbacks
     assert not si.checkMotion(x, y)  # the midpoint keeps 18 mm where the margin is 20 mm
     assert mv.fallbacks == before + 1
+
+
+@pytest.mark.parametrize("factor", [1, 4])
+def test_a_motion_the_certificates_cannot_cover_gets_ompls_dense_states(robot, factor):
+    """Out of the limits the certificates do not apply: the dense check takes the ``f * ceil(d / step)`` states
+    OMPL's discrete validator would (5 instead of 8 for 1.2 steps at f = 4, before)."""
+    mv = _certified(robot)
+    mv._space.setValidSegmentCountFactor(factor)
+    a = robot.lower + 0.5 * (robot.upper - robot.lower)
+    a[1] = robot.upper[1] + 1e-3  # the start outside the limits: nothing is certified
+    b = a + np.r_[1.2 * mv.step, 0.0, 0.0, 0.0]
+    v = mv.certify(a, b)
+    assert isinstance(v, np.ndarray) and len(v) == factor * 2

@@ -30,7 +30,7 @@ from ompl import base as ob
 
 from ..model.robot_checker import RobotChecker
 from ..validation import check_int, check_number
-from .paths import motion_states, state_to_array
+from .paths import state_to_array, unchecked_motion_states
 from .setup import BatchedMotionValidator
 
 __all__ = ["CertifiedMotionOptions", "ClearanceGroups", "CertifiedMotionValidator"]
@@ -169,7 +169,7 @@ class CertifiedMotionValidator(BatchedMotionValidator):
         step = self.effective_step()
         lower, upper = self.robot.lower, self.robot.upper
         if not (self.groups.constant_ok and np.all((a >= lower) & (a <= upper) & (b >= lower) & (b <= upper))):
-            return motion_states(a, b, step)
+            return unchecked_motion_states(a, b, self.step, factor=self.factor())  # OMPL's states
         u = b - a
         length = float(np.linalg.norm(u))
         speed = self.groups.levers @ np.abs(u)  # metres per unit of the segment parameter t
@@ -193,7 +193,7 @@ class CertifiedMotionValidator(BatchedMotionValidator):
         evaluations = 0
         while lo < hi:
             if not (live_lo or live_hi) or evaluations >= self.options.max_evaluations:
-                return self._dense_between(a, u, lo, hi, step)
+                return self._dense_between(a, u, lo, hi)
             forward = live_lo and (not live_hi or evaluations % 2 == 0)
             t = lo if forward else hi
             q = a + t * u
@@ -210,11 +210,12 @@ class CertifiedMotionValidator(BatchedMotionValidator):
                 hi, live_hi = t - r, r >= min_dt
         return True
 
-    def _dense_between(self, a: np.ndarray, u: np.ndarray, lo: float, hi: float, step: float) -> np.ndarray:
-        """The dense states of a -> a + u whose parameter lies in [lo, hi] (the rest is certified); when no
+    def _dense_between(self, a: np.ndarray, u: np.ndarray, lo: float, hi: float) -> np.ndarray:
+        """The dense states of a -> a + u (OMPL's: ``f * ceil(d / step)`` of them at ``validSegmentCountFactor`` f)
+        whose parameter lies in [lo, hi] (the rest is certified); when no
         grid state falls in that gap (it is shorter than a step), its midpoint: never an empty check, so a
         motion with an uncertified stretch is always counted as a fallback."""
-        n = max(1, int(np.ceil(float(np.linalg.norm(u)) / step)))
+        n = self.factor() * max(1, int(np.ceil(float(np.linalg.norm(u)) / self.step)))  # OMPL's count
         t = np.arange(1, n + 1) / n
         t = t[(t >= lo - 1e-12) & (t <= hi + 1e-12)]
         if not len(t):
