@@ -47,3 +47,17 @@ def test_bad_animation_inputs_raise_with_a_message(robot, aimed, tmp_path):
         animate_path(robot, np.zeros((5, 3)), tmp_path / "a.gif")
     with pytest.raises(ValueError, match="unsupported animation format"):
         animate_path(robot, np.tile(q, (3, 1)), tmp_path / "a.avi")
+
+
+@pytest.mark.parametrize("kw, match", [({"frames": 10**6}, "frames"), ({"frames": 2.5}, "frames"), ({"dpi": 0}, "dpi"),
+                                       ({"fps": float("nan")}, "fps"), ({"elev": float("nan")}, "elev")])
+def test_animation_settings_are_value_errors_before_any_frame_is_drawn(robot, tmp_path, kw, match):
+    """(a million frames ran for hours; a NaN camera angle wrote empty frames; a float count was a TypeError)"""
+    with pytest.raises(ValueError, match=match):
+        animate_path(robot, [[0, 0, 0, 0], [0.5, 0.3, 1.0, 0.2]], tmp_path / "a.gif", **kw)
+    assert not list(tmp_path.iterdir())
+
+
+def test_resample_path_refuses_a_count_it_could_not_hold():
+    with pytest.raises(ValueError, match="n"):
+        resample_path([[0.0, 0.0], [1.0, 1.0]], 10**9)

@@ -61,3 +61,13 @@ def test_bad_scene_inputs_raise_with_a_message(robot, aimed):
         render_scene(robot, q, target=[1.0, 2.0])
     with pytest.raises(ValueError, match="shape"):
         render_scene(robot, q[:3])
+
+
+def test_a_figure_name_without_an_image_suffix_is_refused_before_any_folder_is_made(robot, tmp_path):
+    with pytest.raises(ValueError, match="image suffix"):
+        save_scene(robot, np.zeros(4), tmp_path / "new" / "scene.txt")
+    assert not (tmp_path / "new").exists()
+    with pytest.raises(ValueError, match="elev"):
+        save_scene(robot, np.zeros(4), tmp_path / "s.png", elev=float("nan"))  # drew an empty picture
+    with pytest.raises(ValueError, match="out_path"):
+        save_scene(robot, np.zeros(4), None)

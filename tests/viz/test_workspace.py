@@ -38,3 +38,19 @@ def test_sector_pointing_range_marks_reachable_directions(robot):
     assert dirs.shape == (200, 3)
     np.testing.assert_allclose(np.linalg.norm(dirs, axis=1), 1.0)
     assert 0.5 < ok.mean() < 1.0  # most directions reachable, some blind (behind the body)
+
+
+@pytest.mark.parametrize("kw, match", [({"n_samples": 2.5}, "n_samples"), ({"n_samples": 10**12}, "n_samples"),
+                                       ({"rng": 1}, "rng"), ({"ranges": [np.inf]}, "ranges"), ({"ranges": 0.5}, None)])
+def test_workspace_sampling_settings_are_value_errors_naming_them(robot, kw, match):
+    args = {"n_samples": 50, "rng": np.random.default_rng(1), **kw}
+    if match is None:  # one range given as a number is one range
+        assert len(sample_pointing_workspace(robot, **args).points) > 0
+        return
+    with pytest.raises(ValueError, match=match):
+        sample_pointing_workspace(robot, **args)
+
+
+def test_sector_pointing_range_refuses_no_directions(robot):
+    with pytest.raises(ValueError, match="n_dirs"):
+        sector_pointing_range(robot, 1, n_dirs=0)  # warned "mean of empty slice" and drew nan %

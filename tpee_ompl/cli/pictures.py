@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..viz.animation import animate_path
+from ..viz.animation import MAX_FRAMES, animate_path
 from ._common import (
     CliError,
     add_force_arg,
@@ -34,8 +34,6 @@ __all__ = ["ANIMATION_SUFFIXES", "DEFAULT_SCENE_Q", "DEFAULT_SCENE_TARGET", "MAX
 
 ANIMATION_SUFFIXES = (".gif", ".mp4")
 """What ``animate -o`` writes: a GIF (Pillow) or an MP4 (ffmpeg)."""
-MAX_FRAMES = 2000
-"""Most frames ``animate --frames`` accepts (every frame is kept in memory until the file is written)."""
 _LIMIT_TOL = 1e-6
 """Radians a ``--path`` waypoint may lie beyond a joint limit (the decimals ``plan --json`` prints)."""
 

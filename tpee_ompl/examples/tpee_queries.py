@@ -14,15 +14,25 @@ from ..planning.grouped_space import interpolate_waypoints
 from ..planning.paths import motion_is_valid
 from ..model.wearer_arm import WearerArm
 from ..model.sectors import cross_sector_trajectory, posture_preset
+from ..validation import MAX_COUNT, as_float_array, check_bool, check_int
 
-__all__ = ["straight_motion_valid", "cross_sector_query"]
+__all__ = ["cross_sector_query", "straight_motion_valid", "straight_motion_waypoints"]
 
 
 
 def straight_motion_waypoints(i: int, j: int, start: np.ndarray, goal: np.ndarray) -> np.ndarray:
-    """The 7 waypoints (7, 4): Table 3 for DOF1/DOF2, DOF3/DOF4 linear from start to goal."""
+    """The 7 waypoints (7, 4): Table 3 for DOF1/DOF2, DOF3/DOF4 linear from start to goal.
+
+    ValueError when start or goal is not 4 finite numbers at the row's ends (their DOF1/DOF2 would be
+    replaced by the row's, and the answer would be about another motion)."""
+    row = cross_sector_trajectory(i, j)
+    start, goal = as_float_array(start, "start"), as_float_array(goal, "goal")
+    for name, q, end in (("start", start, row[0]), ("goal", goal, row[-1])):
+        if q.shape != (4,) or not np.all(np.isfinite(q)) or not np.allclose(q[:2], end, rtol=0.0, atol=1e-6):
+            raise ValueError(f"{name} must be 4 finite numbers with DOF1/DOF2 at the Table 3 row's end {end.tolist()} "
+                             f"(sectors {i} -> {j}), got {q.tolist()}")
     W = interpolate_waypoints(start, goal, 7)
-    W[:, :2] = cross_sector_trajectory(i, j)
+    W[:, :2] = row
     return W
 
 
@@ -50,6 +60,10 @@ def cross_sector_query(
     """
     if not 0.0 <= limit_margin < 0.5:
         raise ValueError(f"limit_margin must be in [0, 0.5), got {limit_margin!r}")
+    tries = check_int("tries", tries, minimum=1, maximum=MAX_COUNT)
+    need_planning = check_bool("need_planning", need_planning)
+    if not isinstance(rng, np.random.Generator):
+        raise ValueError(f"rng must be a numpy.random.Generator, got {type(rng).__name__}")
     p0, p1 = posture_preset(i), posture_preset(j)
     lo, hi = robot.lower[2:], robot.upper[2:]
     lo, hi = lo + limit_margin * (hi - lo), hi - limit_margin * (hi - lo)

@@ -30,6 +30,16 @@ def new_axes(figsize: tuple[float, float] = (7.0, 7.0), dpi: int = 110) -> Axes:
     return fig.add_subplot(projection="3d")
 
 
+def check_view(elev: float, azim: float, dpi: int) -> None:
+    """The camera angles (degrees, finite) and the resolution (dots per inch, 1..2000); ValueError naming the bad one
+    (a NaN angle drew an empty picture)."""
+    from ..validation import check_int, check_number
+
+    check_number("elev (degrees)", elev)
+    check_number("azim (degrees)", azim)
+    check_int("dpi", dpi, minimum=1, maximum=2000)
+
+
 def set_view(ax: Axes, lo: np.ndarray, hi: np.ndarray, elev: float, azim: float) -> None:
     """Limits [lo, hi] with equal metres per unit on all three axes, the camera, axis labels."""
     ax.set_xlim(lo[0], hi[0])
@@ -83,9 +93,14 @@ def check_waypoints(robot: WearerArm, waypoints: Any) -> np.ndarray:
 
 
 # ---------------------------------------------------------------------------- files
-def output_path(out_path: str | os.PathLike) -> Path:
-    """``out_path`` as a Path, its parent folders created."""
+def output_path(out_path: str | os.PathLike, suffixes: tuple[str, ...] | None = None) -> Path:
+    """``out_path`` as a Path, its parent folders created; ValueError first (nothing made) when it is no path or,
+    with ``suffixes``, its name ends in none of them."""
+    if not isinstance(out_path, (str, os.PathLike)) or not str(out_path):
+        raise ValueError(f"out_path must be a file name, got {out_path!r}")
     out = Path(out_path)
+    if suffixes is not None and out.suffix.lower() not in suffixes:
+        raise ValueError(f"figure file {out}: give a name ending in an image suffix ({', '.join(suffixes[:4])}, ...)")
     out.parent.mkdir(parents=True, exist_ok=True)
     return out
 

@@ -16,16 +16,21 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..files import atomic_path
-from ._common import check_target, check_waypoints, clip_segment, draw_floor, new_axes, output_path, set_view
+from ..validation import MAX_COUNT, check_int
+from ._common import check_target, check_view, check_waypoints, clip_segment, draw_floor, new_axes, output_path, set_view
 from .meshes import arm_polygons, scene_mesh
 from .style import DEFAULT_AZIM, DEFAULT_ELEV, LOS_BLOCKED, LOS_CLEAR
 
 if TYPE_CHECKING:
     from ..model.wearer_arm import WearerArm
 
-__all__ = ["animate_path", "muzzle_trace", "resample_path"]
+__all__ = ["MAX_FRAMES", "animate_path", "muzzle_trace", "resample_path"]
 
 log = logging.getLogger(__name__)
+
+
+MAX_FRAMES = 2000
+"""Most frames an animation takes (every frame is kept in memory until the file is written)."""
 
 
 def resample_path(waypoints: np.ndarray, n: int) -> np.ndarray:
@@ -43,8 +48,7 @@ def resample_path(waypoints: np.ndarray, n: int) -> np.ndarray:
     W = np.asarray(waypoints, dtype=float)
     if W.ndim != 2 or len(W) < 1:
         raise ValueError(f"waypoints must have shape (K, d) with K >= 1; got {W.shape}")
-    if n < 1:
-        raise ValueError(f"n must be >= 1, got {n}")
+    n = check_int("n (points)", n, minimum=1, maximum=MAX_COUNT)
     if len(W) == 1 or n == 1:
         return np.repeat(W[:1], n, axis=0)
     s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(W, axis=0), axis=1))])
@@ -103,10 +107,9 @@ def animate_path(
 
     t0 = time.perf_counter()
     W = check_waypoints(robot, waypoints)
-    if frames < 2:
-        raise ValueError(f"frames must be >= 2, got {frames}")
-    if fps < 1:
-        raise ValueError(f"fps must be >= 1, got {fps}")
+    frames = check_int("frames", frames, minimum=2, maximum=MAX_FRAMES)
+    fps = check_int("fps", fps, minimum=1, maximum=1000)
+    check_view(elev, azim, dpi)
     out = Path(out_path)
     suffix = out.suffix.lower()
     if suffix == ".gif":

@@ -19,7 +19,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..model.sectors import SECTORS, posture_preset
-from ._common import check_target, check_waypoints, clip_segment, draw_floor, new_axes, output_path, set_view, write_figure
+from ..validation import MAX_COUNT, check_int
+from ._common import (check_target, check_view, check_waypoints, clip_segment, draw_floor, image_suffixes, new_axes,
+                      output_path, set_view, write_figure)
 from .animation import muzzle_trace, resample_path
 from .meshes import arm_polygons, scene_mesh
 from .style import DEFAULT_AZIM, DEFAULT_ELEV, LOS_BLOCKED, LOS_CLEAR, SECTOR_COLORS, hex_rgb
@@ -191,6 +193,9 @@ def render_sectors(
     from matplotlib.figure import Figure
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
+    check_view(elev, azim, dpi)
+    n_dirs = check_int("n_dirs", n_dirs, minimum=1, maximum=MAX_COUNT)
+    out = None if out_path is None else output_path(out_path, image_suffixes())  # before the drawing
     mesh = scene_mesh(robot)
     fig = Figure(figsize=(11.0, 10.0), dpi=dpi)
     lo, hi = mesh.view_box([FAN_CENTRE - FAN_RADIUS, FAN_CENTRE + FAN_RADIUS], 10.0)
@@ -216,8 +221,8 @@ def render_sectors(
         )
         ax.legend(loc="upper left", fontsize=7, markerscale=2)
     fig.tight_layout()
-    if out_path is not None:
-        write_figure(fig, output_path(out_path), dpi)
+    if out is not None:
+        write_figure(fig, out, dpi)
     return fig
 
 
@@ -236,6 +241,7 @@ def save_scene(
 
     Returns the written path.  Extra keyword arguments go to :func:`render_scene`.
     """
-    out = output_path(out_path)
+    out = output_path(out_path, image_suffixes())
+    check_view(kwargs.get("elev", DEFAULT_ELEV), kwargs.get("azim", DEFAULT_AZIM), dpi)
     fig = render_scene(robot, q, target=target, sectors=sectors, path=path, **kwargs)
     return write_figure(fig, out, dpi, bbox_inches="tight")

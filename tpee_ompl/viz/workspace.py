@@ -18,8 +18,10 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..model.pointing import MAX_TARGET_DISTANCE
 from ..model.sectors import SECTORS, posture_preset
-from ._common import draw_floor, output_path, set_view, write_figure
+from ..validation import MAX_COUNT, check_int, check_number
+from ._common import check_view, draw_floor, image_suffixes, output_path, set_view, write_figure
 from .meshes import scene_mesh
 from .style import DEFAULT_AZIM, DEFAULT_ELEV, SECTOR_COLORS, SILHOUETTE
 
@@ -72,6 +74,8 @@ def sector_pointing_range(
         Unit vectors, nearly uniform on the sphere.
     reachable : ndarray of bool, shape (n_dirs,)
     """
+    n_dirs = check_int("n_dirs", n_dirs, minimum=1, maximum=MAX_COUNT)
+    los_range = check_number("los_range (metres)", los_range, low=0.0, low_open=True, high=MAX_RANGE)
     d12 = posture_preset(sector)
     q0 = np.concatenate([d12, np.zeros(robot.nq - 2)])
     R3 = robot.joint_placement(q0, robot.joint_names[2]).rotation
@@ -87,6 +91,9 @@ def sector_pointing_range(
             p, u = robot.muzzle(Q[j])
             reachable[j] = robot.line_of_sight_clear(Q[j], p + los_range * u)
     return dirs, reachable
+
+MAX_RANGE = 0.5 * MAX_TARGET_DISTANCE
+"""Metres: the farthest pointing range drawn (its points must stay targets, within ``MAX_TARGET_DISTANCE``)."""
 
 @dataclass(frozen=True)
 class PointingSamples:
@@ -139,11 +146,15 @@ def sample_pointing_workspace(
     -------
     PointingSamples
     """
-    if n_samples < 1:
-        raise ValueError(f"n_samples must be >= 1, got {n_samples}")
-    rs = np.sort(np.asarray(ranges, dtype=float))
-    if rs.ndim != 1 or len(rs) == 0 or not np.all(rs > 0):
-        raise ValueError(f"ranges must be positive distances in metres, got {ranges!r}")
+    n_samples = check_int("n_samples", n_samples, minimum=1, maximum=MAX_COUNT)
+    if not isinstance(rng, np.random.Generator):
+        raise ValueError(f"rng must be a numpy.random.Generator (np.random.default_rng(seed)), got {type(rng).__name__}")
+    try:
+        rs = np.sort(np.atleast_1d(np.asarray(ranges, dtype=float)))
+    except (TypeError, ValueError):
+        raise ValueError(f"ranges must be distances in metres, got {ranges!r}") from None
+    if rs.ndim != 1 or len(rs) == 0 or not np.all((rs > 0) & (rs <= MAX_RANGE)):
+        raise ValueError(f"ranges must be distances in (0, {MAX_RANGE:g}] metres, got {ranges!r}")
     Q = rng.uniform(robot.lower, robot.upper, size=(n_samples, robot.nq))
     if presets_only:
         presets = np.array([posture_preset(k) for k in SECTORS])
@@ -192,6 +203,8 @@ def pointing_workspace(
 
     if color_by not in ("sector", "range"):
         raise ValueError(f"color_by must be 'sector' or 'range', got {color_by!r}")
+    check_view(DEFAULT_ELEV, DEFAULT_AZIM, dpi)
+    out = None if out_path is None else output_path(out_path, image_suffixes())  # before sampling and drawing
     t0 = time.perf_counter()
     s = sample_pointing_workspace(robot, n_samples, rng, ranges=ranges, presets_only=presets_only)
     mesh = scene_mesh(robot)
@@ -252,8 +265,8 @@ def pointing_workspace(
         fontsize=10,
     )
     fig.tight_layout(rect=(0, 0, 1, 0.95))
-    if out_path is not None:
-        write_figure(fig, output_path(out_path), dpi)
+    if out is not None:
+        write_figure(fig, out, dpi)
     log.info(
         "pointing_workspace: %d samples, %d valid, %d points, %.2f s",
         s.n_samples,
