@@ -63,3 +63,11 @@ def test_the_example_runs_as_a_module_and_reports_both_planners() -> None:
                          timeout=120, check=True).stdout.splitlines()
     assert [line.split()[0] for line in out] == ["DimensionRRT", "RRTConnect"]
     assert all("Exact solution" in line and "valid True" in line for line in out)
+
+
+@pytest.mark.parametrize("kw, match", [({"start": (float("nan"), 0, 0, 0)}, "start"), ({"start": (10.0, 0, 0, 0)}, "start"),
+                                       ({"goal": (0.0, 0.0, 0.0)}, "goal"), ({"link_length": float("nan")}, "link_length"),
+                                       ({"resolution": 0.0}, "resolution"), ({"obstacles": [1, 2]}, "obstacles")])
+def test_the_example_setup_names_a_bad_argument(kw, match):
+    with pytest.raises(ValueError, match=match):
+        make_planar_arm_setup(**kw)

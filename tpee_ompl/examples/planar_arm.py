@@ -67,19 +67,33 @@ def make_planar_arm_setup(
 
     The default query sweeps the stretched arm from 0.3 rad to 2.6 rad past an obstacle above the
     base, so the arm must fold to pass.  ``ss.getStateValidityChecker()`` returns the
-    :class:`PlanarArm` checker itself (its ``are_valid``, ``points`` and ``collision_checks``).
+    :class:`PlanarArm` checker itself (its ``are_valid``, ``points`` and ``collision_checks``).  ValueError naming
+    the argument for a start or goal that is not 4 angles in [-pi, pi], obstacles that are not rows of finite
+    (x, y, radius > 0), a link length that is not a finite number > 0, or a resolution outside (0, 1).
     """
+    ends = {}
+    for name, q in (("start", start), ("goal", goal)):
+        ends[name] = np.asarray(q, dtype=float)
+        if ends[name].shape != (4,) or not np.all(np.abs(ends[name]) <= np.pi):  # NaN fails too
+            raise ValueError(f"{name} must be 4 joint angles in [-pi, pi], got {q!r}")
+    obs = np.asarray(obstacles, dtype=float)
+    if obs.ndim != 2 or obs.shape[1] != 3 or not np.all(np.isfinite(obs)) or np.any(obs[:, 2] <= 0):
+        raise ValueError(f"obstacles must be rows of finite (x, y, radius > 0), got {obstacles!r}")
+    if not (np.isfinite(link_length) and link_length > 0):
+        raise ValueError(f"link_length must be a finite number > 0, got {link_length!r}")
+    if not 0.0 < resolution < 1.0:  # NaN fails too
+        raise ValueError(f"resolution must be in (0, 1) (a fraction of the space's extent), got {resolution!r}")
     space = ob.RealVectorStateSpace(4)
     space.setBounds(-np.pi, np.pi)
     ss = og.SimpleSetup(space)
     si = ss.getSpaceInformation()
-    checker = PlanarArm(si, link_length, np.asarray(obstacles))
+    checker = PlanarArm(si, float(link_length), obs)
     ss.setStateValidityChecker(checker)
     si.setStateValidityCheckingResolution(resolution)
     ss.setOptimizationObjective(ob.PathLengthOptimizationObjective(si))
     s0, s1 = si.allocState(), si.allocState()
-    s0[0:4] = [float(v) for v in start]
-    s1[0:4] = [float(v) for v in goal]
+    s0[0:4] = ends["start"].tolist()
+    s1[0:4] = ends["goal"].tolist()
     ss.setStartAndGoalStates(s0, s1, 1e-9)
     ss._planar_arm = checker  # type: ignore[attr-defined]  # keep the Python checker alive
     si.setup()
