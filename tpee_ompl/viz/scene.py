@@ -19,7 +19,6 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..model.sectors import SECTORS, posture_preset
-from ..validation import MAX_COUNT, check_int
 from ._common import (check_target, check_view, check_waypoints, clip_segment, draw_floor, image_suffixes, new_axes,
                       output_path, set_view, write_figure)
 from .animation import muzzle_trace, resample_path
@@ -194,7 +193,6 @@ def render_sectors(
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
     check_view(elev, azim, dpi)
-    n_dirs = check_int("n_dirs", n_dirs, minimum=1, maximum=MAX_COUNT)
     out = None if out_path is None else output_path(out_path, image_suffixes())  # before the drawing
     mesh = scene_mesh(robot)
     fig = Figure(figsize=(11.0, 10.0), dpi=dpi)
