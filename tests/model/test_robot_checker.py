@@ -396,3 +396,14 @@ def test_lookups_by_an_unknown_name_are_value_errors_naming_it(robot):
         RobotChecker(robot.files.urdf, package_dirs=3)
     with pytest.raises(ValueError, match="displacement"):
         robot.max_joint_step("x")
+
+
+def test_check_free_returns_a_free_configuration_and_names_one_out_of_limits_or_colliding(robot, rng) -> None:
+    free, colliding = valid_and_colliding(robot, rng, 1)
+    np.testing.assert_array_equal(robot.check_free(list(free[0]), "start"), free[0])
+    with pytest.raises(ValueError, match=r"^goal \[.*\] is in collision \(.+ vs .+, distance -?\d"):
+        robot.check_free(colliding[0], "goal")
+    with pytest.raises(ValueError, match=r"^start \[.*\] is outside the joint limits"):
+        robot.check_free(robot.upper + 0.1, "start")
+    with pytest.raises(ValueError, match=r"^initial configuration: configuration contains NaN"):
+        robot.check_free(np.full(robot.nq, np.nan), "initial configuration")

@@ -149,7 +149,8 @@ def run_query(args: argparse.Namespace) -> int:
         i, j = args.from_sector, args.to_sector
         start, goal, off_posture = on_postures(args.start, args.goal, i, j)
         with argument("--start/--goal"):
-            _check_endpoints(default_robot(), start, goal)
+            robot = default_robot()
+            robot.check_free(start, "start"), robot.check_free(goal, "goal")
         if off_posture:
             raise CliError(off_posture)
     lib = _load(Path(args.library), fallback=not args.no_fallback)
@@ -163,15 +164,6 @@ def run_query(args: argparse.Namespace) -> int:
         print(f"{i}->{j}: {res.outcome} (demo {res.demo_index}, {res.candidates_tried} DMP candidates) "
               f"in {res.seconds * 1e3:.1f} ms{extra}")
     return 0 if res.path is not None else 1
-
-
-def _check_endpoints(robot, start: np.ndarray, goal: np.ndarray) -> None:
-    """Start and goal are collision-free configurations inside the joint limits (ValueError naming which)."""
-    for name, q in (("start", start), ("goal", goal)):
-        if not robot.within_limits(q):
-            raise ValueError(f"{name} {np.round(q, 4).tolist()} is outside the joint limits")
-        if not robot.is_valid(q):
-            raise ValueError(f"{name} {np.round(q, 4).tolist()} is in collision")
 
 
 def run_stats(args: argparse.Namespace) -> int:

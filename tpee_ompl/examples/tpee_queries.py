@@ -10,8 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..planning.grouped_space import interpolate_waypoints
 from ..planning.paths import motion_is_valid
+from ..model.queries import straight_motion
 from ..model.wearer_arm import WearerArm
 from ..model.sectors import cross_sector_trajectory, posture_preset
 from ..validation import MAX_COUNT, as_float_array, check_bool, check_int
@@ -19,21 +19,19 @@ from ..validation import MAX_COUNT, as_float_array, check_bool, check_int
 __all__ = ["cross_sector_query", "straight_motion_valid", "straight_motion_waypoints"]
 
 
-
 def straight_motion_waypoints(i: int, j: int, start: np.ndarray, goal: np.ndarray) -> np.ndarray:
     """The 7 waypoints (7, 4): Table 3 for DOF1/DOF2, DOF3/DOF4 linear from start to goal.
 
-    ValueError when start or goal is not 4 finite numbers at the row's ends (their DOF1/DOF2 would be
-    replaced by the row's, and the answer would be about another motion)."""
+    ValueError when start or goal is not 4 finite numbers at the row's ends (the interior follows the row,
+    so the answer would be about another motion); the waypoints are
+    :func:`~tpee_ompl.model.queries.straight_motion`'s."""
     row = cross_sector_trajectory(i, j)
     start, goal = as_float_array(start, "start"), as_float_array(goal, "goal")
     for name, q, end in (("start", start, row[0]), ("goal", goal, row[-1])):
         if q.shape != (4,) or not np.all(np.isfinite(q)) or not np.allclose(q[:2], end, rtol=0.0, atol=1e-6):
             raise ValueError(f"{name} must be 4 finite numbers with DOF1/DOF2 at the Table 3 row's end {end.tolist()} "
                              f"(sectors {i} -> {j}), got {q.tolist()}")
-    W = interpolate_waypoints(start, goal, 7)
-    W[:, :2] = row
-    return W
+    return straight_motion(start, goal, i, j)
 
 
 def straight_motion_valid(robot: WearerArm, i: int, j: int, start: np.ndarray, goal: np.ndarray) -> bool:

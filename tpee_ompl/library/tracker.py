@@ -146,11 +146,7 @@ class Tracker:
                              "(initial_sector)")
         self.check_step = motion_step(robot, self.options.check_step)
         """The step the tracker checks its motions at: ``check_step``, at most the robot's ``max_joint_step()``."""
-        if not robot.within_limits(q0):
-            raise ValueError(f"initial configuration {np.round(q0, 4).tolist()} is outside the joint limits")
-        if not robot.is_valid(q0):
-            raise ValueError(f"initial configuration {np.round(q0, 4).tolist()} is in collision")
-        self.q = q0.copy()
+        self.q = robot.check_free(q0, "initial configuration").copy()
         self.time = -math.inf
         self._times: list[float] = []
         self._qs: list[np.ndarray] = []

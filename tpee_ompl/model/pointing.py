@@ -44,7 +44,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..validation import as_float_array, check_bool
-from .wearer_arm import MAX_TARGET_DISTANCE, MUZZLE_FRAME, WearerArm, default_robot
+from .wearer_arm import MAX_TARGET_DISTANCE, MUZZLE_FRAME, WearerArm, check_target_point, default_robot
 from .sectors import posture_preset
 
 __all__ = [
@@ -374,15 +374,9 @@ def check_target(target: np.ndarray, robot: WearerArm | None = None) -> np.ndarr
     line of sight can reach them.
     """
     try:
-        t = as_float_array(target, "target")
+        t = check_target_point(target)
     except ValueError as exc:
-        raise UnreachableTargetError(str(exc)) from exc
-    if t.shape != (3,):
-        raise UnreachableTargetError(f"target must have shape (3,); got {t.shape}")
-    if not np.all(np.isfinite(t)):
-        raise UnreachableTargetError(f"target {t} is not finite")
-    if np.max(np.abs(t)) > MAX_TARGET_DISTANCE:
-        raise UnreachableTargetError(f"target {t} is farther than MAX_TARGET_DISTANCE = {MAX_TARGET_DISTANCE:g} m")
+        raise UnreachableTargetError(str(exc)) from None
     if robot is not None:
         point = coal.Sphere(1e-6)
         tf = coal.Transform3s(np.eye(3), t)

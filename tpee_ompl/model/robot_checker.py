@@ -338,6 +338,21 @@ class RobotChecker:
         q = self.check_config(q)
         return bool(np.all(q >= self.lower) and np.all(q <= self.upper))
 
+    def check_free(self, q: np.ndarray, name: str = "configuration") -> np.ndarray:
+        """Return q (nq,) when it is finite, inside the joint limits and collision-free, else raise ValueError
+        naming ``name`` and, for a collision, the closest pair (a planning or tracking endpoint's check)."""
+        try:
+            q = self.check_config(q)
+        except ValueError as exc:
+            raise ValueError(f"{name}: {exc}") from None
+        shown = f"[{', '.join(f'{v:.4g}' for v in q)}]"
+        if not self.within_limits(q):
+            raise ValueError(f"{name} {shown} is outside the joint limits")
+        if not self.is_valid(q):
+            a, b, d = self.closest_pair(q)
+            raise ValueError(f"{name} {shown} is in collision ({a} vs {b}, distance {d:.3f} m)")
+        return q
+
     def frame_placement(self, q: np.ndarray, frame: str) -> pin.SE3:
         """World placement of a named frame at configuration q."""
         q = self.check_config(q)

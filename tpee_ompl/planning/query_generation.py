@@ -20,7 +20,7 @@ from ..model.pointing import PointingGeometry, aim_checked
 from ..model.queries import Query, straight_motion
 from ..model.sectors import POSTURE_AZIMUTH, SECTORS, in_pointing_sector
 from ..model.wearer_arm import WearerArm
-from .paths import polyline_motion_states
+from .paths import motion_is_valid
 
 __all__ = [
     "NECESSITY_REGIONS",
@@ -120,9 +120,7 @@ def straight_motion_valid(
     robot: WearerArm, start: np.ndarray, goal: np.ndarray, i: int, j: int, step: float = STRAIGHT_MOTION_STEP
 ) -> bool:
     """True if every state along the straight motion (checked every ``step`` rad) is collision-free."""
-    w = straight_motion(start, goal, i, j)
-    states = polyline_motion_states(w, step)
-    return bool(robot.are_valid(states).all())
+    return motion_is_valid(robot, straight_motion(start, goal, i, j), step)
 
 
 def _sample_aimable(

@@ -248,21 +248,10 @@ def make_simple_setup(
     if start is not None or goal is not None:
         if start is None or goal is None:
             raise ValueError("give both start and goal, or neither")
-        try:
-            q0 = robot.check_config(start)
-        except ValueError as exc:
-            raise ValueError(f"start: {exc}") from None
-        try:
-            q1 = robot.check_config(goal)
-        except ValueError as exc:
-            raise ValueError(f"goal: {exc}") from None
         if check_endpoints:
-            for name, q in (("start", q0), ("goal", q1)):
-                if not robot.within_limits(q):
-                    raise ValueError(f"{name} [{', '.join(f'{v:.4g}' for v in q)}] is outside the joint limits")
-                if not robot.is_valid(q):
-                    a, b, d = robot.closest_pair(q)
-                    raise ValueError(f"{name} [{', '.join(f'{v:.4g}' for v in q)}] is in collision ({a} vs {b}, distance {d:.3f} m)")
+            q0, q1 = robot.check_free(start, "start"), robot.check_free(goal, "goal")
+        else:
+            q0, q1 = _named_config(robot, start, "start"), _named_config(robot, goal, "goal")
         s0, s1 = si.allocState(), si.allocState()
         set_state(s0, q0)
         set_state(s1, q1)
@@ -283,6 +272,14 @@ def _motion_validator_kind(name: str | None, batched: bool | None) -> str:
     if (old == "discrete") != (name == "discrete") and old is not None:
         raise ValueError(f"batched_motion_validator={batched} contradicts motion_validator={name!r}")
     return name
+
+
+def _named_config(robot: RobotChecker, q: np.ndarray, name: str) -> np.ndarray:
+    """q as (nq,) finite numbers, else ValueError starting with ``name``."""
+    try:
+        return robot.check_config(q)
+    except ValueError as exc:
+        raise ValueError(f"{name}: {exc}") from None
 
 
 def motion_check_step(setup: og.SimpleSetup | ob.SpaceInformation) -> float:
