@@ -12,8 +12,8 @@ from pathlib import Path
 import pytest
 
 PACKAGE = Path(__file__).resolve().parents[1] / "tpee_ompl"
-FLOORS = {"validation": 0, "resources": 0, "files": 0, "signals": 0, "model": 1, "planning": 2, "viz": 2, "library": 3, "examples": 3,
-          "bench": 4, "cli": 5}
+FLOORS = {"_version": 0, "validation": 0, "resources": 0, "files": 0, "signals": 0, "model": 1, "planning": 2, "viz": 2, "library": 3, "examples": 3,
+          "bench": 4, "cli": 5, "__init__": 5}
 MAX_LINES = 500
 
 
@@ -28,8 +28,13 @@ def _unit(path: Path) -> str:
 
 
 def _imported_units(path: Path) -> set[str]:
-    tree = ast.parse(path.read_text())
     package = path.relative_to(PACKAGE.parent).with_suffix("").parts[:-1]  # e.g. ("tpee_ompl", "bench")
+    return _units_of(path.read_text(), package)
+
+
+def _units_of(source: str, package: tuple[str, ...]) -> set[str]:
+    """The floor units a module's source imports, the module being in ``package``."""
+    tree = ast.parse(source)
     units = set()
     for node in ast.walk(tree):
         if isinstance(node, ast.ImportFrom):
@@ -46,9 +51,21 @@ def _imported_units(path: Path) -> set[str]:
         else:
             continue
         for parts in names:
-            if len(parts) >= 2 and parts[0] == "tpee_ompl":
+            if parts[0] != "tpee_ompl":
+                continue
+            if len(parts) >= 2 and _is_unit(parts[1]):
                 units.add(parts[1])
+            else:  # the top-level package itself (``import tpee_ompl``, ``from .. import name``): it imports every floor
+                units.add(TOP)
     return units
+
+
+TOP = "__init__"
+"""The top-level package as an import target: it exports the public API from every floor below the CLI."""
+
+
+def _is_unit(name: str) -> bool:
+    return (PACKAGE / name).is_dir() or (PACKAGE / f"{name}.py").is_file()
 
 
 @pytest.mark.parametrize("path", _modules(), ids=lambda p: str(p.relative_to(PACKAGE)))
@@ -62,3 +79,10 @@ def test_module_imports_only_its_own_folder_or_lower_floors(path: Path):
 @pytest.mark.parametrize("path", _modules(), ids=lambda p: str(p.relative_to(PACKAGE)))
 def test_module_stays_under_the_size_limit(path: Path):
     assert len(path.read_text().splitlines()) <= MAX_LINES
+
+
+@pytest.mark.parametrize("source", ["import tpee_ompl", "from tpee_ompl import WearerArm", "from .. import __version__",
+                                    "import tpee_ompl.bench"])
+def test_an_import_of_the_top_level_package_or_a_higher_floor_counts_against_a_lower_one(source: str):
+    units = _units_of(source, ("tpee_ompl", "model"))
+    assert units & {TOP, "bench"} and any(FLOORS[u] > FLOORS["model"] for u in units)
