@@ -84,7 +84,16 @@ def test_smoke_campaign_fills_the_database(query_file, tmp_path):
                         "ON runs.plannerid = plannerConfigs.id WHERE plannerConfigs.name='geometric_RRTstar'").fetchone()
     assert graph[0] > 0 and graph[1] > 0
     params = con.execute("SELECT query_id, from_sector, to_sector, query_set FROM experiments").fetchall()
-    assert ("0", 1, 2, "tiny") in params
+    assert (0, 1, 2, "tiny") in params  # numbers as numbers: Planner Arena compares a numeric-looking filter as one
+    # one experiment name per comparison, cap or budget and validator, its queries told apart by query_id
+    names = con.execute("SELECT name, COUNT(DISTINCT query_id) FROM experiments GROUP BY name").fetchall()
+    assert sorted(names) == [("anytime_tiny_T0.05s_batched", 2), ("iterations_tiny_N30_batched", 2),
+                             ("iterations_tiny_N60_batched", 2)]
+    # each progress row carries its run's experiment parameters (Planner Arena filters progress rows by them)
+    assert con.execute("SELECT COUNT(*) FROM progress JOIN runs ON progress.runid = runs.id JOIN experiments "
+                       "ON runs.experimentid = experiments.id WHERE progress.query_id IS NOT experiments.query_id "
+                       "OR progress.sample_cap IS NOT experiments.sample_cap").fetchone()[0] == 0
+    assert con.execute("SELECT COUNT(*) FROM progress WHERE tpee_ompl_version IS NULL").fetchone()[0] == 0
     con.close()
     table = (res.directory / "table4.csv").read_text()
     assert table.splitlines()[0].endswith(",paper") and "length_dof12" in table

@@ -67,9 +67,10 @@ def test_benchmark_aborted_by_a_python_callback_records_failed_runs_and_restores
 
 
 def _experiment_names(db: Path) -> list[str]:
+    """"experiment name/qNNN" per experiment (one name is shared by the queries)."""
     con = sqlite3.connect(db)
     try:
-        return [r[0] for r in con.execute("SELECT name FROM experiments")]
+        return [r[0] for r in con.execute("SELECT printf('%s/q%03d', name, query_id) FROM experiments")]
     finally:
         con.close()
 
@@ -171,7 +172,7 @@ def test_signal_keeps_finished_runs_never_half_writes_the_db_and_resume_complete
     assert len(logs) == meta["expected_experiments"]
     assert all(logs[name] == data for name, data in kept.items())  # finished logs untouched
     con = sqlite3.connect(db)
-    names = [r[0] for r in con.execute("SELECT name FROM experiments")]
+    names = [r[0] for r in con.execute("SELECT printf('%s/q%03d', name, query_id) FROM experiments")]
     con.close()
     assert len(names) == len(set(names)) == meta["expected_experiments"]
     assert len(list(tmp_path.glob("*_sig"))) == 1  # resumed in place, no new folder

@@ -81,7 +81,7 @@ def test_killed_dask_worker_has_its_task_retried_and_nothing_is_lost_or_doubled(
     tasks = [json.loads(line) for line in (res.directory / "tasks.jsonl").read_text().splitlines()]
     assert sorted(t["qpos"] for t in tasks) == [0, 1, 2]
     con = sqlite3.connect(res.database)
-    per_exp = con.execute("SELECT experiments.name, COUNT(*) FROM runs JOIN experiments "
-                          "ON runs.experimentid = experiments.id GROUP BY experiments.name").fetchall()
+    per_exp = con.execute("SELECT printf('%s/q%03d', experiments.name, experiments.query_id), COUNT(*) FROM runs JOIN experiments "
+                          "ON runs.experimentid = experiments.id GROUP BY experiments.id").fetchall()
     con.close()
     assert len(per_exp) == 3 and all(n == 2 for _, n in per_exp)

@@ -23,11 +23,12 @@ def query_file(tmp_path_factory, robot) -> Path:
 
 
 def _experiments(db: Path) -> list[tuple[str, int]]:
-    """(experiment name, runs) per experiment of the database."""
+    """("experiment name/qNNN", runs) per experiment of the database (one name is shared by the queries)."""
     con = sqlite3.connect(db)
     try:
-        return con.execute("SELECT experiments.name, COUNT(runs.id) FROM experiments LEFT JOIN runs "
-                           "ON runs.experimentid = experiments.id GROUP BY experiments.id").fetchall()
+        return con.execute("SELECT printf('%s/q%03d', experiments.name, experiments.query_id), COUNT(runs.id) "
+                           "FROM experiments LEFT JOIN runs ON runs.experimentid = experiments.id "
+                           "GROUP BY experiments.id").fetchall()
     finally:
         con.close()
 

@@ -12,11 +12,11 @@ from tpee_ompl.bench.report import (PAPER_TABLE4, anytime_quality_table, best_fo
                                     success_table, summarize)
 
 
-def run(planner, qid, cap, time, length, l12, l34, ok=True, straight=1.0):
-    return {"planner": planner, "query_id": str(qid), "comparison": "iterations", "motion_validator": "batched",
+def run(planner, qid, cap, time, length, l12, l34, ok=True, straight=1.0, from_sector=1):
+    return {"planner": planner, "query_id": qid, "comparison": "iterations", "motion_validator": "batched",
             "sample_cap": cap, "time_budget": 0.0, "time": time, "solution_length": length if ok else None,
             "length_dof12": l12, "length_dof34": l34, "success": ok, "solved": 1 if ok else 0,
-            "straight_length": straight}
+            "straight_length": straight, "from_sector": from_sector}
 
 
 def test_ratio_is_the_mean_of_per_query_ratios_not_the_ratio_of_means():
@@ -27,6 +27,15 @@ def test_ratio_is_the_mean_of_per_query_ratios_not_the_ratio_of_means():
     assert table["length"]["median"] == pytest.approx((0.5 + 3.0) / 2)
     assert table["length_dof12"]["mean"] == pytest.approx((0.5 + 3.0) / 2)
     assert table["length"]["paper"] == PAPER_TABLE4[500]["length"] and table["length"]["n"] == 2
+
+
+def test_a_problem_without_sectors_gets_its_own_labels_and_no_paper_figures(tmp_path):
+    runs = [run("D", q, 500, 1.0, 2.0, 1.0, 1.0, from_sector=0) for q in (0, 1)]
+    runs += [run("R", q, 500, 2.0, 4.0, 2.0, 2.0, from_sector=0) for q in (0, 1)]
+    table = {r["metric"]: r for r in ratio_table(runs, "D", "R")}
+    assert math.isnan(table["length"]["paper"]) and table["length"]["label"] == "Path length"
+    text = report._markdown(list(table.values()), [], [], [], "D", "R", "batched")
+    assert "DOF1" not in text and "paper" not in text and "| First group's length |" in text
 
 
 def test_failed_runs_are_counted_and_excluded_from_ratios():
@@ -127,7 +136,7 @@ def test_within_share_averages_a_querys_runs_and_is_per_budget():
 
 
 def test_best_found_is_the_shortest_successful_path_of_any_planner_and_comparison():
-    assert best_found(anytime_campaign()) == {"0": 2.0, "1": 3.0, "2": 4.0, "3": 4.8}
+    assert best_found(anytime_campaign()) == {0: 2.0, 1: 3.0, 2: 4.0, 3: 4.8}
 
 
 def test_report_has_the_anytime_quality_section_and_csv(tmp_path, monkeypatch):

@@ -19,6 +19,7 @@ import contextlib
 import io
 import logging
 import os
+import sqlite3
 import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -38,7 +39,7 @@ log = logging.getLogger(__name__)
 
 def failed_run_properties(error: str) -> dict:
     """The extra run properties of a run that failed with ``error`` (a planner or callback exception)."""
-    return {"planner_error INTEGER": 1, "path_valid_dense INTEGER": 0, "reaches_goal INTEGER": 0,
+    return {"planner_error INTEGER": 1, "path_valid_dense INTEGER": None, "reaches_goal INTEGER": 0,
             "error_message TEXT": error[:200].replace("\n", " ").replace(";", ",")}
 
 
@@ -66,8 +67,8 @@ def pad_aborted_runs(bench, records: dict, run_count: int, error: str) -> None:
 
 PER_QUERY_SETTINGS = ("seed", "pair")
 """Planner settings that change from query to query (the process seed, the sector pair).  Kept out of
-the planner's configuration, so Planner Arena groups one planner's runs across queries: the seeds are
-in the ``experiments`` table (``process_seed``) and the pair in its query columns."""
+the planner's configuration, so one planner has one configuration across queries: the seeds are in the
+``experiments`` table (``process_seed``) and the pair in its query columns."""
 
 
 SAMPLED_SPACE_SETTINGS = ("projection.cellsize",)
@@ -178,7 +179,35 @@ def build_database(logs: Sequence[os.PathLike], db_path: os.PathLike) -> tuple[P
         tmp.unlink()  # readBenchmarkLog creates the database itself
         ot.readBenchmarkLog(str(tmp), [str(p) for p in good], False)
         ot.computeViews(str(tmp), False)
+        _parameters_on_progress_rows(tmp)
     return db_path, bad
+
+
+EXPERIMENT_COLUMNS = 12
+"""The ``experiments`` table's own columns (id, name, ..., setup); the experiment parameters follow them."""
+
+
+def _parameters_on_progress_rows(db: Path) -> None:
+    """Repeat each run's experiment parameters on its ``progress`` rows.
+
+    Planner Arena (1.0.1) filters the progress rows by every experiment parameter, as it does the runs, but
+    joins them with the runs' id and planner only: without the parameters there, its progress tab fails on
+    any database with experiment parameters (``ColumnNotFoundError``)."""
+    con = sqlite3.connect(str(db))
+    try:
+        params = [r[1] for r in con.execute("PRAGMA table_info(experiments)")][EXPERIMENT_COLUMNS:]
+        have = {r[1] for r in con.execute("PRAGMA table_info(progress)")}
+        if not have:
+            return
+        for c in params:
+            if c in have:
+                continue
+            con.execute(f'ALTER TABLE progress ADD COLUMN "{c}"')
+            con.execute(f'UPDATE progress SET "{c}" = (SELECT experiments."{c}" FROM runs JOIN experiments '
+                        'ON runs.experimentid = experiments.id WHERE runs.id = progress.runid)')
+        con.commit()
+    finally:
+        con.close()
 
 
 class _EofGuardedFile:

@@ -36,11 +36,12 @@ from ..planning.paths import path_length, path_passes_motion_checks
 from .database import failed_run_properties, pad_aborted_runs, patch_recorded_data
 from .planners import SINGLE_USE_PLANNERS, PlannerContext, RecordingPlanner, planner_factory
 from .problems import get_problem
+from .._version import __version__
 from ..files import write_new_file
 from .results import format_value
 from ..validation import sub_seed
 
-__all__ = ["experiment_specs", "group_lengths", "log_name", "run_query_task"]
+__all__ = ["experiment_name", "experiment_specs", "group_lengths", "log_name", "run_query_task"]
 
 log = logging.getLogger(__name__)
 
@@ -171,6 +172,16 @@ def _guarded(fn: Callable, *args) -> None:
         log.exception("benchmark event %s failed", getattr(fn, "__name__", fn))
 
 
+def experiment_name(query_set: str, spec: dict) -> str:
+    """The OMPL experiment name: comparison, query set, cap or budget and validator, the same for every query.
+
+    Planner Arena pools the runs of experiments with one name (its "problem") and offers the experiment
+    parameters (``query_id``, ...) as filters within it, so a planner's runs at one cap are one box over
+    the campaign's queries rather than one point per query."""
+    setting = f"N{spec['cap']}" if spec["cap"] is not None else f"T{spec['budget']:g}s"
+    return f"{spec['comparison']}_{query_set}_{setting}_{spec['checker']}"
+
+
 def _experiment_parameters(cfg: dict, task: dict, spec: dict, straight: float, model_hash: str) -> dict:
     """The experiment's parameters (``"name TYPE": text``), columns of the ``experiments`` table.
 
@@ -180,7 +191,7 @@ def _experiment_parameters(cfg: dict, task: dict, spec: dict, straight: float, m
     return {
         "comparison TEXT": spec["comparison"],
         "query_set TEXT": task["query_set"],
-        "query_id TEXT": str(query["id"]),
+        "query_id INTEGER": str(int(query["id"])),
         "query_index INTEGER": str(int(task["qpos"])),
         "from_sector INTEGER": str(int(query.get("from_sector", 0))),
         "to_sector INTEGER": str(int(query.get("to_sector", 0))),
@@ -191,6 +202,7 @@ def _experiment_parameters(cfg: dict, task: dict, spec: dict, straight: float, m
         "campaign_seed INTEGER": str(cfg["seed"]),
         "process_seed INTEGER": str(task["seed"]),
         "model_hash TEXT": str(model_hash),
+        "tpee_ompl_version TEXT": __version__,  # the log's version line is OMPL's
     }
 
 
@@ -200,9 +212,11 @@ def _path_properties(si, rec: dict, start: np.ndarray, goal: np.ndarray, first: 
     W = rec.get("waypoints")
     if W is None or len(W) < 1:
         return {}
+    ends = bool(np.all(np.abs(layout.delta(W[0], start)) <= 1e-6) and np.all(np.abs(layout.delta(W[-1], goal)) <= 1e-6))
+    if len(W) < 2 and not ends:  # one state short of the goal (AORRTC's timeout answer) is no path to measure
+        return {}
     l4, l12, l34 = group_lengths(W, first, layout) if len(W) >= 2 else (0.0, 0.0, 0.0)
     ok = path_passes_motion_checks(si, W if layout.is_plain else layout.to_path(si, W))
-    ends = bool(np.all(np.abs(layout.delta(W[0], start)) <= 1e-6) and np.all(np.abs(layout.delta(W[-1], goal)) <= 1e-6))
     best = rec["best_cost"]
     if best is None or not math.isfinite(float(best)):  # a planner without bestCost(): its path's length, when
         best = l4 if ends else None  # it reaches the goal (an approximate path's length is no best cost)
@@ -240,8 +254,7 @@ def _run_experiment(cfg: dict, task: dict, spec: dict, ladder=None, only: list[s
     layout = RealVectorLayout(si.getStateSpace())
     straight = si.distance(layout.write(si.allocState(), start), layout.write(si.allocState(), goal))
     cap, budget = spec["cap"], spec["budget"]
-    name = (f"{spec['comparison']}_{task['query_set']}_q{qpos:03d}_"
-            + (f"N{cap}" if cap is not None else f"T{budget:g}s") + f"_{spec['checker']}")
+    name = experiment_name(task["query_set"], spec)
     bench = ot.Benchmark(ss, name)
     for k, v in _experiment_parameters(cfg, task, spec, straight, checker.model_hash).items():
         pname, ptype = k.rsplit(" ", 1)
@@ -295,7 +308,7 @@ def _run_experiment(cfg: dict, task: dict, spec: dict, ladder=None, only: list[s
             "length_dof12 REAL": None,
             "length_dof34 REAL": None,
             "raw_length REAL": None,
-            "path_valid_dense INTEGER": 0,
+            "path_valid_dense INTEGER": None,  # no path: NULL (0 is a path that failed the check)
             "reaches_goal INTEGER": 0,
             "planner_error INTEGER": int(rec["error"] is not None),
         }

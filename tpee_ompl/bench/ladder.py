@@ -359,7 +359,7 @@ class Ladder:
         out.update({"collision_checks INTEGER": checks, "iterations INTEGER": snap["iterations"],
                     "samples INTEGER": snap["iterations"], "first_solution_time REAL": first,
                     "best_cost REAL": None, "length_dof12 REAL": None, "length_dof34 REAL": None,
-                    "raw_length REAL": None, "path_valid_dense INTEGER": 0, "reaches_goal INTEGER": 0})
+                    "raw_length REAL": None, "path_valid_dense INTEGER": None, "reaches_goal INTEGER": 0})
         if snap.get("graph_states") is not None:
             out["graph states INTEGER"] = snap["graph_states"]
             out["graph motions INTEGER"] = snap["graph_motions"]

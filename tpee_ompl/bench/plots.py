@@ -61,18 +61,21 @@ def _make_plots(db_path: str | Path, directory: str | Path, planner: str | None,
         ratios = ratio_table(runs, planner, reference)
         for chk in sorted({r["checker"] for r in ratios}):
             fig, ax = plt.subplots(figsize=(7, 4.5))
-            for k, (key, (_, label)) in enumerate(RATIO_METRICS.items()):
+            has_paper = any(not math.isnan(r["paper"]) for r in ratios)
+            for k, key in enumerate(RATIO_METRICS):
                 rows = sorted((r for r in ratios if r["checker"] == chk and r["metric"] == key), key=lambda r: r["sample_cap"])
                 caps = [r["sample_cap"] for r in rows]
                 color = f"C{k}"
-                ax.plot(caps, [r["mean"] for r in rows], "o-", color=color, label=f"{label} (mean)")
+                ax.plot(caps, [r["mean"] for r in rows], "o-", color=color, label=f"{rows[0]['label']} (mean)")
                 ax.fill_between(caps, [r["q1"] for r in rows], [r["q3"] for r in rows], color=color, alpha=0.15)
-                pc = sorted(PAPER_TABLE4)
-                ax.plot(pc, [PAPER_TABLE4[c][key] for c in pc], "x:", color=color, alpha=0.8)
+                if has_paper:  # the paper's Table 4 is the wearer's
+                    pc = sorted(PAPER_TABLE4)
+                    ax.plot(pc, [PAPER_TABLE4[c][key] for c in pc], "x:", color=color, alpha=0.8)
             ax.axhline(1.0, color="grey", lw=0.8)
             ax.set_xlabel("samples (dimension-RRT) = iterations (RRT*)")
             ax.set_ylabel(f"{planner} / {reference}")
-            ax.set_title(f"Per-query ratios ({chk} motion validator); dotted x: paper Table 4; band: Q1-Q3")
+            paper = "; dotted x: paper Table 4" if has_paper else ""
+            ax.set_title(f"Per-query ratios ({chk} motion validator){paper}; band: Q1-Q3")
             ax.title.set_fontsize(9)
             ax.legend(fontsize=7)
             fig.tight_layout()

@@ -54,7 +54,16 @@ RATIO_METRICS = {
     "length_dof34": ("length_dof34", "DOF3/DOF4-group length"),
     "length_dof12": ("length_dof12", "DOF1/DOF2-group length"),
 }
-"""Metric key -> (runs column, label)."""
+"""Metric key -> (runs column, label) on the wearer, whose groups are DOF1/DOF2 and DOF3/DOF4."""
+
+GENERIC_LABELS = {"time": "Time", "length": "Path length", "length_dof34": "Other DOFs' length",
+                  "length_dof12": "First group's length"}
+"""The metrics' labels on a problem without the wearer's sectors (its first group and the rest; no paper figures)."""
+
+
+def _is_tpee(runs: Sequence[dict]) -> bool:
+    """True when the runs are the wearer's cross-sector queries (the paper's Table 4 applies): they have sectors."""
+    return any(r.get("from_sector") for r in runs)
 
 
 def _columns(con: sqlite3.Connection, table: str) -> set[str]:
@@ -142,6 +151,7 @@ def ratio_table(runs: list[dict], planner: str, reference: str, checker: str | N
     """
     out = []
     it = [r for r in runs if r["comparison"] == "iterations"]
+    tpee = _is_tpee(it)
     checkers = sorted({r["motion_validator"] for r in it}) if checker is None else [checker]
     for chk in checkers:
         for cap in sorted({int(r["sample_cap"]) for r in it if r["motion_validator"] == chk}):
@@ -153,8 +163,9 @@ def ratio_table(runs: list[dict], planner: str, reference: str, checker: str | N
                 pa, pb = _per_query_mean(a, col), _per_query_mean(b, col)
                 ratios = [pa[q] / pb[q] for q in queries if q in pa and q in pb and pb[q] > 0]
                 s = summarize(ratios)
-                out.append({"checker": chk, "sample_cap": cap, "metric": key, "label": label, **s,
-                            "queries": len(queries), "paper": PAPER_TABLE4.get(cap, {}).get(key, math.nan)})
+                paper = PAPER_TABLE4.get(cap, {}).get(key, math.nan) if tpee else math.nan
+                out.append({"checker": chk, "sample_cap": cap, "metric": key,
+                            "label": label if tpee else GENERIC_LABELS[key], **s, "queries": len(queries), "paper": paper})
     return out
 
 
@@ -314,20 +325,23 @@ def _f(x: float, nd: int = 3) -> str:
 def _markdown(ratios: list[dict], succ: list[dict], quality: list[dict], anytime: list[dict],
               planner: str, reference: str, headline: str | None) -> str:
     lines = [f"## Table 4: {planner} / {reference} at equal sample counts", ""]
-    lines.append("Mean of per-query ratios (paper in brackets), then median [Q1, Q3]; n = queries where both succeeded. "
-                 "Lengths are raw planner output in joint space (rad).")
+    has_paper = any(not math.isnan(r["paper"]) for r in ratios)
+    lines.append(f"Mean of per-query ratios{' (paper in brackets)' if has_paper else ''}, then median [Q1, Q3]; "
+                 "n = queries where both succeeded. Lengths are raw planner output in joint space (rad).")
+    labels = {r["metric"]: r["label"] for r in ratios}
     checkers = sorted({r["checker"] for r in ratios}, key=lambda c: (c != headline, c))
     for chk in checkers:
         tag = " (headline)" if chk == headline else ""
         lines += ["", f"Motion validator: **{chk}**{tag}", ""]
-        lines.append("| N | n | " + " | ".join(lbl for _, lbl in RATIO_METRICS.values()) + " |")
+        lines.append("| N | n | " + " | ".join(labels[k] for k in RATIO_METRICS) + " |")
         lines.append("|---|---|" + "---|" * len(RATIO_METRICS))
         for cap in sorted({r["sample_cap"] for r in ratios if r["checker"] == chk}):
             cells, n = [], 0
             for key in RATIO_METRICS:
                 r = next(x for x in ratios if x["checker"] == chk and x["sample_cap"] == cap and x["metric"] == key)
                 n = max(n, r["n"])
-                cells.append(f"{_f(r['mean'])} ({_f(r['paper'])}) med {_f(r['median'])} [{_f(r['q1'])}, {_f(r['q3'])}]")
+                paper = f" ({_f(r['paper'])})" if has_paper else ""
+                cells.append(f"{_f(r['mean'])}{paper} med {_f(r['median'])} [{_f(r['q1'])}, {_f(r['q3'])}]")
             lines.append(f"| {cap} | {n}/{r['queries']} | " + " | ".join(cells) + " |")
     lines += ["", "## Success counts", "",
               "| comparison | validator | setting | planner | success / runs | solved but invalid | unsolved | missing queries |",
