@@ -65,14 +65,15 @@ def test_progress_share_follows_the_best_cost_inside_the_longest_budget_runs(tmp
 
 def test_median_cost_curve_is_the_median_of_the_runs_step_functions_inside_the_longest_budget(tmp_path):
     db = make_db(tmp_path / "b.db", RUNS, PROGRESS)
-    t, med = _progress_median(db, "A")
+    t, med = _progress_median(db, load_runs(db), "A")
     assert t[0] == 0.0 and t[-1] == pytest.approx(1.0)
     # runs 5 (2.5 from 0.05 s, 2.0 from 0.5 s) and 7 (3.0 from 0.05 s): nothing before 0.05 s
     assert np.all(np.isnan(med[t < 0.05]))
     assert np.all(med[(t >= 0.05) & (t < 0.5)] == pytest.approx(2.75)) and np.all(med[t >= 0.5] == pytest.approx(2.5))
     # progress rows without a time say nothing: no curve, as for a planner without rows
     db2 = make_db(tmp_path / "c.db", RUNS, [(5, None, 2.5), (7, None, 3.0)])
-    assert _progress_median(db2, "A") == (None, None) and _progress_median(db, "C") == (None, None)
+    assert _progress_median(db2, load_runs(db2), "A") == (None, None)
+    assert _progress_median(db, load_runs(db), "C") == (None, None)
 
 
 def test_within_best_plot_is_its_own_file_beside_the_others(tmp_path):

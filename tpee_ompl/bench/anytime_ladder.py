@@ -34,7 +34,8 @@ from collections.abc import Callable
 import numpy as np
 from ompl import tools as ot
 
-from .ladder import CheckpointPlanner, derive_planner_runs, log_text, run_seconds
+from .database import log_text
+from .ladder import CheckpointPlanner, derive_planner_runs, run_seconds
 from .planners import PlannerContext, RecordingPlanner
 from .results import format_value
 
@@ -96,16 +97,9 @@ class TimeCheckpointPlanner(CheckpointPlanner):
     def __init__(self, si, inner, checkpoints: list[float], context: tuple[str, PlannerContext], mode: str,
                  checker=None, read=None, renew=None, deadline: float | None = None):
         RecordingPlanner.__init__(self, si, inner, max_iterations=None, read=read, renew=renew, deadline=deadline)
+        self._init_checkpoints(si, context, checker, python=mode == "posted")
         self.checkpoints = sorted({float(c) for c in checkpoints})
-        self.context = context
         self.mode = mode
-        self.python = mode == "posted"
-        if self.python and not hasattr(inner, "set_intermediate_solution_callback"):
-            raise ValueError(f"{inner.getName()}: no intermediate-solution callback, no checkpoints")
-        self.checker = checker if checker is not None else getattr(si.getStateValidityChecker(), "robot", None)
-        self.snapshots: list[dict[float, dict]] = []
-        self.start_checks: list[int] = []
-        self._run: dict = {}
 
     def _count(self) -> int | None:
         if self.python or hasattr(self.inner, "numIterations"):

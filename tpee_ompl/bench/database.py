@@ -21,6 +21,7 @@ import logging
 import os
 import sqlite3
 import sys
+import tempfile
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
@@ -31,8 +32,8 @@ from .config import PROGRESS_PROPERTIES
 from .planners import planner_settings
 from .results import format_value
 
-__all__ = ["build_database", "check_log", "failed_run_properties", "pad_aborted_runs", "patch_recorded_data",
-           "set_aside_broken_logs"]
+__all__ = ["build_database", "check_log", "failed_run_properties", "log_text", "pad_aborted_runs",
+           "patch_recorded_data", "set_aside_broken_logs"]
 
 log = logging.getLogger(__name__)
 
@@ -108,6 +109,14 @@ def patch_recorded_data(bench, wrappers: dict, records: dict, cap: int | None) -
             ]
             for rec in recs
         ]
+
+
+def log_text(bench) -> str:
+    """The OMPL log of the benchmark's recorded data, as text (``saveResultsToFile`` into a temporary folder)."""
+    with tempfile.TemporaryDirectory(prefix="tpee_log_") as tmp:
+        path = Path(tmp) / "experiment.log"
+        bench.saveResultsToFile(str(path))
+        return path.read_text()
 
 
 def _dedupe_times(progress: Sequence[tuple[float, float, int]]) -> list[tuple[float, float, int]]:

@@ -21,7 +21,6 @@ import logging
 import math
 import os
 import socket
-import tempfile
 import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -33,7 +32,7 @@ from ompl import util as ou
 
 from ..planning.grouped_space import RealVectorLayout
 from ..planning.paths import path_length, path_passes_motion_checks
-from .database import failed_run_properties, pad_aborted_runs, patch_recorded_data
+from .database import failed_run_properties, log_text, pad_aborted_runs, patch_recorded_data
 from .planners import SINGLE_USE_PLANNERS, PlannerContext, RecordingPlanner, planner_factory
 from .problems import get_problem
 from .._version import __version__
@@ -353,10 +352,7 @@ def _run_experiment(cfg: dict, task: dict, spec: dict, ladder=None, only: list[s
     if error is not None:
         pad_aborted_runs(bench, records, int(cfg["runs"]), error)
     patch_recorded_data(bench, wrappers, records, cap)
-    with tempfile.TemporaryDirectory(prefix="tpee_log_") as tmp:
-        path = Path(tmp) / "experiment.log"
-        bench.saveResultsToFile(str(path))
-        text = path.read_text()
+    text = log_text(bench)
     if sink is not None:
         from .anytime_ladder import copy_planner
 

@@ -40,6 +40,7 @@ from ompl import tools as ot
 from ..planning.grouped_space import RealVectorLayout
 from ..planning.setup import motion_counts, valid_motion_fraction
 from .planners import PlannerContext, RecordingPlanner, planner_factory
+from .database import log_text
 from .results import format_value
 
 __all__ = ["LADDER_PLANNERS", "CheckpointPlanner", "Ladder", "group_ladders"]
@@ -129,18 +130,23 @@ class CheckpointPlanner(RecordingPlanner):
 
     def __init__(self, si, inner, max_iterations: int, checkpoints: list[int], context: tuple[str, PlannerContext],
                  checker=None, read=None, renew=None):
-        super().__init__(si, inner, max_iterations=None if hasattr(inner, "last_run_stats") else max_iterations,
-                         read=read, renew=renew)
+        python = hasattr(inner, "last_run_stats")
+        super().__init__(si, inner, max_iterations=None if python else max_iterations, read=read, renew=renew)
+        self._init_checkpoints(si, context, checker, python)
         self.checkpoints = sorted({int(c) for c in checkpoints if int(c) < max_iterations})
-        self.context = context
-        self.python = hasattr(inner, "last_run_stats")
-        if self.python and not hasattr(inner, "set_intermediate_solution_callback"):
-            raise ValueError(f"{inner.getName()}: no intermediate-solution callback, no checkpoints")
         if not self.python and type(inner) is not og.RRTstar:
             raise ValueError(f"{inner.getName()}: checkpoint rows are verified for og.RRTstar only")
+
+    def _init_checkpoints(self, si, context: tuple[str, PlannerContext], checker, python: bool) -> None:
+        """What every checkpoint planner holds besides its checkpoints (they are caps here, times in the anytime
+        ladder); ``python``: the inner planner is one of this package's, read through its posted paths."""
+        self.context = context
+        self.python = python
+        if python and not hasattr(self.inner, "set_intermediate_solution_callback"):
+            raise ValueError(f"{self.inner.getName()}: no intermediate-solution callback, no checkpoints")
         self.checker = checker if checker is not None else getattr(si.getStateValidityChecker(), "robot", None)
         """The problem's checker: its ``collision_checks`` counter gives each checkpoint's checks."""
-        self.snapshots: list[dict[int, dict]] = []
+        self.snapshots: list[dict] = []
         self.start_checks: list[int] = []
         self._run: dict = {}
 
@@ -423,14 +429,3 @@ def set_runs(pl, rows: list[dict], progress: list[list]) -> None:
     pl.runsProgressData = [
         [{"best cost REAL": format_value(c), "iterations INTEGER": format_value(k),
           "time REAL": format_value(t)} for t, c, k in _dedupe_times(p)] for p in progress]
-
-
-def log_text(bench) -> str:
-    """The OMPL log of the benchmark's recorded data, as text."""
-    import tempfile
-    from pathlib import Path
-
-    with tempfile.TemporaryDirectory(prefix="tpee_log_") as tmp:
-        path = Path(tmp) / "experiment.log"
-        bench.saveResultsToFile(str(path))
-        return path.read_text()

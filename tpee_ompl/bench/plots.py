@@ -46,7 +46,7 @@ def make_plots(db_path: str | Path, directory: str | Path, planner: str | None =
 
 
 def _make_plots(db_path: str | Path, directory: str | Path, planner: str | None, reference: str | None) -> list[Path]:
-    from .report import PAPER_TABLE4, RATIO_METRICS, load_runs, ratio_table, resolve_planner_name
+    from .report import PAPER_TABLE4, RATIO_METRICS, anytime_table, load_runs, ratio_table, resolve_planner_name
 
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
@@ -104,14 +104,11 @@ def _make_plots(db_path: str | Path, directory: str | Path, planner: str | None,
     any_runs = [r for r in runs if r["comparison"] == "anytime"]
     if any_runs:
         fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4.5))
+        costs = anytime_table(runs)
         for k, pl in enumerate(sorted({r["planner"] for r in any_runs})):
-            budgets = sorted({float(r["time_budget"]) for r in any_runs})
-            med = []
-            for b in budgets:
-                v = [float(r["solution_length"]) for r in any_runs if r["planner"] == pl and float(r["time_budget"]) == b and r["success"]]
-                med.append(float(np.median(v)) if v else math.nan)
-            ax1.plot(budgets, med, "o-", color=f"C{k}", label=pl)
-            t, c = _progress_median(db_path, pl)
+            pts = sorted((r["budget"], r["cost_median"]) for r in costs if r["planner"] == pl)
+            ax1.plot([b for b, _ in pts], [c for _, c in pts], "o-", color=f"C{k}", label=pl)
+            t, c = _progress_median(db_path, runs, pl)
             if t is not None:
                 ax2.step(t, c, where="post", color=f"C{k}", label=pl)
         ax1.set_xscale("log")
@@ -155,29 +152,38 @@ def _within_best_plot(db_path, runs: list[dict], directory: Path, plt) -> Path:
     return p
 
 
+def _longest_budget_runs(runs: list[dict], planner: str | None = None) -> tuple[float, list[dict]]:
+    """The longest anytime budget and its runs (of ``planner``, when given)."""
+    at = [r for r in runs if r["comparison"] == "anytime"]
+    bmax = max(float(r["time_budget"]) for r in at)
+    return bmax, [r for r in at if float(r["time_budget"]) == bmax and planner in (None, r["planner"])]
+
+
+def _progress_series(db_path, run_ids) -> dict[int, tuple[np.ndarray, np.ndarray]]:
+    """:func:`_series` of the progress rows of ``run_ids`` (empty without any, or without a progress table)."""
+    run_ids = list(run_ids)
+    con = sqlite3.connect(str(db_path))
+    try:
+        pcols = {r[1] for r in con.execute("PRAGMA table_info(progress)")}
+        if not run_ids or not {"runid", "time", "best_cost"} <= pcols:
+            return {}
+        marks = ",".join("?" * len(run_ids))
+        rows = con.execute(f"SELECT runid, time, best_cost FROM progress WHERE runid IN ({marks}) "
+                           "ORDER BY runid, time", run_ids).fetchall()
+    finally:
+        con.close()
+    return _series(rows) if rows else {}
+
+
 def _progress_within(db_path, runs: list[dict], planner: str, best: dict, within: float):
     """Share of the longest budget's queries whose run's best cost is within ``within`` x best found, over time.
 
     Only successful runs count (as in the report); a query's share is averaged over its runs. None when
     the planner's runs have no progress rows.
     """
-    at = [r for r in runs if r["comparison"] == "anytime"]
-    bmax = max(float(r["time_budget"]) for r in at)
-    at = [r for r in at if float(r["time_budget"]) == bmax]
+    bmax, at = _longest_budget_runs(runs)
     mine = {r["id"]: r for r in at if r["planner"] == planner}
-    con = sqlite3.connect(str(db_path))
-    try:
-        pcols = {r[1] for r in con.execute("PRAGMA table_info(progress)")}
-        if not mine or not {"runid", "time", "best_cost"} <= pcols:
-            return None, None
-        marks = ",".join("?" * len(mine))
-        rows = con.execute(f"SELECT runid, time, best_cost FROM progress WHERE runid IN ({marks}) "
-                           "ORDER BY runid, time", list(mine)).fetchall()
-    finally:
-        con.close()
-    if not rows:
-        return None, None
-    series = _series(rows)
+    series = _progress_series(db_path, mine)
     if not series:
         return None, None
     per_query = defaultdict(int)
@@ -195,26 +201,10 @@ def _progress_within(db_path, runs: list[dict], planner: str, best: dict, within
     return grid, share / len({r["query_id"] for r in at})
 
 
-def _progress_median(db_path, planner: str):
+def _progress_median(db_path, runs: list[dict], planner: str):
     """Median over runs of the best-cost step function, for the longest anytime budget."""
-    con = sqlite3.connect(str(db_path))
-    try:
-        ecols = {r[1] for r in con.execute("PRAGMA table_info(experiments)")}
-        pcols = {r[1] for r in con.execute("PRAGMA table_info(progress)")}
-        if "comparison" not in ecols or "best_cost" not in pcols:
-            return None, None
-        (bmax,) = con.execute("SELECT MAX(time_budget) FROM experiments WHERE comparison='anytime'").fetchone()
-        rows = con.execute(
-            "SELECT progress.runid, progress.time, progress.best_cost FROM progress "
-            "JOIN runs ON progress.runid = runs.id JOIN experiments ON runs.experimentid = experiments.id "
-            "JOIN plannerConfigs ON runs.plannerid = plannerConfigs.id "
-            "WHERE experiments.comparison='anytime' AND experiments.time_budget=? AND plannerConfigs.name=? "
-            "ORDER BY progress.runid, progress.time", (bmax, f"geometric_{planner}")).fetchall()
-    finally:
-        con.close()
-    if not rows:
-        return None, None
-    series = _series(rows)
+    bmax, mine = _longest_budget_runs(runs, planner)
+    series = _progress_series(db_path, (r["id"] for r in mine))
     if not series:
         return None, None
     grid = np.linspace(0, float(bmax), 60)
