@@ -101,3 +101,18 @@ def test_negative_numbers_in_any_notation_are_values_not_options(value):
 
     args = get_argument_parser().parse_args(["aim", "--target", "5", value, "1.5"])
     assert args.target[1] == float(value)
+
+
+def test_output_into_a_closed_pipe_ends_quietly_with_sigpipes_code():
+    import os
+    import subprocess
+    import sys
+
+    r, w = os.pipe()
+    os.close(r)  # the reader went away before the first line (``| head -0``)
+    try:
+        proc = subprocess.run([sys.executable, "-c", "import sys; from tpee_ompl.cli import main; sys.exit(main())",
+                               "bench", "--list-problems"], stdout=w, stderr=subprocess.PIPE, text=True, timeout=120)
+    finally:
+        os.close(w)
+    assert proc.returncode == 141 and proc.stderr == ""

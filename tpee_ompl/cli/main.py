@@ -1,4 +1,4 @@
-"""The ``tpee-ompl`` command line: plan, aim, bench, library, track, show, animate, view.
+"""The ``tpee-ompl`` command line: plan, aim, track, bench, library, show, animate, workspace, view.
 
 One module per command group, each with ``register(sub, fmt)``: :mod:`.plan` (plan, aim, track),
 :mod:`.pictures` (show, animate, workspace, view), :mod:`.library` (library build|query|stats) and
@@ -6,7 +6,8 @@ the bench group.  Every subcommand is one function.  Errors are one line on stde
 traceback (``-v`` adds it): exit code 2 for a usage error (argparse's, or a
 :class:`~tpee_ompl.cli._common.CliError` from the argument checks that run before any work), 1 for
 an error at run time (a damaged input file, a model mismatch, a failure, anything unexpected),
-130 when interrupted (Ctrl-C, or SIGTERM, which every command handles as Ctrl-C).
+130 when interrupted (Ctrl-C, or SIGTERM, which every command handles as Ctrl-C), 141 without a word when
+the reader of its output went away (``tpee-ompl plan ... | head -1``), as a command killed by SIGPIPE.
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ from __future__ import annotations
 import argparse
 import gc
 import logging
+import os
 import sys
 import traceback
 from collections.abc import Sequence
@@ -47,7 +49,12 @@ def main(argv: Sequence[str] | None = None) -> int:
                         format="%(levelname)s %(name)s: %(message)s")
     try:
         with sigterm_as_keyboard_interrupt():  # kill / a scheduler: the same cleanup as Ctrl-C (temporary files, workers)
-            return int(args.func(args) or 0)
+            code = int(args.func(args) or 0)
+            sys.stdout.flush()  # a closed pipe shows here, not in the interpreter's own flush at exit
+            return code
+    except BrokenPipeError:
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # nothing more to write, and no error at exit
+        return 141
     except Exception as exc:  # noqa: BLE001 (the last resort: one line, never a traceback without -v)
         if args.verbose:
             traceback.print_exc()
