@@ -16,8 +16,7 @@ import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
-__all__ = ["OutputExistsError", "atomic_path", "atomic_write", "atomic_write_bytes", "atomic_write_text",
-           "write_new_file",
+__all__ = ["OutputExistsError", "atomic_path", "atomic_write", "atomic_write_text", "write_new_file",
            "check_output_path"]
 
 
@@ -113,11 +112,6 @@ def atomic_write(path: str | os.PathLike, write: Callable[[Path], object], *, fo
     with atomic_path(path, force=force) as tmp:
         write(tmp)
     return Path(path)
-
-
-def atomic_write_bytes(path: str | os.PathLike, data: bytes, *, force: bool = True) -> Path:
-    """Write ``data`` to ``path`` atomically."""
-    return atomic_write(path, lambda tmp: tmp.write_bytes(data), force=force)
 
 
 def atomic_write_text(path: str | os.PathLike, text: str, *, force: bool = True) -> Path:

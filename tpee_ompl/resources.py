@@ -9,10 +9,7 @@ from __future__ import annotations
 from importlib import resources
 from pathlib import Path
 
-__all__ = ["DEFAULT_LIBRARY", "QUERY_SET_NAMES", "data_path", "default_library_path", "model_file", "query_set_path"]
-
-QUERY_SET_NAMES: tuple[str, ...] = ("planning_necessary", "paper_random")
-"""The named query sets shipped with the package (``load_queries(name)``)."""
+__all__ = ["DEFAULT_LIBRARY", "data_path", "default_library_path", "model_file", "query_set_path"]
 
 DEFAULT_LIBRARY = "default.npz"
 

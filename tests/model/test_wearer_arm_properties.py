@@ -1,4 +1,5 @@
-"""Property-based tests (hypothesis) of the wearer model (checks, files): adversarial inputs work or raise one documented error."""
+"""Property-based tests (hypothesis) of the wearer model (checks, files): adversarial inputs work or raise one
+documented error."""
 
 from __future__ import annotations
 
@@ -60,13 +61,9 @@ def test_batched_validity_matches_single_checks_or_raises(robot: WearerArm, Q: n
     assert [robot.is_valid(q) for q in Q] == ok.tolist()
 
 
-
-
-
-
 @SETTINGS
 @given(t=targets, q=hnp.arrays(float, (4,), elements=st.floats(-1.5, 1.5)))
-def test_line_of_sight_answers_or_raises_value_error_namingresolve_target(robot: WearerArm, t, q: np.ndarray) -> None:
+def test_line_of_sight_answers_or_raises_value_error_naming_target(robot: WearerArm, t, q: np.ndarray) -> None:
     t = resolve_target(robot, t)
     try:
         clear = robot.line_of_sight_clear(q, t)

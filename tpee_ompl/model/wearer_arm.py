@@ -34,8 +34,6 @@ __all__ = [
 ]
 
 
-ARM_LINKS = ("link1", "link2", "link3", "link4")
-BOOM_LINKS = ("link1", "link2")
 MAX_TARGET_DISTANCE = 1.0e6
 """Metres. Targets with a coordinate beyond +-this are refused (no physical target is that far; beyond
 it the line-of-sight and aiming arithmetic would lose its precision or overflow)."""

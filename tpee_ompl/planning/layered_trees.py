@@ -74,10 +74,6 @@ class Tree:
             if alive[j] and not alive[parents[j]]:
                 alive[j] = False
 
-    def sq_dist(self, x: np.ndarray, delta: Callable[[np.ndarray, np.ndarray], np.ndarray]) -> np.ndarray:
-        D = delta(self.values[: len(self.parents)], x)
-        return np.einsum("ij,ij->i", D, D)
-
     def layers(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The live nodes ordered by step, then index, with each step's start in that order and its count."""
         live = self.alive[: len(self.parents)].nonzero()[0]

@@ -172,7 +172,8 @@ def _check_step(step: float) -> None:
 def motion_states(a: np.ndarray, b: np.ndarray, step: float, include_start: bool = False) -> np.ndarray:
     """States checked along the straight motion a -> b, as OMPL's DiscreteMotionValidator picks them.
 
-    ``ceil(|b - a| / step)`` segments; the end state is included, the start only on request.
+    ``max(1, ceil(|b - a| / step))`` segments (one when a == b); the end state is included, the start only
+    on request.
 
     Raises
     ------
@@ -294,8 +295,8 @@ def motion_step(robot: WearerArm, step: float | None = None) -> float:
         raise ValueError("security_margin is 0: the robot has no motion step of its own; give a step")
     step = own if step is None else min(check_number("step (radians)", step, low=MIN_JOINT_STEP), own)
     if step < MIN_JOINT_STEP:
-        raise ValueError(f"the robot's motion step {step:.3g} rad (security margin {robot.security_margin:g} m) is below "
-                         f"MIN_JOINT_STEP = {MIN_JOINT_STEP:g} rad: give a larger security_margin")
+        raise ValueError(f"the robot's motion step {step:.3g} rad (security margin {robot.security_margin:g} m) is "
+                         f"below MIN_JOINT_STEP = {MIN_JOINT_STEP:g} rad: give a larger security_margin")
     return step
 
 
