@@ -7,7 +7,8 @@ import stat
 
 import pytest
 
-from tpee_ompl.files import OutputExistsError, atomic_path, atomic_write_text, check_output_path, write_new_file
+from tpee_ompl.files import (OutputExistsError, atomic_path, atomic_write_text, check_output_path, check_writable_folder,
+                             write_new_file)
 
 
 def test_atomic_write_replaces_the_file_in_one_step(tmp_path):
@@ -115,3 +116,13 @@ def test_writing_to_a_folder_says_it_is_a_folder(tmp_path):
         atomic_write_text(tmp_path, "x", force=True)
     with pytest.raises(ValueError, match="is a folder"):
         atomic_write_text(tmp_path, "x", force=False)
+
+
+def test_a_folder_that_exists_or_can_be_made_passes_and_a_file_in_the_way_is_named(tmp_path):
+    assert check_writable_folder(tmp_path / "new" / "deeper", "out") == tmp_path / "new" / "deeper"
+    assert not (tmp_path / "new").exists()  # nothing is created
+    (tmp_path / "f").write_text("")
+    with pytest.raises(ValueError, match=r"^out .*f: is a file, not a folder"):
+        check_writable_folder(tmp_path / "f", "out")
+    with pytest.raises(ValueError, match=r"^out .*: .*f is a file, not a folder"):
+        check_writable_folder(tmp_path / "f" / "below", "out")

@@ -1,10 +1,12 @@
-"""Argument checks shared by the options dataclasses: seeds."""
+"""Argument checks shared by the options dataclasses: seeds, options with keyword overrides."""
 
 from __future__ import annotations
 
 import pytest
 
-from tpee_ompl.validation import MAX_SEED, check_seed
+from dataclasses import dataclass
+
+from tpee_ompl.validation import MAX_SEED, check_seed, resolve_options
 
 
 @pytest.mark.parametrize("seed", [0, -5, MAX_SEED + 1, 10**20, 1.5, True, "3", None])
@@ -15,3 +17,20 @@ def test_bad_seeds_are_refused_naming_the_argument(seed):
 
 def test_seed_range_ends_are_accepted():
     assert check_seed("seed", 1) == 1 and check_seed("seed", MAX_SEED) == MAX_SEED
+
+
+@dataclass(frozen=True)
+class _Options:
+    a: int = 1
+    b: str = "x"
+
+
+def test_options_resolve_to_defaults_or_the_given_ones_with_overrides_and_refuse_another_class():
+    assert resolve_options(_Options, None, {}) == _Options()
+    given = _Options(a=2)
+    assert resolve_options(_Options, given, {}) is given
+    assert resolve_options(_Options, given, {"b": "y"}) == _Options(a=2, b="y")
+    with pytest.raises(ValueError, match="options must be a _Options, got dict"):
+        resolve_options(_Options, {"a": 2}, {})
+    with pytest.raises(TypeError):
+        resolve_options(_Options, None, {"c": 3})

@@ -104,4 +104,4 @@ __all__ = [
     "generate_blended",
 ]
 
-from ._version import __version__  # noqa: E402  (one home, floor 0)
+from ._version import __version__ as __version__  # noqa: E402  (one home, floor 0)

@@ -17,7 +17,7 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 
 __all__ = ["OutputExistsError", "atomic_path", "atomic_write", "atomic_write_text", "write_new_file",
-           "check_output_path"]
+           "check_output_path", "check_writable_folder"]
 
 
 class OutputExistsError(FileExistsError):
@@ -38,16 +38,31 @@ def check_output_path(path: str | os.PathLike, *, force: bool = False, what: str
     """
     p = Path(path)
     _check_replaceable(p, what)
-    for parent in (Path(os.path.realpath(p)) if p.is_symlink() else p).parents:  # a link: where the file is written
-        if parent.exists():
-            if not parent.is_dir():
-                raise ValueError(f"{what} {p}: {parent} is a file, not a folder")
-            if not os.access(parent, os.W_OK | os.X_OK):
-                raise ValueError(f"{what} {p}: folder {parent} is not writable")
-            break
+    _check_nearest_folder((Path(os.path.realpath(p)) if p.is_symlink() else p).parents,  # a link: where it is written
+                          f"{what} {p}")
     if p.exists() and not force:
         raise OutputExistsError(f"{what} {p} exists; pass --force to replace it")
     return p
+
+
+def check_writable_folder(folder: str | os.PathLike, what: str = "folder") -> Path:
+    """``folder`` is, or can become, a writable folder (ValueError naming ``what`` otherwise); nothing is created."""
+    p = Path(folder)
+    if p.exists() and not p.is_dir():
+        raise ValueError(f"{what} {folder}: is a file, not a folder")
+    _check_nearest_folder((p, *p.parents), f"{what} {folder}")
+    return p
+
+
+def _check_nearest_folder(candidates, label: str) -> None:
+    """The first of ``candidates`` (a path and its parents) that exists is a folder this process can write in."""
+    for parent in candidates:
+        if parent.exists():
+            if not parent.is_dir():
+                raise ValueError(f"{label}: {parent} is a file, not a folder")
+            if not os.access(parent, os.W_OK | os.X_OK):
+                raise ValueError(f"{label}: folder {parent} is not writable")
+            return
 
 
 def _check_replaceable(p: Path, what: str) -> None:

@@ -6,13 +6,29 @@ so a bad setting is refused with one clear line instead of a crash deep in the b
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import numbers
-from typing import Any
+from collections.abc import Mapping
+from typing import Any, TypeVar
 
 import numpy as np
 
-__all__ = ["MAX_COUNT", "MAX_JOINT_VALUE", "MAX_SECONDS", "MAX_SEED", "as_float_array", "check_bool", "check_int", "check_name", "check_number", "check_seed", "sub_seed"]
+__all__ = ["MAX_COUNT", "MAX_JOINT_VALUE", "MAX_SECONDS", "MAX_SEED", "as_float_array", "check_bool", "check_int",
+           "check_name", "check_number", "check_seed", "resolve_options", "sub_seed"]
+
+
+_Options = TypeVar("_Options")
+
+
+def resolve_options(cls: type[_Options], options: _Options | None, overrides: Mapping[str, Any]) -> _Options:
+    """``options`` (``cls()``'s defaults if None) with keyword overrides applied (validated by ``cls``); an options
+    object of another class is a ValueError, an unknown override a TypeError."""
+    if options is None:
+        options = cls()
+    elif not isinstance(options, cls):
+        raise ValueError(f"options must be a {cls.__name__}, got {type(options).__name__}")
+    return dataclasses.replace(options, **overrides) if overrides else options
 
 
 def check_int(name: str, value: Any, *, minimum: int | None = None, maximum: int | None = None,

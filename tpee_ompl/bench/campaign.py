@@ -35,7 +35,7 @@ from pathlib import Path
 from .config import CampaignConfig, CampaignResult
 from .database import build_database, set_aside_broken_logs
 from .experiment import experiment_specs, log_name, run_query_task
-from ..files import write_new_file
+from ..files import check_writable_folder, write_new_file
 from ..signals import sigterm_as_keyboard_interrupt
 from .results import append_json_line, make_results_dir, package_versions, utc_now, write_json
 
@@ -136,7 +136,7 @@ def prepare_campaign(config: CampaignConfig) -> CampaignPlan:
     from .planners import planner_factory
     from .problems import get_problem
 
-    _check_out_folder(config.out)
+    check_writable_folder(config.out, "out")
     for field_name in ("iteration_planners", "anytime_planners"):
         for name in getattr(config, field_name):
             try:
@@ -162,20 +162,6 @@ def prepare_campaign(config: CampaignConfig) -> CampaignPlan:
         raise ValueError(f"seed {config.seed}: query k uses seed + k, which must stay <= {MAX_SEED} "
                          f"for {len(queries)} queries")
     return CampaignPlan(config, set_name, queries)
-
-
-def _check_out_folder(out: str) -> None:
-    """``out`` is (or can become) a writable folder; nothing is created."""
-    p = Path(out)
-    if p.exists() and not p.is_dir():
-        raise ValueError(f"out {out}: is a file, not a folder")
-    for parent in (p, *p.parents):
-        if parent.exists():
-            if not parent.is_dir():
-                raise ValueError(f"out {out}: {parent} is a file, not a folder")
-            if not os.access(parent, os.W_OK | os.X_OK):
-                raise ValueError(f"out {out}: folder {parent} is not writable")
-            return
 
 
 def run_campaign(

@@ -12,7 +12,6 @@ smooth in fake time, which the DMP needs to reproduce it within 1e-3 rad (docs/d
 
 from __future__ import annotations
 
-import dataclasses
 import logging
 import signal
 from collections import Counter
@@ -28,7 +27,7 @@ from ..signals import child_sigint, sigint_blocked_for_children
 from ..model.sectors import SECTOR_PAIRS, check_sector
 from ..model.wearer_arm import WearerArm
 from ..planning.paths import resample_waypoints
-from ..validation import check_bool, check_int, check_number
+from ..validation import check_bool, check_int, check_number, resolve_options
 from .demos import (
     DEMO_MARGINS,
     MAX_PER_STEP,
@@ -126,11 +125,7 @@ class LibraryBuildOptions:
     @classmethod
     def resolve(cls, options: LibraryBuildOptions | None, overrides: Mapping[str, Any]) -> LibraryBuildOptions:
         """``options`` (defaults if None) with keyword overrides applied; an unknown name raises TypeError."""
-        if options is None:
-            options = cls()
-        elif not isinstance(options, cls):
-            raise ValueError(f"options must be a LibraryBuildOptions, got {type(options).__name__}")
-        return dataclasses.replace(options, **overrides) if overrides else options
+        return resolve_options(cls, options, overrides)
 
 
 def _check_pairs(pairs: Sequence[tuple[int, int]]) -> tuple[tuple[int, int], ...]:

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from ..files import atomic_write_text
-from .queries import QuerySetError, query_entries, read_query_document
+from .queries import QuerySetError, check_set_model, query_entries, read_query_document
 from .robot_checker import RobotChecker
 
 __all__ = ["JOINT_FORMAT", "JointQuery", "load_joint_query_set", "save_joint_queries"]
@@ -106,9 +106,7 @@ def load_joint_query_set(name_or_path: str | os.PathLike,
         raise QuerySetError(f"{p}: queries have different numbers of joints")
     header = {k: v for k, v in doc.items() if k != "queries"}
     if checker is not None:
-        if header.get("model_hash") != checker.model_hash:
-            raise QuerySetError(f"{p}: made for model_hash {header.get('model_hash')!r}, but the checker's is "
-                                f"{checker.model_hash!r} (regenerate the set for this model)")
+        check_set_model(p, header, checker.model_hash, "checker")
         if queries and queries[0].start.size != checker.nq:
             raise QuerySetError(f"{p}: queries have {queries[0].start.size} joints, the checker {checker.nq}")
     return queries, header

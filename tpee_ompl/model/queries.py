@@ -35,6 +35,7 @@ __all__ = [
     "FORMAT_VERSION",
     "Query",
     "QuerySetError",
+    "check_set_model",
     "load_queries",
     "load_query_set",
     "query_entries",
@@ -184,6 +185,14 @@ def read_query_document(name_or_path: str | os.PathLike) -> tuple[Path, object]:
         raise QuerySetError(f"{p}: not a JSON query set (truncated or corrupt?): {exc}") from exc
 
 
+def check_set_model(p: Path, header: dict, model_hash: str, who: str) -> None:
+    """A query set's header names the model it was made for: QuerySetError unless it is ``model_hash``
+    (the ``who``'s: robot or checker)."""
+    if header.get("model_hash") != model_hash:
+        raise QuerySetError(f"{p}: made for model_hash {header.get('model_hash')!r}, but the {who}'s is "
+                            f"{model_hash!r} (regenerate the set for this model)")
+
+
 def query_entries(p: Path, doc: dict, from_dict: Callable[[object], Any]) -> list:
     """The document's ``queries`` list parsed by ``from_dict``, or QuerySetError naming the file and the
     entry (not a list, a malformed entry, an id that appears twice)."""
@@ -212,11 +221,8 @@ def load_query_set(name_or_path: str | os.PathLike, robot: WearerArm | None = No
         raise QuerySetError(f"{p}: unsupported format_version {version!r} (expected {FORMAT_VERSION})")
     queries = query_entries(p, doc, Query.from_dict)
     header = {k: v for k, v in doc.items() if k != "queries"}
-    if robot is not None and header.get("model_hash") != robot.model_hash:
-        raise QuerySetError(
-            f"{p}: made for model_hash {header.get('model_hash')!r}, but the robot's is {robot.model_hash!r} "
-            "(regenerate the set for this model)"
-        )
+    if robot is not None:
+        check_set_model(p, header, robot.model_hash, "robot")
     if robot is not None:
         for q in queries:
             for name in ("start", "goal"):

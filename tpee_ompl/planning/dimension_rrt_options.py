@@ -3,7 +3,6 @@ that module's docstring and ``docs/dimension_rrt.md``)."""
 
 from __future__ import annotations
 
-import dataclasses
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -11,6 +10,7 @@ from typing import Any
 import numpy as np
 
 from ..validation import check_bool, check_int, check_name, check_number
+from ..validation import resolve_options as resolve
 from .grouped_space import MAX_H, group_lists
 
 __all__ = ["RELEASE_AFTER", "DimensionRRTOptions", "resolve_options", "shortcuts_on"]
@@ -119,8 +119,4 @@ def shortcuts_on(options: DimensionRRTOptions, prescribed: bool) -> bool:
 
 def resolve_options(options: DimensionRRTOptions | None, overrides: Mapping[str, Any]) -> DimensionRRTOptions:
     """``options`` (default settings if None) with the keyword overrides applied, validated."""
-    if options is None:
-        options = DimensionRRTOptions()
-    elif not isinstance(options, DimensionRRTOptions):
-        raise ValueError(f"options must be a DimensionRRTOptions, got {type(options).__name__}")
-    return dataclasses.replace(options, **overrides) if overrides else options
+    return resolve(DimensionRRTOptions, options, overrides)
