@@ -1,5 +1,6 @@
 """Foreign suite: dimension-RRT vs RRTConnect (+ OMPL's PathSimplifier) on generic problems set up
-with plain OMPL + numpy (no project code in their set-up), every listed grouping, same seeds.
+with plain OMPL + numpy (built by ``tpee_ompl/bench/generic_problems.py``, which imports no other project
+code), every listed grouping, same seeds.
 
     PYTHONPATH=. .venv/bin/python experiments/foreign_problems.py            # default run, ~3-5 min
     PYTHONPATH=. .venv/bin/python experiments/foreign_problems.py --seeds 5 --time 2
@@ -23,99 +24,26 @@ import gc
 import math
 import statistics
 import time
+from collections.abc import Callable
 
-import numpy as np
 from _common import first_path_time
 from ompl import base as ob
 from ompl import geometric as og
 from ompl import util as ou
 
+from tpee_ompl.bench.generic_problems import ARM_OBS, ARM_OBS2, box_point_setup, planar_arm_setup
 from tpee_ompl.planning.dimension_rrt import DimensionRRT  # the planner under test only
 
 
-# ----------------------------------------------------------------- problems (plain OMPL + numpy)
-def _arm_points(q: np.ndarray, link: float) -> np.ndarray:
-    ang = np.cumsum(q)
-    d = link * np.stack([np.cos(ang), np.sin(ang)], axis=-1)
-    joints = np.vstack([np.zeros((1, 2)), np.cumsum(d, axis=0)])
-    s = np.linspace(0.0, 1.0, 4)
-    return (joints[:-1, None, :] + s[None, :, None] * d[:, None, :]).reshape(-1, 2)
-
-
-def _setup(space, valid, start, goal, read, write, resolution=0.01):
-    ss = og.SimpleSetup(space)
-    si = ss.getSpaceInformation()
-    ss.setStateValidityChecker(valid)
-    si.setStateValidityCheckingResolution(resolution)
-    ss.setOptimizationObjective(ob.PathLengthOptimizationObjective(si))
-    s0, s1 = si.allocState(), si.allocState()
-    write(s0, start)
-    write(s1, goal)
-    ss.setStartAndGoalStates(s0, s1, 1e-9)
-    ss._keep = (valid, s0, s1)
-    si.setup()
-    return ss
-
-
-def planar_arm(n: int, obstacles, start, goal, continuous: bool = False):
-    if continuous:
-        space = ob.CompoundStateSpace()
-        for _ in range(n):
-            space.addSubspace(ob.SO2StateSpace(), 1.0)
-    else:
-        space = ob.RealVectorStateSpace(n)
-        space.setBounds(-math.pi, math.pi)
-    obs = np.asarray(obstacles, dtype=float)
-    link = 1.5 / n
-
-    def read(s):
-        return np.array([s[i].value for i in range(n)] if continuous else [s[i] for i in range(n)])
-
-    def write(s, q):
-        for i in range(n):
-            if continuous:
-                s[i].value = float(q[i])
-            else:
-                s[i] = float(q[i])
-
-    def valid(s):
-        p = _arm_points(read(s), link)
-        diff = p[:, None, :] - obs[None, :, :2]
-        return bool(np.all(np.einsum("poc,poc->po", diff, diff) > obs[:, 2] ** 2))
-
-    return _setup(space, valid, start, goal, read, write)
-
-
-def box_point(n: int, blocked, start, goal):
-    space = ob.RealVectorStateSpace(n)
-    space.setBounds(0.0, 1.0)
-
-    def write(s, q):
-        for i in range(n):
-            s[i] = float(q[i])
-
-    def valid(s):
-        return not blocked([s[i] for i in range(n)])
-
-    return _setup(space, valid, start, goal, None, write, resolution=0.005)
-
-
-def wall_with_hole(x):  # 4-D: wall 0.45 < x0 < 0.55 with a hole |x_i - 0.5| < 0.12 for i = 1..3
-    return 0.45 < x[0] < 0.55 and not all(abs(v - 0.5) < 0.12 for v in x[1:])
-
-
-def narrow_passage(x):  # 3-D: wall 0.4 < x0 < 0.6 with a slot 0.48 < x1 < 0.52 (any x2)
-    return 0.4 < x[0] < 0.6 and not 0.48 < x[1] < 0.52
-
-
-ARM_OBS = ((0.0, 1.0, 0.25), (-0.9, 0.8, 0.2), (0.9, 0.75, 0.2))
-ARM_OBS2 = ((0.0, 1.0, 0.25), (-0.9, 0.8, 0.2), (0.9, 0.75, 0.2), (-0.3, -0.9, 0.25), (0.6, -0.6, 0.15))
-
-
-def problems():
+# ----------------------------------------------------------------- problems
+def problems() -> list[tuple[str, Callable[[], og.SimpleSetup], list[list[list[int]]]]]:
     """(name, builder, list of groupings)."""
     def arm(n, obs, start0=0.3, goal0=2.8, continuous=False):
-        return lambda: planar_arm(n, obs, (start0,) + (0.0,) * (n - 1), (goal0,) + (0.0,) * (n - 1), continuous)
+        start, goal = (start0,) + (0.0,) * (n - 1), (goal0,) + (0.0,) * (n - 1)
+        return lambda: planar_arm_setup(n, start, goal, obs, continuous, resolution=0.01)[0]
+
+    def box(n, blocked, start, goal):
+        return lambda: box_point_setup(n, blocked, start, goal, resolution=0.005)[0]
 
     def contiguous(n, sizes):
         out, i = [], 0
@@ -136,9 +64,8 @@ def problems():
         ("arm7", arm(7, ARM_OBS2), groupings(7)),
         ("arm8", arm(8, ARM_OBS2), groupings(8)),
         ("arm5_so2", arm(5, ARM_OBS, 2.8, -2.6, continuous=True), groupings(5)),
-        ("point4_hole", lambda: box_point(4, wall_with_hole, (0.1, 0.2, 0.8, 0.2), (0.9, 0.8, 0.2, 0.8)),
-         groupings(4)),
-        ("narrow3", lambda: box_point(3, narrow_passage, (0.1, 0.1, 0.5), (0.9, 0.9, 0.5)), groupings(3)),
+        ("point4_hole", box(4, "wall_with_hole", (0.1, 0.2, 0.8, 0.2), (0.9, 0.8, 0.2, 0.8)), groupings(4)),
+        ("narrow3", box(3, "narrow_passage", (0.1, 0.1, 0.5), (0.9, 0.9, 0.5)), groupings(3)),
     ]
 
 
@@ -176,7 +103,8 @@ def main() -> None:
     if args.ompl_seed:
         ou.RNG.setSeed(args.ompl_seed)
     print(f"{'problem':12s} {'groups':34s} {'solved D/R':>10s} {'t1 D ms':>8s} {'t1 R ms':>8s} {'ratio':>6s}"
-          f" {'n D':>7s} {'us/n':>6s} {'len D':>7s} {'len R':>7s} {'len R+S':>7s}" + ("  layered: ratio, len" if args.layered else ""))
+          f" {'n D':>7s} {'us/n':>6s} {'len D':>7s} {'len R':>7s} {'len R+S':>7s}"
+          + ("  layered: ratio, len" if args.layered else ""))
     for name, build, groupings in problems():
         if args.only and args.only not in name:
             continue
@@ -195,7 +123,8 @@ def main() -> None:
                 d_samples.append(planner.last_run_stats()["samples"])
                 d_len.append(_length_at(ss, DimensionRRT(si, groups=groups, seed=seed), args.time))
                 if args.layered:
-                    l_first.append(first_path_time(ss, DimensionRRT(si, groups=groups, seed=seed, connect=False), args.limit))
+                    l_first.append(first_path_time(ss, DimensionRRT(si, groups=groups, seed=seed, connect=False),
+                                                   args.limit))
                     l_len.append(_length_at(ss, DimensionRRT(si, groups=groups, seed=seed, connect=False), args.time))
             solved_d = sum(x is not None for x in d_first)
             solved_r = sum(x is not None for x in rc_first)

@@ -6,6 +6,8 @@ Planar arms among circles (4-8 joints; one with continuous joints, a ``CompoundS
 state, counted by :class:`CountingChecker`); motions are checked by OMPL's default
 ``DiscreteMotionValidator``, so these problems have no batched motion validator (checker
 ``discrete`` only).  OMPL is imported only when a set-up is built, so listing the problems needs none.
+:func:`planar_arm_setup` and :func:`box_point_setup` build such a set-up for any start and goal
+(``experiments/foreign_problems.py`` and the planning tests' arms use them).
 
 Each problem has a deterministic query set: ``n_queries`` start/goal pairs drawn from a seeded
 generator, both valid, whose straight motion collides (checked here in numpy at the set-up's
@@ -18,7 +20,6 @@ import hashlib
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -27,7 +28,8 @@ if TYPE_CHECKING:
     from ompl import base as ob
     from ompl import geometric as og
 
-__all__ = ["GENERIC_PROBLEMS", "CountingChecker", "GenericProblem", "generic_queries", "make_generic_setup"]
+__all__ = ["ARM_OBS", "ARM_OBS2", "ARM_REACH", "GENERIC_PROBLEMS", "CountingChecker", "GenericProblem", "arm_free",
+           "arm_points", "box_point_setup", "generic_queries", "make_generic_setup", "planar_arm_setup"]
 
 ARM_OBS = ((0.0, 1.0, 0.25), (-0.9, 0.8, 0.2), (0.9, 0.75, 0.2))
 ARM_OBS2 = ((0.0, 1.0, 0.25), (-0.9, 0.8, 0.2), (0.9, 0.75, 0.2), (-0.3, -0.9, 0.25), (0.6, -0.6, 0.15))
@@ -42,7 +44,8 @@ class GenericProblem:
     name: str
     description: str
     kind: str
-    """``arm`` (planar arm, joint angles), ``arm-so2`` (the same with continuous joints) or ``box`` (point in [0, 1]^n)."""
+    """``arm`` (planar arm, joint angles), ``arm-so2`` (the same with continuous joints) or ``box`` (point in
+    [0, 1]^n)."""
     n: int
     groups: tuple[tuple[int, ...], ...]
     """Grouping of dimension-RRT (contiguous index groups)."""
@@ -60,19 +63,20 @@ class GenericProblem:
 
 
 # ----------------------------------------------------------------- validity rules (numpy)
-def _arm_points(q: np.ndarray, link: float) -> np.ndarray:
-    """Four points per link of a planar arm at joint angles q (n,), base at the origin; shape (4n, 2)."""
+def arm_points(q: np.ndarray, link: float, per_link: int = 4) -> np.ndarray:
+    """Points along the links of a planar arm at joint angles q (n,), base at the origin -> (n * per_link, 2)."""
     ang = np.cumsum(q)
     d = link * np.stack([np.cos(ang), np.sin(ang)], axis=-1)
     joints = np.vstack([np.zeros((1, 2)), np.cumsum(d, axis=0)])
-    s = np.linspace(0.0, 1.0, 4)
+    s = np.linspace(0.0, 1.0, per_link)
     return (joints[:-1, None, :] + s[None, :, None] * d[:, None, :]).reshape(-1, 2)
 
 
-def _arm_free(q: np.ndarray, n: int, obs: np.ndarray) -> bool:
-    p = _arm_points(q, ARM_REACH / n)
-    diff = p[:, None, :] - obs[None, :, :2]
-    return bool(np.all(np.einsum("poc,poc->po", diff, diff) > obs[:, 2] ** 2))
+def arm_free(q: np.ndarray, obstacles: np.ndarray, link: float) -> bool:
+    """True if no point of :func:`arm_points` (4 points a link) lies in or on a circle of ``obstacles`` (m, 3)."""
+    p = arm_points(q, link)
+    diff = p[:, None, :] - obstacles[None, :, :2]
+    return bool(np.all(np.einsum("poc,poc->po", diff, diff) > obstacles[:, 2] ** 2))
 
 
 def _wall_with_hole(x: Sequence[float]) -> bool:
@@ -92,48 +96,59 @@ _BLOCKED: dict[str, Callable[[Sequence[float]], bool]] = {"wall_with_hole": _wal
 def _validity_rule(p: GenericProblem) -> Callable[[np.ndarray], bool]:
     """The problem's validity test of one configuration (numpy array (n,))."""
     if p.kind in ("arm", "arm-so2"):
-        obs = np.asarray(p.obstacles, dtype=float)
-        return lambda q: _arm_free(q, p.n, obs)
-    blocked = _BLOCKED[p.blocked]
-    return lambda x: not blocked(x)
+        return _arm_rule(p.obstacles, ARM_REACH / p.n)
+    return _box_rule(p.blocked)
+
+
+def _arm_rule(obstacles: Sequence[Sequence[float]] | np.ndarray, link: float) -> Callable[[np.ndarray], bool]:
+    obs = np.asarray(obstacles, dtype=float).reshape(-1, 3)
+    return lambda q: arm_free(q, obs, link)
+
+
+def _box_rule(blocked: str) -> Callable[[np.ndarray], bool]:
+    rule = _BLOCKED[blocked]
+    return lambda x: not rule(x)
 
 
 # ----------------------------------------------------------------- OMPL set-up
-def _space(p: GenericProblem) -> ob.StateSpace:
+def _space(kind: str, n: int) -> ob.StateSpace:
     from ompl import base as ob
 
-    if p.kind == "arm-so2":
+    if kind == "arm-so2":
         space = ob.CompoundStateSpace()
-        for _ in range(p.n):
+        for _ in range(n):
             space.addSubspace(ob.SO2StateSpace(), 1.0)
         return space
-    space = ob.RealVectorStateSpace(p.n)
-    if p.kind == "arm":
+    space = ob.RealVectorStateSpace(n)
+    if kind == "arm":
         space.setBounds(-math.pi, math.pi)
     else:
         space.setBounds(0.0, 1.0)
     return space
 
 
-def _reader(p: GenericProblem) -> Callable[[ob.State], np.ndarray]:
-    n = p.n
-    if p.kind == "arm-so2":
+def _reader(kind: str, n: int) -> Callable[[ob.State], np.ndarray]:
+    if kind == "arm-so2":
         return lambda s: np.array([s[i].value for i in range(n)])
     return lambda s: np.array([s[i] for i in range(n)])
 
 
-def _write(p: GenericProblem, s: ob.State, q: Sequence[float]) -> None:
-    for i in range(p.n):
-        if p.kind == "arm-so2":
+def _write(kind: str, n: int, s: ob.State, q: Sequence[float]) -> None:
+    for i in range(n):
+        if kind == "arm-so2":
             s[i].value = float(q[i])
         else:
             s[i] = float(q[i])
 
 
+def _hash(kind: str, n: int, obstacles: tuple, blocked: str, reach: float, resolution: float) -> str:
+    text = repr((kind, n, obstacles, blocked, reach, resolution))
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
 def model_hash(p: GenericProblem) -> str:
     """A short hash of everything that decides validity: kind, dimension, obstacles or rule, resolution."""
-    text = repr((p.kind, p.n, p.obstacles, p.blocked, ARM_REACH, p.resolution))
-    return hashlib.sha256(text.encode()).hexdigest()[:16]
+    return _hash(p.kind, p.n, p.obstacles, p.blocked, ARM_REACH, p.resolution)
 
 
 class CountingChecker:
@@ -149,6 +164,54 @@ class CountingChecker:
         return bool(self.valid(self.read(state)))
 
 
+def _setup(kind: str, n: int, checker: CountingChecker, start: Sequence[float], goal: Sequence[float],
+           resolution: float) -> og.SimpleSetup:
+    from ompl import base as ob
+    from ompl import geometric as og
+
+    ss = og.SimpleSetup(_space(kind, n))
+    si = ss.getSpaceInformation()
+    ss.setStateValidityChecker(checker)
+    si.setStateValidityCheckingResolution(resolution)
+    ss.setOptimizationObjective(ob.PathLengthOptimizationObjective(si))
+    s0, s1 = si.allocState(), si.allocState()
+    _write(kind, n, s0, start)
+    _write(kind, n, s1, goal)
+    ss.setStartAndGoalStates(s0, s1, 1e-9)
+    ss._generic_refs = (checker, s0, s1)  # Python objects referenced only from C++ would be collected
+    ss.endpoint_states = (s0, s1)  # Python's copies: pdef.getStartState from Python is unsafe
+    si.setup()
+    return ss
+
+
+def planar_arm_setup(n: int, start: Sequence[float], goal: Sequence[float],
+                     obstacles: Sequence[Sequence[float]] | np.ndarray, continuous: bool = False,
+                     resolution: float = 0.01, reach: float = ARM_REACH) -> tuple[og.SimpleSetup, CountingChecker]:
+    """A planar arm of n equal links (total ``reach``) among circles (x, y, r), from ``start`` to ``goal``.
+
+    Joints in [-pi, pi] (``RealVectorStateSpace``), or continuous (a ``CompoundStateSpace`` of ``SO2StateSpace``);
+    path-length objective.  Returns the ``SimpleSetup`` (its ``endpoint_states`` are the start and goal states)
+    and its :class:`CountingChecker`.
+    """
+    kind = "arm-so2" if continuous else "arm"
+    obs = tuple(tuple(float(v) for v in o) for o in np.asarray(obstacles, dtype=float).reshape(-1, 3))
+    checker = CountingChecker(_arm_rule(obs, reach / n), _reader(kind, n),
+                              _hash(kind, n, obs, "", reach, resolution), n)
+    return _setup(kind, n, checker, start, goal, resolution), checker
+
+
+def box_point_setup(n: int, blocked: str, start: Sequence[float], goal: Sequence[float],
+                    resolution: float = 0.005) -> tuple[og.SimpleSetup, CountingChecker]:
+    """A point in [0, 1]^n, invalid where the rule ``blocked`` (``wall_with_hole`` or ``narrow_passage``) says.
+
+    Path-length objective; returns the ``SimpleSetup`` (with ``endpoint_states``) and its :class:`CountingChecker`.
+    """
+    # ARM_REACH is in the hash of every generic problem, boxes included (hashes already stored stay valid)
+    hash_ = _hash("box", n, (), blocked, ARM_REACH, resolution)
+    checker = CountingChecker(_box_rule(blocked), _reader("box", n), hash_, n)
+    return _setup("box", n, checker, start, goal, resolution), checker
+
+
 def make_generic_setup(p: GenericProblem, start: Sequence[float], goal: Sequence[float],
                        batched: bool = False) -> tuple[og.SimpleSetup, CountingChecker]:
     """The problem's ``SimpleSetup`` (path-length objective) from ``start`` to ``goal``, and its counting checker.
@@ -158,23 +221,9 @@ def make_generic_setup(p: GenericProblem, start: Sequence[float], goal: Sequence
     if batched:
         raise ValueError(f"problem {p.name}: no batched motion validator (Python validity checker, "
                          "OMPL's discrete motion validator): use checker 'discrete'")
-    from ompl import base as ob
-    from ompl import geometric as og
-
-    space = _space(p)
-    ss = og.SimpleSetup(space)
-    si = ss.getSpaceInformation()
-    checker = CountingChecker(_validity_rule(p), _reader(p), model_hash(p), p.n)
-    ss.setStateValidityChecker(checker)
-    si.setStateValidityCheckingResolution(p.resolution)
-    ss.setOptimizationObjective(ob.PathLengthOptimizationObjective(si))
-    s0, s1 = si.allocState(), si.allocState()
-    _write(p, s0, start)
-    _write(p, s1, goal)
-    ss.setStartAndGoalStates(s0, s1, 1e-9)
-    ss._generic_refs = (checker, s0, s1)  # Python objects referenced only from C++ would be collected
-    si.setup()
-    return ss, checker
+    if p.kind == "box":
+        return box_point_setup(p.n, p.blocked, start, goal, p.resolution)
+    return planar_arm_setup(p.n, start, goal, p.obstacles, p.kind == "arm-so2", p.resolution)
 
 
 # ----------------------------------------------------------------- queries (numpy)
@@ -239,11 +288,13 @@ GENERIC_PROBLEMS: dict[str, GenericProblem] = {p.name: p for p in (
     _arm("arm7", 7, ARM_OBS2, ((0, 1), (2, 3), (4, 5, 6)), seed=7),
     _arm("arm8", 8, ARM_OBS2, ((0, 1), (2, 3), (4, 5), (6, 7)), seed=8),
     _arm("arm5-so2", 5, ARM_OBS2, ((0, 1), (2, 3, 4)), seed=5, continuous=True),
-    GenericProblem(name="point4-hole", description="4-D point in the unit box, a wall with a hole (0.24 wide); groups [[0, 1], [2, 3]]",
+    GenericProblem(name="point4-hole",
+                   description="4-D point in the unit box, a wall with a hole (0.24 wide); groups [[0, 1], [2, 3]]",
                    kind="box", n=4, groups=((0, 1), (2, 3)), blocked="wall_with_hole",
                    start_box=((0.05, 0.35),) + ((0.05, 0.95),) * 3, goal_box=((0.65, 0.95),) + ((0.05, 0.95),) * 3,
                    resolution=0.005, seed=41),
-    GenericProblem(name="narrow3", description="3-D point in the unit box, a wall with a 0.04-wide slot; groups [[0, 1], [2]]",
+    GenericProblem(name="narrow3",
+                   description="3-D point in the unit box, a wall with a 0.04-wide slot; groups [[0, 1], [2]]",
                    kind="box", n=3, groups=((0, 1), (2,)), blocked="narrow_passage",
                    start_box=((0.05, 0.35),) + ((0.05, 0.95),) * 2, goal_box=((0.65, 0.95),) + ((0.05, 0.95),) * 2,
                    resolution=0.005, seed=31),
