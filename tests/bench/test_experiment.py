@@ -55,3 +55,21 @@ def test_every_run_starts_from_the_experiments_cost_threshold_whatever_the_plann
                           "ON runs.plannerid = plannerConfigs.id").fetchall()
     assert sorted(name.rsplit("_", 1)[-1] for name, _ in rows) == ["HonoursThreshold"] * 2 + ["LowersThreshold"] * 2
     assert [it for _, it in rows] == [30] * 4  # HonoursThreshold drew its 30 samples: the threshold was 0 again
+
+
+def test_a_one_state_answer_short_of_the_goal_has_no_path_columns_and_one_at_the_goal_has(robot):
+    """AORRTC answers a timeout with its start state alone, which OMPL records as a correct solution of length 0."""
+    from tpee_ompl.bench.experiment import _path_properties
+    from tpee_ompl.model.sectors import posture_preset
+    from tpee_ompl.planning.grouped_space import RealVectorLayout
+    from tpee_ompl.planning.setup import make_simple_setup
+
+    start, goal = np.r_[posture_preset(1), 0.0, 0.0], np.r_[posture_preset(4), 0.0, 0.0]
+    si = make_simple_setup(robot, start, goal).getSpaceInformation()
+    layout = RealVectorLayout(si.getStateSpace())
+    rec = {"waypoints": start[None, :], "best_cost": None}
+    assert _path_properties(si, rec, start, goal, (0, 1), layout) == {}
+    at_goal = _path_properties(si, rec, start, start, (0, 1), layout)  # a query whose goal is its start
+    assert at_goal["raw_length REAL"] == 0.0 and at_goal["path_valid_dense INTEGER"] == 1
+    two = _path_properties(si, {"waypoints": np.array([start, goal]), "best_cost": None}, start, goal, (0, 1), layout)
+    assert two["reaches_goal INTEGER"] == 1 and two["raw_length REAL"] > 0

@@ -56,6 +56,7 @@ def _raising(exc: BaseException):
     (IndexError("index 0 is out of bounds"), 1, "unexpected IndexError"),
     (RuntimeError("planner failed\non two lines"), 1, "planner failed on two lines"),
     (ValueError("damaged file x.npz"), 1, "damaged file x.npz"),
+    (BrokenPipeError(32, "Broken pipe"), 1, "Broken pipe"),  # another pipe than standard output's
 ])
 def test_any_exception_at_run_time_is_one_line_with_exit_code_1(monkeypatch, capsys, exc, code, text):
     import tpee_ompl.cli.plan as plan

@@ -46,7 +46,7 @@ def test_invalid_configuration_is_flagged(robot):
     assert "INVALID" in fig.axes[0].get_title()
 
 
-def test_scene_with_sectors_and_path(robot, aimed, tmp_path):
+def test_a_scene_with_sectors_labels_all_four_and_saves_a_png_with_the_path(robot, aimed, tmp_path):
     q, target = aimed
     W = np.hstack([cross_sector_trajectory(1, 4), np.linspace([0.0, 0.0], q[2:], 7)])
     out = save_scene(robot, q, tmp_path / "sectors.png", target=target, sectors=True, path=W)

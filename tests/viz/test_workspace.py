@@ -21,7 +21,7 @@ def test_sample_pointing_workspace_is_seeded_and_line_of_sight_clear(robot):
     assert len(a.points) <= 2 * a.n_valid
 
 
-def test_pointing_workspace_figure(robot, tmp_path):
+def test_pointing_workspace_draws_four_panels_into_a_png(robot, tmp_path):
     out = tmp_path / "workspace.png"
     fig = pointing_workspace(robot, 600, np.random.default_rng(0), out, color_by="range")
     assert len(fig.axes) == 4

@@ -19,6 +19,7 @@ import contextlib
 import io
 import logging
 import os
+import re
 import sqlite3
 import sys
 import tempfile
@@ -184,36 +185,58 @@ def build_database(logs: Sequence[os.PathLike], db_path: os.PathLike) -> tuple[P
             bad.append(Path(p))
     if not good:
         return None, bad
-    with atomic_path(db_path) as tmp, contextlib.redirect_stdout(io.StringIO()):
+    with atomic_path(db_path) as tmp, contextlib.redirect_stdout(io.StringIO()), \
+            tempfile.TemporaryDirectory(prefix="tpee_logs_") as folder:
         tmp.unlink()  # readBenchmarkLog creates the database itself
-        ot.readBenchmarkLog(str(tmp), [str(p) for p in good], False)
+        ot.readBenchmarkLog(str(tmp), [str(_in_current_format(p, Path(folder))) for p in good], False)
         ot.computeViews(str(tmp), False)
         _parameters_on_progress_rows(tmp)
     return db_path, bad
 
 
-EXPERIMENT_COLUMNS = 12
-"""The ``experiments`` table's own columns (id, name, ..., setup); the experiment parameters follow them."""
+_OLD_NAME = re.compile(r"^(Experiment \S+)_q\d{3}(_(?:N\d+|T\S+s)_\S+)$", re.MULTILINE)
+_OLD_QUERY_ID = re.compile(r"^query_id TEXT = ", re.MULTILINE)
+
+
+def _in_current_format(path: Path, folder: Path) -> Path:
+    """``path``, or for a log written before 2026-11-26 (a resumed campaign's) a copy in ``folder`` in today's format.
+
+    Those logs named the experiment after its query (``..._q007_N500_batched``) and wrote ``query_id`` as TEXT.
+    OMPL's reader types a parameter's column by the first log that has it, so one such log first would make
+    ``query_id`` text for the whole database, and Planner Arena fails on a numeric-looking text parameter."""
+    text = path.read_text()
+    new = _OLD_QUERY_ID.sub("query_id INTEGER = ", _OLD_NAME.sub(r"\1\2", text, count=1), count=1)
+    if new == text:
+        return path
+    copy = folder / f"{len(list(folder.iterdir()))}_{path.name}"
+    copy.write_text(new)
+    return copy
+
+
+OMPL_EXPERIMENT_COLUMNS = ("id", "name", "totaltime", "timelimit", "memorylimit", "runcount", "version", "hostname",
+                           "cpuinfo", "date", "seed", "setup")
+"""The ``experiments`` table's own columns; the others are the experiment parameters."""
 
 
 def _parameters_on_progress_rows(db: Path) -> None:
-    """Repeat each run's experiment parameters on its ``progress`` rows.
+    """Repeat each run's experiment parameters on its ``progress`` rows (one UPDATE, declared types kept).
 
     Planner Arena (1.0.1) filters the progress rows by every experiment parameter, as it does the runs, but
     joins them with the runs' id and planner only: without the parameters there, its progress tab fails on
     any database with experiment parameters (``ColumnNotFoundError``)."""
     con = sqlite3.connect(str(db))
     try:
-        params = [r[1] for r in con.execute("PRAGMA table_info(experiments)")][EXPERIMENT_COLUMNS:]
         have = {r[1] for r in con.execute("PRAGMA table_info(progress)")}
-        if not have:
+        params = [(r[1], r[2]) for r in con.execute("PRAGMA table_info(experiments)")
+                  if r[1] not in OMPL_EXPERIMENT_COLUMNS and r[1] not in have]
+        if not params:
             return
-        for c in params:
-            if c in have:
-                continue
-            con.execute(f'ALTER TABLE progress ADD COLUMN "{c}"')
-            con.execute(f'UPDATE progress SET "{c}" = (SELECT experiments."{c}" FROM runs JOIN experiments '
-                        'ON runs.experimentid = experiments.id WHERE runs.id = progress.runid)')
+        for name, kind in params:
+            con.execute(f'ALTER TABLE progress ADD COLUMN "{name}" {kind}')
+        names = ", ".join(f'"{n}"' for n, _ in params)
+        values = ", ".join(f'experiments."{n}"' for n, _ in params)
+        con.execute(f"UPDATE progress SET ({names}) = (SELECT {values} FROM runs JOIN experiments "
+                    "ON runs.experimentid = experiments.id WHERE runs.id = progress.runid)")
         con.commit()
     finally:
         con.close()

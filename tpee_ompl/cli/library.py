@@ -150,7 +150,8 @@ def run_query(args: argparse.Namespace) -> int:
         start, goal, off_posture = on_postures(args.start, args.goal, i, j)
         with argument("--start/--goal"):
             robot = default_robot()
-            robot.check_free(start, "start"), robot.check_free(goal, "goal")
+            robot.check_free(start, "start")
+            robot.check_free(goal, "goal")
         if off_posture:
             raise CliError(off_posture)
     lib = _load(Path(args.library), fallback=not args.no_fallback)

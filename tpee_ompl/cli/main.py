@@ -16,6 +16,7 @@ import argparse
 import gc
 import logging
 import os
+import select
 import sys
 import traceback
 from collections.abc import Sequence
@@ -52,20 +53,41 @@ def main(argv: Sequence[str] | None = None) -> int:
             code = int(args.func(args) or 0)
             sys.stdout.flush()  # a closed pipe shows here, not in the interpreter's own flush at exit
             return code
-    except BrokenPipeError:
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # nothing more to write, and no error at exit
-        return 141
+    except BrokenPipeError as exc:
+        if _stdout_gone():
+            return 141
+        return _report(args, exc)  # another pipe (a worker's): an error like any other
     except Exception as exc:  # noqa: BLE001 (the last resort: one line, never a traceback without -v)
-        if args.verbose:
-            traceback.print_exc()
-        code, message = _describe(exc)
-        print(f"tpee-ompl {args.command}: error: {message}", file=sys.stderr)
-        return code
+        return _report(args, exc)
     except KeyboardInterrupt:
         print(f"tpee-ompl {args.command}: interrupted", file=sys.stderr)
         return 130
     finally:
         gc.collect()  # break si <-> Python checker cycles before exit (nanobind leak warnings otherwise)
+
+
+def _report(args: argparse.Namespace, exc: Exception) -> int:
+    """Say ``exc`` in one line on stderr (its traceback first with ``-v``); the exit code."""
+    if args.verbose:
+        traceback.print_exception(exc)
+    code, message = _describe(exc)
+    print(f"tpee-ompl {args.command}: error: {message}", file=sys.stderr)
+    return code
+
+
+def _stdout_gone() -> bool:
+    """True when standard output is a pipe whose reader went away (poll says POLLERR); it is then pointed at
+    /dev/null, so that nothing fails again at exit."""
+    try:
+        fd = sys.stdout.fileno()
+        poller = select.poll()
+        poller.register(fd, select.POLLOUT)
+        gone = any(events & select.POLLERR for _, events in poller.poll(0))
+        if gone:
+            os.dup2(os.open(os.devnull, os.O_WRONLY), fd)
+        return gone
+    except (OSError, ValueError, AttributeError):  # no file descriptor (redirected in-process), no poll
+        return False
 
 
 def _describe(exc: Exception) -> tuple[int, str]:

@@ -119,7 +119,8 @@ def _random_region(k: int) -> tuple[TargetRegion, ...]:
 def straight_motion_valid(
     robot: WearerArm, start: np.ndarray, goal: np.ndarray, i: int, j: int, step: float = STRAIGHT_MOTION_STEP
 ) -> bool:
-    """True if every state along the straight motion (checked every ``step`` rad) is collision-free."""
+    """True if every state along the straight motion is collision-free, checked every ``step`` rad (at most the
+    robot's own motion step, :func:`~tpee_ompl.planning.paths.motion_step`: 0.0122 rad for the wearer)."""
     return motion_is_valid(robot, straight_motion(start, goal, i, j), step)
 
 
