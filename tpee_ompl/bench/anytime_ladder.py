@@ -31,11 +31,10 @@ from __future__ import annotations
 import logging
 from collections.abc import Callable
 
-import numpy as np
 from ompl import tools as ot
 
 from .database import log_text
-from .ladder import CheckpointPlanner, derive_planner_runs, run_seconds
+from .ladder import CheckpointPlanner, DeriveContext, derive_planner_runs, run_seconds
 from .planners import PlannerContext, RecordingPlanner
 from .results import format_value
 
@@ -170,15 +169,13 @@ class AnytimeLadder:
                 out.add(name)
         return out
 
-    def derive(self, bench, ss, name: str, records: dict, start: np.ndarray, goal: np.ndarray,
-               simplify: bool, max_time: float, path_properties) -> list[tuple[str, dict, str | None]]:
+    def derive(self, bench, name: str, records: dict, ctx: DeriveContext) -> list[tuple[str, dict, str | None]]:
         """One ``(log text, extras, error)`` per shorter budget, ascending (edits the recorded data in place:
-        call after the longest budget's log is saved).  ``path_properties`` as in :meth:`Ladder.derive`."""
+        call after the longest budget's log is saved)."""
         from .database import _planner_name
 
         ed = bench.getRecordedExperimentData()
-        si, pdef = ss.getSpaceInformation(), ss.getProblemDefinition()
-        pdef.clearSolutionPaths()
+        ctx.ss.getProblemDefinition().clearSolutionPaths()
         base = [copy_planner(pl) for pl in ed.planners]
         order = [_planner_name(pl.name) for pl in base]
         separate = {}
@@ -208,8 +205,7 @@ class AnytimeLadder:
                     planners.append(pl)
                     continue
                 pl = copy_planner(pl0)
-                extras[pname], seconds = derive_planner_runs(pl0, pl, self.wrappers[pname], records.get(pname, []), b,
-                                                             si, pdef, simplify, start, goal, path_properties)
+                extras[pname], seconds = derive_planner_runs(pl0, pl, self.wrappers[pname], records.get(pname, []), b, ctx)
                 total += seconds
                 planners.append(pl)
             ed.planners = planners

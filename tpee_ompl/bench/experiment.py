@@ -30,15 +30,16 @@ from ompl import base as ob
 from ompl import tools as ot
 from ompl import util as ou
 
-from ..planning.grouped_space import RealVectorLayout
-from ..planning.paths import path_length, path_passes_motion_checks
-from .database import failed_run_properties, log_text, pad_aborted_runs, patch_recorded_data
-from .planners import SINGLE_USE_PLANNERS, PlannerContext, RecordingPlanner, planner_factory
-from .problems import get_problem
 from .._version import __version__
 from ..files import write_new_file
-from .results import format_value
+from ..planning.grouped_space import RealVectorLayout
+from ..planning.paths import path_length, path_passes_motion_checks
 from ..validation import sub_seed
+from .database import failed_run_properties, log_text, pad_aborted_runs, patch_recorded_data
+from .ladder import DeriveContext
+from .planners import SINGLE_USE_PLANNERS, PlannerContext, RecordingPlanner, planner_factory
+from .problems import get_problem
+from .results import format_value
 
 __all__ = ["experiment_name", "experiment_specs", "group_lengths", "log_name", "run_query_task"]
 
@@ -359,9 +360,9 @@ def _run_experiment(cfg: dict, task: dict, spec: dict, ladder=None, only: list[s
         sink["planners"] = [copy_planner(pl) for pl in bench.getRecordedExperimentData().planners]
     if ladder is not None:
         try:
-            ladder.derived = ladder.derive(
-                bench, ss, name, records, start, goal, bool(cfg["simplify"]), float(cfg["max_time"]),
-                lambda si_, rec, s0, s1: _path_properties(si_, rec, s0, s1, problem.groups[0], layout))
+            ctx = DeriveContext(ss, start, goal, bool(cfg["simplify"]), float(cfg["max_time"]),
+                                lambda si_, rec, s0, s1: _path_properties(si_, rec, s0, s1, problem.groups[0], layout))
+            ladder.derived = ladder.derive(bench, name, records, ctx)
         except Exception:  # noqa: BLE001 (the smaller caps then run separately)
             log.exception("checkpoint rows of %s failed; running its smaller caps (budgets) separately", name)
     extras = {n: [{k.rsplit(" ", 1)[0]: v for k, v in r["props"].items()} for r in recs] for n, recs in records.items()}

@@ -31,6 +31,7 @@ import dataclasses
 import logging
 import math
 import time
+from collections.abc import Callable
 
 import numpy as np
 from ompl import base as ob
@@ -39,11 +40,11 @@ from ompl import tools as ot
 
 from ..planning.grouped_space import RealVectorLayout
 from ..planning.setup import motion_counts, valid_motion_fraction
-from .planners import PlannerContext, RecordingPlanner, planner_factory
 from .database import log_text
+from .planners import PlannerContext, RecordingPlanner, planner_factory
 from .results import format_value
 
-__all__ = ["LADDER_PLANNERS", "CheckpointPlanner", "Ladder", "group_ladders"]
+__all__ = ["LADDER_PLANNERS", "CheckpointPlanner", "DeriveContext", "Ladder", "group_ladders"]
 
 log = logging.getLogger(__name__)
 
@@ -116,6 +117,20 @@ def _tree_path(pd, si, goal_state, dim: int, read=None) -> tuple[np.ndarray | No
             raise RuntimeError(f"vertex {chain[-1]} has {len(parents)} parents: not a tree")
         chain.append(parents[0])
     return _waypoints([pd.getVertex(i).getState() for i in reversed(chain)], dim, read), exact, diff
+
+
+@dataclasses.dataclass(frozen=True)
+class DeriveContext:
+    """What deriving a ladder's rows takes from its experiment: the set-up, the query's ends, OMPL's ``simplify``
+    request, the safety time limit of a separate run, and ``path_properties(si, record, start, goal)``, which
+    measures a path as the post-run event does (with the problem's groups and state layout)."""
+
+    ss: og.SimpleSetup
+    start: np.ndarray
+    goal: np.ndarray
+    simplify: bool
+    max_time: float
+    path_properties: Callable[..., dict]
 
 
 class CheckpointPlanner(RecordingPlanner):
@@ -255,16 +270,13 @@ class Ladder:
         self.wrappers[w.getName()] = w
         return w
 
-    def derive(self, bench, ss, name: str, records: dict, start: np.ndarray, goal: np.ndarray,
-               simplify: bool, max_time: float, path_properties) -> list[tuple[str, dict, None]]:
+    def derive(self, bench, name: str, records: dict, ctx: DeriveContext) -> list[tuple[str, dict, None]]:
         """One ``(log text, extras, None)`` per smaller cap, ascending (edits the recorded data in place:
-        call after the largest cap's log is saved).  ``path_properties(si, record, start, goal)`` measures a
-        path as the post-run event does (the experiment's, with its problem's groups and state layout)."""
+        call after the largest cap's log is saved)."""
         from .database import _planner_name
 
         ed = bench.getRecordedExperimentData()
-        si, pdef = ss.getSpaceInformation(), ss.getProblemDefinition()
-        self._run_pending(ss, max_time)
+        self._run_pending(ctx.ss, ctx.max_time)
         out = []
         for n in self.checkpoints:
             ed.name = name.replace(f"_N{self.cap}_", f"_N{n}_")
@@ -274,8 +286,7 @@ class Ladder:
             extras, total = {}, 0.0
             for pl in ed.planners:
                 pname = _planner_name(pl.name)
-                extras[pname], seconds = derive_planner_runs(pl, pl, self.wrappers[pname], records.get(pname, []), n,
-                                                             si, pdef, simplify, start, goal, path_properties)
+                extras[pname], seconds = derive_planner_runs(pl, pl, self.wrappers[pname], records.get(pname, []), n, ctx)
                 total += seconds
                 pl.common["iteration_cap"] = str(n)
                 if "planner.max_samples" in pl.common.to_dict():  # our planners' own cap: the row's, as a run capped at n
@@ -377,15 +388,16 @@ class Ladder:
         return out
 
 
-def derived_run(si, pdef, w: CheckpointPlanner, i: int, row: dict, rec: dict, snap: dict | None, simplify: bool,
-                start: np.ndarray, goal: np.ndarray, path_properties) -> tuple[dict, list, dict]:
+def derived_run(ctx: DeriveContext, w: CheckpointPlanner, i: int, row: dict, rec: dict,
+                snap: dict | None) -> tuple[dict, list, dict]:
     """Run ``i``'s (OMPL row, progress, our columns) at one checkpoint: the recorded run itself when
     ``snap`` is None (the run ended before the checkpoint), else the snapshot's columns."""
     if snap is None:
         return row, rec["progress"], rec["props"]
-    row = Ladder._ompl_columns(si, pdef, row, snap, simplify)
+    si = ctx.ss.getSpaceInformation()
+    row = Ladder._ompl_columns(si, ctx.ss.getProblemDefinition(), row, snap, ctx.simplify)
     checks = snap.get("own_checks", snap["checks"] - w.start_checks[i])  # the search's, as a full run's
-    props = Ladder._our_columns(si, rec["props"], snap, checks, start, goal, path_properties)
+    props = Ladder._our_columns(si, rec["props"], snap, checks, ctx.start, ctx.goal, ctx.path_properties)
     row.update({k: format_value(v) for k, v in props.items()})
     prog = snap.get("progress")
     if prog is None:
@@ -394,15 +406,15 @@ def derived_run(si, pdef, w: CheckpointPlanner, i: int, row: dict, rec: dict, sn
     return row, prog, props
 
 
-def derive_planner_runs(source, target, w: CheckpointPlanner, recs: list[dict], key, si, pdef, simplify: bool,
-                        start: np.ndarray, goal: np.ndarray, path_properties) -> tuple[list[dict], float]:
+def derive_planner_runs(source, target, w: CheckpointPlanner, recs: list[dict], key,
+                        ctx: DeriveContext) -> tuple[list[dict], float]:
     """Write into ``target`` (an ``ot.PlannerExperiment``) the runs of ``source`` as they stood at checkpoint
     ``key`` (a cap or a budget; :func:`derived_run` per run); return the runs' extra columns and their seconds."""
     rows, progress, extras = [], [], []
     for i, run in enumerate(source.runs):
         snap = w.snapshots[i].get(key) if i < len(w.snapshots) else None
         rec = recs[i] if i < len(recs) else {"props": {}, "progress": []}
-        row, prog, props = derived_run(si, pdef, w, i, run.to_dict(), rec, snap, simplify, start, goal, path_properties)
+        row, prog, props = derived_run(ctx, w, i, run.to_dict(), rec, snap)
         rows.append(row)
         progress.append(prog)
         extras.append({k.rsplit(" ", 1)[0]: v for k, v in props.items()})
