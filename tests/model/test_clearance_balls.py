@@ -177,3 +177,13 @@ def test_every_motion_rrtstar_asks_about_gets_the_dense_verdict(robot):
     dense = np.array([robot.are_valid(motion_states(a, b, step)).all() for a, b, _ in recorder.seen])
     assert len(verdicts) > 300 and 0 < verdicts.sum() < len(verdicts)
     np.testing.assert_array_equal(verdicts, dense)
+
+
+def test_the_screens_cost_ratio_counts_no_checks_and_is_unknown_without_free_states(robot, monkeypatch):
+    from tpee_ompl.model.clearance_balls import BallScreen
+
+    screen = BallScreen(robot)
+    before = robot.collision_checks
+    assert screen.cost_ratio(4 * robot.max_joint_step()) > 0 and robot.collision_checks == before
+    monkeypatch.setattr(robot, "collision_free", lambda Q, pool=None: np.zeros(len(Q), dtype=bool))
+    assert screen.cost_ratio(robot.max_joint_step()) is None and screen.pays(robot.max_joint_step())

@@ -340,6 +340,10 @@ def test_joints_it_cannot_plan_are_refused_with_what_to_do_and_locking_them_work
     with pytest.raises(ValueError, match="joint 'j2' is continuous.*lock it at an angle"):
         RobotChecker(continuous)
     assert RobotChecker(continuous, locked={"j2": 0.3}).nq == 1  # the advice can be followed
+    both = tmp_path / "both.urdf"  # every continuous joint in one message, not one per attempt
+    both.write_text(continuous.read_text().replace('name="j1" type="revolute"', 'name="j1" type="continuous"'))
+    with pytest.raises(ValueError, match="joints 'j1', 'j2' are continuous.*lock them at an angle"):
+        RobotChecker(both)
     floating = _two_joint_urdf(tmp_path / "floating.urdf", 'type="floating"><parent link="base"/><child link="b"/>')
     with pytest.raises(ValueError, match="'j2' .*7 position values.*fixed joint"):
         RobotChecker(floating)
@@ -407,3 +411,13 @@ def test_check_free_returns_a_free_configuration_and_names_one_out_of_limits_or_
         robot.check_free(robot.upper + 0.1, "start")
     with pytest.raises(ValueError, match=r"^initial configuration: configuration contains NaN"):
         robot.check_free(np.full(robot.nq, np.nan), "initial configuration")
+
+
+def test_a_package_mesh_not_found_names_package_dirs(tmp_path):
+    urdf = tmp_path / "m.urdf"
+    urdf.write_text("""<robot name="m"><link name="base"/><link name="a"><collision><geometry>
+      <mesh filename="package://nowhere/meshes/a.stl"/></geometry></collision></link>
+      <joint name="j1" type="revolute"><parent link="base"/><child link="a"/><axis xyz="0 0 1"/>
+        <limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>""")
+    with pytest.raises(ValueError, match=r"could not be found.*package_dirs.*given: none"):
+        RobotChecker(urdf)

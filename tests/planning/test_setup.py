@@ -249,3 +249,19 @@ def test_setup_arguments_are_named_in_their_errors(robot):
         make_simple_setup(robot, check_endpoints=None)
     with pytest.raises(ValueError, match="contradicts"):
         make_simple_setup(robot, batched_motion_validator=True, motion_validator="discrete")
+
+
+def test_a_robot_whose_screen_costs_more_than_it_saves_is_checked_densely_with_the_same_verdicts(rng, monkeypatch):
+    from tpee_ompl.model.clearance_balls import SCREEN_COST_LIMIT, SCREEN_LEVELS, BallScreen
+
+    ratios = {"costly": 10 * SCREEN_COST_LIMIT, "cheap": SCREEN_COST_LIMIT / 10}
+    validators = {}
+    for kind, ratio in ratios.items():
+        monkeypatch.setattr(BallScreen, "cost_ratio", lambda self, radius, r=ratio: r)
+        robot = WearerArm()  # its own screen: the measured ratio is kept per robot
+        validators[kind] = make_simple_setup(robot).getSpaceInformation().getMotionValidator()
+    assert validators["costly"].screen_levels == () and validators["cheap"].screen_levels == SCREEN_LEVELS
+    robot = validators["cheap"].robot
+    A = rng.uniform(robot.lower, robot.upper, (60, robot.nq))
+    B = np.clip(A + rng.normal(scale=0.3, size=A.shape), robot.lower, robot.upper)
+    np.testing.assert_array_equal(validators["costly"].check_motions(A, B), validators["cheap"].check_motions(A, B))

@@ -18,6 +18,7 @@ changes, only its cost):
 from __future__ import annotations
 
 import math
+import time
 from collections.abc import Iterable
 from typing import TYPE_CHECKING
 
@@ -27,7 +28,8 @@ import pinocchio as pin
 if TYPE_CHECKING:
     from .robot_checker import RobotChecker
 
-__all__ = ["BallScreen", "SCREEN_LEVELS", "separated_pairs", "screened_all_valid", "screened_lines_valid"]
+__all__ = ["BallScreen", "SCREEN_COST_LIMIT", "SCREEN_LEVELS", "separated_pairs", "screened_all_valid",
+           "screened_lines_valid"]
 
 SEPARATION_TOLERANCE = 1e-5
 """Metres taken off every Coal distance (and added to every inflated margin) before it proves anything."""
@@ -40,6 +42,16 @@ certified by one state checked at the inflated margins; what no ball covers is c
 Measured on RRT* motions of the wearer and the Panda (``experiments/screened_motions.py --levels 2,1
 4,1 ...``): against (2, 1), the radii until 2026-11-25, 10-11 % less time on the wearer's motions and
 7 % on the Panda's; (3, 1), (4, 2, 1) and (8, 1) were slower, (6, 1) slower on the wearer."""
+
+
+SCREEN_COST_LIMIT = 4.0
+"""The screen is used where its inflated check of a state costs at most this many plain checks
+(:meth:`BallScreen.pays`).  A ball of 4 steps covers up to 9 states; near contact, Coal's mesh-mesh checks at
+inflated margins can cost far more than that saves (a helper's probe, 2026-11-26: per valid state, 0.7x a
+plain check on the wearer and 0.8x on the Panda shelf, 9x on a UR5 with gripper, 11x on the Talos arm, 51x on a
+Kinova arm whose link meshes have 17,000-45,000 triangles: there one 28-state screen call took 3 s)."""
+_CALIBRATION_DRAWS = 512
+_CALIBRATION_STATES = 32
 
 
 def separated_pairs(robot: RobotChecker) -> list[int]:
@@ -97,6 +109,42 @@ class BallScreen:
         self.robot = robot
         self._lever_norms = np.linalg.norm(robot.pair_lever_arms(), axis=1)
         self._pools: dict[float, pin.GeometryPool] = {}
+        self._pays: dict[float, bool] = {}
+
+    def pays(self, radius: float) -> bool:
+        """Whether screening at ``radius`` pays on this robot: its check of a state costs at most
+        :data:`SCREEN_COST_LIMIT` plain checks (:meth:`cost_ratio`, measured once per radius; True when it
+        cannot be measured).  Only the cost depends on it: a screened and a dense check give the same verdicts."""
+        radius = float(radius)
+        if radius not in self._pays:
+            ratio = self.cost_ratio(radius)
+            self._pays[radius] = ratio is None or ratio <= SCREEN_COST_LIMIT
+        return self._pays[radius]
+
+    def cost_ratio(self, radius: float) -> float | None:
+        """Time of the inflated check at ``radius`` over the plain check, on up to 32 collision-free states drawn
+        (seeded) in the joint box, the best of three calls each (a call the scheduler interrupted does not
+        decide); None when fewer than 4 of 512 draws are free.  The checks are not counted in ``collision_checks``."""
+        robot = self.robot
+        counted = robot.collision_checks
+        try:
+            Q = np.random.default_rng(0).uniform(robot.lower, robot.upper, (_CALIBRATION_DRAWS, robot.nq))
+            V = Q[robot.collision_free(Q)][:_CALIBRATION_STATES]
+            if len(V) < 4:
+                return None
+            plain, screened = math.inf, math.inf
+            for _ in range(3):
+                t0 = time.perf_counter()
+                robot.collision_free(V)
+                t1 = time.perf_counter()
+                self.clear(V, radius)
+                t2 = time.perf_counter()
+                plain, screened = min(plain, t1 - t0), min(screened, t2 - t1)
+                if screened > 10 * SCREEN_COST_LIMIT * plain:  # far beyond the limit: no need to look again
+                    break
+            return screened / max(plain, 1e-9)
+        finally:
+            robot.collision_checks = counted
 
     def _pool(self, radius: float) -> pin.GeometryPool:
         pool = self._pools.get(radius)

@@ -197,7 +197,11 @@ def load_urdf_model(
         model = pin.buildModelFromXML(text)
         gmodel = pin.buildGeomFromUrdfString(model, text, pin.GeometryType.COLLISION, package_dirs=dirs)
     except Exception as exc:  # the bindings raise RuntimeError/ValueError with C++ text
-        raise ValueError(f"Pinocchio could not load URDF {urdf}: {exc}") from exc
+        hint = ""
+        if "package://" in str(exc) and "could not be found" in str(exc):
+            hint = (" (a package:// mesh is looked up in package_dirs: give the folder that holds the package's "
+                    f"folder, e.g. package_dirs=[...]; given: {dirs or 'none'})")
+        raise ValueError(f"Pinocchio could not load URDF {urdf}: {' '.join(str(exc).split())}{hint}") from exc
     if gmodel.ngeoms != n_collision_elements:
         raise ValueError(
             f"URDF {urdf}: {n_collision_elements} <collision> elements but only "
@@ -295,11 +299,15 @@ def _lock_joints(model: pin.Model, gmodel: pin.GeometryModel, locked: Mapping[st
 
 def _check_joints(model: pin.Model, urdf: Path) -> None:
     """Every planned joint is 1-DOF (revolute or prismatic) with finite limits."""
+    continuous = [model.names[jid] for jid in range(1, model.njoints) if is_continuous(model.joints[jid])]
+    if continuous:  # all of them in one message: a user fixes them in one pass
+        joints = ", ".join(repr(n) for n in continuous)
+        raise ValueError(f"URDF {urdf}: joint{'s' if len(continuous) > 1 else ''} {joints} "
+                         f"{'are' if len(continuous) > 1 else 'is'} continuous (no limits): give "
+                         f"{'them' if len(continuous) > 1 else 'it'} limits as revolute joints in the URDF, or lock "
+                         f"{'them' if len(continuous) > 1 else 'it'} at an angle (locked={{{continuous[0]!r}: angle}})")
     for jid in range(1, model.njoints):
         j, name = model.joints[jid], model.names[jid]
-        if is_continuous(j):
-            raise ValueError(f"URDF {urdf}: joint {name!r} is continuous (no limits): give it limits as a revolute "
-                             f"joint in the URDF, or lock it at an angle (locked={{{name!r}: angle}})")
         if j.nq != 1 or j.nv != 1:
             raise ValueError(f"URDF {urdf}: joint {name!r} ({j.shortname()}) has {j.nq} position values; only 1-DOF "
                              "joints are planned: make it a fixed joint in the URDF")

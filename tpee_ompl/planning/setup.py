@@ -16,6 +16,7 @@ checked links.**
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
@@ -23,7 +24,7 @@ import numpy as np
 from ompl import base as ob
 from ompl import geometric as og
 
-from ..model.clearance_balls import SCREEN_LEVELS, screened_all_valid, screened_lines_valid
+from ..model.clearance_balls import SCREEN_COST_LIMIT, SCREEN_LEVELS, screened_all_valid, screened_lines_valid
 from ..model.robot_checker import RobotChecker
 from ..validation import check_bool, check_number
 from .paths import MIN_JOINT_STEP, batched_motion_states, set_state, state_to_array, unchecked_motion_states
@@ -42,6 +43,8 @@ __all__ = [
     "valid_motion_fraction",
     "MOTION_VALIDATORS",
 ]
+
+log = logging.getLogger(__name__)
 
 MOTION_VALIDATORS = ("batched", "certified", "dense", "discrete")
 """Names accepted by ``make_simple_setup(motion_validator=...)``."""
@@ -101,9 +104,17 @@ class BatchedMotionValidator(ob.MotionValidator):
         self.motions_valid = 0
         """Motions checked / found valid (OMPL's own counters stay at 0 under a Python ``checkMotion``:
         :func:`motion_counts` reads these)."""
-        self.screen_levels = tuple(check_number("screen_levels (motion-check steps)", h, low=0.5, high=1e3)
-                                   for h in screen_levels)
-        robot.ball_screen().prepare(h * self.step for h in self.screen_levels)  # not in the first plan's time
+        levels = tuple(check_number("screen_levels (motion-check steps)", h, low=0.5, high=1e3) for h in screen_levels)
+        if levels:
+            screen = robot.ball_screen()
+            screen.prepare(h * self.step for h in levels)  # not in the first plan's time
+            if not screen.pays(max(levels) * self.step):
+                log.info("motion checks without clearance balls: on this robot a screened state costs more than "
+                         "%g plain checks", SCREEN_COST_LIMIT)
+                levels = ()
+        self.screen_levels = levels
+        """The ball radii screened with (motion-check steps); () where screening does not pay on the robot
+        (:meth:`~tpee_ompl.model.clearance_balls.BallScreen.pays`) or was not asked for."""
 
     def factor(self) -> int:
         """The space's ``validSegmentCountFactor`` f now: a motion of length d gets ``f * ceil(d / step)``
