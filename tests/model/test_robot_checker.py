@@ -421,3 +421,15 @@ def test_a_package_mesh_not_found_names_package_dirs(tmp_path):
         <limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>""")
     with pytest.raises(ValueError, match=r"could not be found.*package_dirs.*given: none"):
         RobotChecker(urdf)
+
+
+def test_a_collision_between_neighbouring_links_points_to_the_srdf(tmp_path):
+    ball = '<collision><geometry><sphere radius="0.1"/></geometry></collision>'
+    urdf = tmp_path / "touching.urdf"
+    urdf.write_text(f"""<robot name="t"><link name="base"/><link name="a">{ball}</link><link name="b">{ball}</link>
+      <joint name="j1" type="revolute"><parent link="base"/><child link="a"/><axis xyz="0 0 1"/>
+        <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+      <joint name="j2" type="revolute"><parent link="a"/><child link="b"/><origin xyz="0 0 0.05"/><axis xyz="0 0 1"/>
+        <limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>""")
+    with pytest.raises(ValueError, match=r"^start .* is in collision \(.* neighbouring links: .* SRDF\)"):
+        RobotChecker(urdf).check_free(np.zeros(2), "start")

@@ -350,8 +350,17 @@ class RobotChecker:
             raise ValueError(f"{name} {shown} is outside the joint limits")
         if not self.is_valid(q):
             a, b, d = self.closest_pair(q)
-            raise ValueError(f"{name} {shown} is in collision ({a} vs {b}, distance {d:.3f} m)")
+            hint = ""
+            if self._neighbours(a, b):
+                hint = "; they are neighbouring links: if they always touch, disable the pair in the SRDF"
+            raise ValueError(f"{name} {shown} is in collision ({a} vs {b}, distance {d:.3f} m{hint})")
         return q
+
+    def _neighbours(self, geometry_a: str, geometry_b: str) -> bool:
+        """True when the two geometries' bodies are joined by one joint (or are one body)."""
+        geoms = self.gmodel.geometryObjects
+        ja, jb = (geoms[self.gmodel.getGeometryId(g)].parentJoint for g in (geometry_a, geometry_b))
+        return ja == jb or self.model.parents[ja] == jb or self.model.parents[jb] == ja
 
     def frame_placement(self, q: np.ndarray, frame: str) -> pin.SE3:
         """World placement of a named frame at configuration q."""

@@ -345,8 +345,11 @@ def _apply_srdf(model: pin.Model, gmodel: pin.GeometryModel, srdf: Path) -> None
     """Remove the SRDF's disabled pairs, after checking that it names only links of the model."""
     root = _read_robot_xml(srdf, "SRDF")
     links = {f.name for f in model.frames}
-    for dc in root.iter("disable_collisions"):
-        for key in ("link1", "link2"):
-            if dc.get(key) not in links:
-                raise ValueError(f"SRDF {srdf} names unknown link {dc.get(key)!r}")
+    pairs = [(dc.get("link1"), dc.get("link2")) for dc in root.iter("disable_collisions")]
+    foreign = [p for p in pairs if p[0] not in links or p[1] not in links]
+    if foreign:
+        name = next(n for n in foreign[0] if n not in links)
+        raise ValueError(f"SRDF {srdf} names unknown link {name!r} ({len(foreign)} of its {len(pairs)} disabled pairs "
+                         "name links the URDF lacks: an SRDF of another or a larger robot? keep only the pairs of "
+                         "this URDF's links)")
     pin.removeCollisionPairs(model, gmodel, str(srdf))
