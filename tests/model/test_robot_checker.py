@@ -433,3 +433,32 @@ def test_a_collision_between_neighbouring_links_points_to_the_srdf(tmp_path):
         <limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>""")
     with pytest.raises(ValueError, match=r"^start .* is in collision \(.* neighbouring links: .* SRDF\)"):
         RobotChecker(urdf).check_free(np.zeros(2), "start")
+
+
+def _l_shaped_stl(path) -> None:
+    """An ASCII STL of an L-shaped prism (0.4 x 0.4 x 0.1 m, the square [0.1, 0.4]^2 cut out of its corner)."""
+    outline = [(0, 0), (0.4, 0), (0.4, 0.1), (0.1, 0.1), (0.1, 0.4), (0, 0.4)]
+    tris = [((0, 0), (0.4, 0), (0.4, 0.1)), ((0, 0), (0.4, 0.1), (0.1, 0.1)), ((0, 0), (0.1, 0.1), (0.1, 0.4)),
+            ((0, 0), (0.1, 0.4), (0, 0.4))]
+    facets = [[(x, y, z) for x, y in t] for t in tris for z in (0.0, 0.1)]
+    for k in range(len(outline)):  # the side walls
+        (x0, y0), (x1, y1) = outline[k], outline[(k + 1) % len(outline)]
+        facets += [[(x0, y0, 0), (x1, y1, 0), (x1, y1, 0.1)], [(x0, y0, 0), (x1, y1, 0.1), (x0, y0, 0.1)]]
+    body = "".join("facet normal 0 0 0\n outer loop\n" + "".join(f"  vertex {x} {y} {z}\n" for x, y, z in f)
+                   + " endloop\nendfacet\n" for f in facets)
+    path.write_text(f"solid l\n{body}endsolid l\n")
+
+
+def test_convex_meshes_check_a_mesh_as_its_hull_which_covers_its_notch(tmp_path):
+    _l_shaped_stl(tmp_path / "l.stl")
+    urdf = tmp_path / "l.urdf"
+    urdf.write_text(f"""<robot name="l"><link name="base"/><link name="a"><collision><geometry>
+      <mesh filename="{tmp_path / 'l.stl'}"/></geometry></collision></link>
+      <joint name="j1" type="revolute"><parent link="base"/><child link="a"/><axis xyz="0 0 1"/>
+        <limit lower="-0.1" upper="0.1" effort="1" velocity="1"/></joint></robot>""")
+    notch = [Obstacle("ball", "sphere", (0.02,), (0.2, 0.2, 0.05))]  # in the L's cut-out corner, inside its hull
+    detailed = RobotChecker(urdf, obstacles=notch, security_margin=0.0)
+    hull = RobotChecker(urdf, obstacles=notch, security_margin=0.0, convex_meshes=True)
+    assert isinstance(hull.gmodel.geometryObjects[0].geometry, coal.ConvexBase)
+    assert detailed.is_valid(np.zeros(1)) and not hull.is_valid(np.zeros(1))
+    assert hull.model_hash != detailed.model_hash  # libraries and query sets made with one are not the other's

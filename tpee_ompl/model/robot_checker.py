@@ -92,6 +92,9 @@ class RobotChecker:
         False keeps true cylinders.  Obstacles are never converted.
     extra_points : sequence of frame names
         Frames whose origins count as robot points in :meth:`lever_arms` (e.g. a tool tip).
+    convex_meshes : bool
+        Check every robot mesh as its convex hull (never a collision missed; cheap near contact, where a
+        detailed mesh at a positive margin can cost milliseconds per pair).  Off by default.
     """
 
     def __init__(
@@ -107,6 +110,7 @@ class RobotChecker:
         package_dirs: Sequence[str | os.PathLike] = (),
         cylinders_as_capsules: bool = True,
         extra_points: Sequence[str] = (),
+        convex_meshes: bool = False,
     ) -> None:
         for what, value in (("urdf_path", urdf_path), ("srdf_path", srdf_path)):
             if value is not None and not isinstance(value, (str, os.PathLike)) or isinstance(value, bool):
@@ -122,7 +126,8 @@ class RobotChecker:
         if not isinstance(package_dirs, (list, tuple)) or not all(isinstance(d, (str, os.PathLike)) for d in package_dirs):
             raise ValueError(f"package_dirs must be a path or a list of paths, got {package_dirs!r}")
         self._options = {"package_dirs": tuple(package_dirs), "locked": dict(locked or {}), "obstacles": tuple(obstacles),
-                         "cylinders_as_capsules": check_bool("cylinders_as_capsules", cylinders_as_capsules)}
+                         "cylinders_as_capsules": check_bool("cylinders_as_capsules", cylinders_as_capsules),
+                         "convex_meshes": check_bool("convex_meshes", convex_meshes)}
         self._setup(ModelFiles(Path(urdf_path), Path(srdf_path) if srdf_path is not None else None),
                     security_margin, n_threads, link_margins, extra_points)
 
@@ -350,9 +355,8 @@ class RobotChecker:
             raise ValueError(f"{name} {shown} is outside the joint limits")
         if not self.is_valid(q):
             a, b, d = self.closest_pair(q)
-            hint = ""
-            if self._neighbours(a, b):
-                hint = "; they are neighbouring links: if they always touch, disable the pair in the SRDF"
+            hint = ("; neighbouring links: if they always touch, disable the pair in the SRDF"
+                    if self._neighbours(a, b) else "")
             raise ValueError(f"{name} {shown} is in collision ({a} vs {b}, distance {d:.3f} m{hint})")
         return q
 
