@@ -186,7 +186,7 @@ def load_urdf_model(
     meshes).  Obstacles go on the universe joint.
     Collision pairs: every pair of geometries on different joints (so never obstacle-obstacle or
     obstacle-base), minus the SRDF's disabled link pairs.  The model hash covers the URDF and SRDF
-    texts and, when given, the locked values, obstacles and a ``cylinders_as_capsules=False``.
+    texts and, when given, the locked values, obstacles, a ``cylinders_as_capsules=False`` and ``convex_meshes``.
 
     Raises FileNotFoundError (a missing file) or ValueError (anything that would load wrongly).
     """
