@@ -1,12 +1,13 @@
 """Mesh robots of example-robot-data: what a check costs, whether the clearance-ball screen pays, and what
 ``convex_meshes=True`` changes.
 
-    PYTHONPATH=. .venv/bin/python experiments/mesh_robots.py          # about 1 min
+    PYTHONPATH=. .venv/bin/python experiments/mesh_robots.py          # about 2 min
 
 For each robot (UR5 with gripper, a Kinova arm, the SO101 arm, the Talos left arm), as a user would set it up:
 continuous joints limited to +-pi in a copy of the URDF (what the refusal says to do), and an SRDF that
 disables the pairs of links touching in at least 95 % of 300 random configurations (the MoveIt setup
-assistant's "always" pairs), plus the shipped SRDF's pairs of links the URDF has.  Prints, with the meshes as
+assistant's "always" pairs; found with the convex hulls, which touch at least as often as the meshes, and used
+for both), plus the shipped SRDF's pairs of links the URDF has.  Prints, with the meshes as
 they are and as convex hulls: the checker's build time, the cost of a batched check per configuration, the
 share of 300 random configurations that are free, and the screen's cost ratio (:meth:`BallScreen.cost_ratio`;
 the validator screens where it is at most ``SCREEN_COST_LIMIT``).

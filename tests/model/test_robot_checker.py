@@ -433,6 +433,11 @@ def test_a_collision_between_neighbouring_links_points_to_the_srdf(tmp_path):
         <limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>""")
     with pytest.raises(ValueError, match=r"^start .* is in collision \(.* neighbouring links: .* SRDF\)"):
         RobotChecker(urdf).check_free(np.zeros(2), "start")
+    srdf = tmp_path / "touching.srdf"  # the neighbours' pair disabled: what is left is the table
+    srdf.write_text('<robot name="t"><disable_collisions link1="a" link2="b" reason="Adjacent"/></robot>')
+    table = Obstacle("table", "box", (1.0, 1.0, 0.1), (0.0, 0.0, 0.0))  # an obstacle is nobody's neighbour
+    with pytest.raises(ValueError, match=r"is in collision \(\S+ vs \S+, distance -?[\d.]+ m\)$"):
+        RobotChecker(urdf, srdf, obstacles=[table]).check_free(np.zeros(2), "start")
 
 
 def _l_shaped_stl(path) -> None:
@@ -462,3 +467,20 @@ def test_convex_meshes_check_a_mesh_as_its_hull_which_covers_its_notch(tmp_path)
     assert isinstance(hull.gmodel.geometryObjects[0].geometry, coal.ConvexBase)
     assert detailed.is_valid(np.zeros(1)) and not hull.is_valid(np.zeros(1))
     assert hull.model_hash != detailed.model_hash  # libraries and query sets made with one are not the other's
+
+
+def test_convex_meshes_keep_a_flat_mesh_and_leave_a_robot_without_meshes_as_it_was(tmp_path, robot):
+    (tmp_path / "flat.stl").write_text("solid f\n" + "".join(
+        "facet normal 0 0 1\n outer loop\n" + "".join(f"  vertex {x} {y} 0\n" for x, y in t) + " endloop\nendfacet\n"
+        for t in (((0, 0), (0.2, 0), (0.2, 0.2)), ((0, 0), (0.2, 0.2), (0, 0.2)))) + "endsolid f\n")
+    urdf = tmp_path / "flat.urdf"
+    urdf.write_text(f"""<robot name="f"><link name="base"/><link name="a"><collision><geometry>
+      <mesh filename="{tmp_path / 'flat.stl'}"/></geometry></collision></link>
+      <joint name="j1" type="revolute"><parent link="base"/><child link="a"/><axis xyz="0 0 1"/>
+        <limit lower="-0.1" upper="0.1" effort="1" velocity="1"/></joint></robot>""")
+    flat = RobotChecker(urdf, convex_meshes=True)  # Coal's hull crashed the process on four coplanar points
+    assert isinstance(flat.gmodel.geometryObjects[0].geometry, coal.BVHModelBase)
+    assert flat.model_hash == RobotChecker(urdf).model_hash  # nothing was converted
+    wearer = WearerArm()
+    assert RobotChecker(wearer.files.urdf, wearer.files.srdf, convex_meshes=True).model_hash == \
+        RobotChecker(wearer.files.urdf, wearer.files.srdf).model_hash

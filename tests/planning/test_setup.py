@@ -261,6 +261,9 @@ def test_a_robot_whose_screen_costs_more_than_it_saves_is_checked_densely_with_t
         robot = WearerArm()  # its own screen: the measured ratio is kept per robot
         validators[kind] = make_simple_setup(robot).getSpaceInformation().getMotionValidator()
     assert validators["costly"].screen_levels == () and validators["cheap"].screen_levels == SCREEN_LEVELS
+    costly = validators["costly"]
+    si = make_simple_setup(costly.robot).getSpaceInformation()
+    assert BatchedMotionValidator(si, costly.robot, costly.step, screen_levels=(2.0, 1.0)).screen_levels == (2.0, 1.0)
     robot = validators["cheap"].robot
     A = rng.uniform(robot.lower, robot.upper, (60, robot.nq))
     B = np.clip(A + rng.normal(scale=0.3, size=A.shape), robot.lower, robot.upper)

@@ -361,10 +361,10 @@ class RobotChecker:
         return q
 
     def _neighbours(self, geometry_a: str, geometry_b: str) -> bool:
-        """True when the two geometries' bodies are joined by one joint (or are one body)."""
-        geoms = self.gmodel.geometryObjects
-        ja, jb = (geoms[self.gmodel.getGeometryId(g)].parentJoint for g in (geometry_a, geometry_b))
-        return ja == jb or self.model.parents[ja] == jb or self.model.parents[jb] == ja
+        """True when the geometries' bodies are one or joined by one joint; an obstacle (universe frame) never is."""
+        a, b = (self.gmodel.geometryObjects[self.gmodel.getGeometryId(g)] for g in (geometry_a, geometry_b))
+        ja, jb, up = a.parentJoint, b.parentJoint, self.model.parents
+        return (ja == jb or up[ja] == jb or up[jb] == ja) and 0 not in (a.parentFrame, b.parentFrame)
 
     def frame_placement(self, q: np.ndarray, frame: str) -> pin.SE3:
         """World placement of a named frame at configuration q."""

@@ -186,7 +186,8 @@ def load_urdf_model(
     meshes).  Obstacles go on the universe joint.
     Collision pairs: every pair of geometries on different joints (so never obstacle-obstacle or
     obstacle-base), minus the SRDF's disabled link pairs.  The model hash covers the URDF and SRDF
-    texts and, when given, the locked values, obstacles, a ``cylinders_as_capsules=False`` and ``convex_meshes``.
+    texts and, when given, the locked values, obstacles, a ``cylinders_as_capsules=False`` and the meshes made
+    convex hulls (``convex_meshes``; a flat mesh, which has none, stays a mesh).
 
     Raises FileNotFoundError (a missing file) or ValueError (anything that would load wrongly).
     """
@@ -221,17 +222,19 @@ def load_urdf_model(
         raise ValueError(f"URDF {urdf}: no joint left to plan (every joint is fixed or locked)")
     if not any(go.parentJoint != 0 for go in gmodel.geometryObjects):
         raise ValueError(f"URDF {urdf}: no <collision> geometry moves with the planned joints: nothing to check")
+    hulls: list[str] = []
     for go in gmodel.geometryObjects:
         _check_shape_sizes(go.geometry, go.name, urdf)
         if cylinders_as_capsules and isinstance(go.geometry, coal.Cylinder):
             go.geometry = coal.Capsule(go.geometry.radius, 2.0 * go.geometry.halfLength)
-        if convex_meshes and isinstance(go.geometry, coal.BVHModelBase):
+        if convex_meshes and isinstance(go.geometry, coal.BVHModelBase) and _solid(go.geometry):
             go.geometry.buildConvexHull(True, "Qt")
             go.geometry = go.geometry.convex
+            hulls.append(go.name)
     if not cylinders_as_capsules:
         extra.append("cylinders_as_capsules=False")
-    if convex_meshes:
-        extra.append("convex_meshes=True")
+    if hulls:
+        extra.append("convex_meshes=" + ",".join(hulls))
     dropped = _drop_contained_spheres(gmodel)
     if dropped:
         extra.append("dropped_contained_spheres=" + ",".join(dropped))
@@ -250,6 +253,16 @@ def load_urdf_model(
     if srdf is not None:
         _apply_srdf(model, gmodel, srdf)
     return LoadedModel(model, gmodel, digest.hexdigest()[:16])
+
+
+def _solid(mesh: coal.BVHModelBase) -> bool:
+    """True when a mesh's vertices span three dimensions, so that it has a convex hull (Coal's ``buildConvexHull``
+    crashes the process on four or more coplanar points and refuses fewer than four): a flat mesh stays a mesh."""
+    V = np.asarray(mesh.vertices(), dtype=float).reshape(-1, 3)
+    if len(V) < 4:
+        return False
+    s = np.linalg.svd(V - V.mean(axis=0), compute_uv=False)
+    return bool(s[2] > 1e-9 * max(s[0], 1e-12))
 
 
 def _drop_contained_spheres(gmodel: pin.GeometryModel) -> list[str]:

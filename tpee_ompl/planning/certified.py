@@ -132,7 +132,7 @@ class CertifiedMotionValidator(BatchedMotionValidator):
 
     def __init__(self, si: ob.SpaceInformation, robot: RobotChecker, step: float,
                  options: CertifiedMotionOptions | None = None) -> None:
-        super().__init__(si, robot, step)
+        super().__init__(si, robot, step, screen_levels=())  # its own certificates, not the balls' screen
         self.options = options if options is not None else CertifiedMotionOptions()
         if not isinstance(self.options, CertifiedMotionOptions):
             raise ValueError(f"options must be CertifiedMotionOptions, got {type(self.options).__name__}")

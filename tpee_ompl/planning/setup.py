@@ -86,14 +86,14 @@ class BatchedMotionValidator(ob.MotionValidator):
     honours the space's ``validSegmentCountFactor``: OMPL's Benchmark sets it to 4 for its
     ``correct_solution_strict`` column, which then really checks 4x more densely.
 
-    By default the states are screened first (``screen_levels``,
+    By default the states are screened first where that pays on the robot (``screen_levels``,
     :func:`~tpee_ompl.model.clearance_balls.screened_all_valid`): one state checked at margins
     inflated for a ball of a few steps certifies its neighbours, and only the states no ball covers
     are checked themselves; the verdict is the same.  ``screen_levels=()`` checks every state.
     """
 
     def __init__(self, si: ob.SpaceInformation, robot: RobotChecker, step: float,
-                 screen_levels: Sequence[float] = SCREEN_LEVELS) -> None:
+                 screen_levels: Sequence[float] | None = None) -> None:
         super().__init__(si)
         self.robot = robot
         self.step = float(step)
@@ -104,17 +104,18 @@ class BatchedMotionValidator(ob.MotionValidator):
         self.motions_valid = 0
         """Motions checked / found valid (OMPL's own counters stay at 0 under a Python ``checkMotion``:
         :func:`motion_counts` reads these)."""
-        levels = tuple(check_number("screen_levels (motion-check steps)", h, low=0.5, high=1e3) for h in screen_levels)
+        levels = SCREEN_LEVELS if screen_levels is None else screen_levels
+        levels = tuple(check_number("screen_levels (motion-check steps)", h, low=0.5, high=1e3) for h in levels)
+        if levels and screen_levels is None and not robot.ball_screen().pays(max(levels) * self.step):
+            log.info("motion checks without clearance balls: on this robot a screened state costs more than "
+                     "%g plain checks", SCREEN_COST_LIMIT)
+            levels = ()
         if levels:
-            screen = robot.ball_screen()
-            screen.prepare(h * self.step for h in levels)  # not in the first plan's time
-            if not screen.pays(max(levels) * self.step):
-                log.info("motion checks without clearance balls: on this robot a screened state costs more than "
-                         "%g plain checks", SCREEN_COST_LIMIT)
-                levels = ()
+            robot.ball_screen().prepare(h * self.step for h in levels)  # not in the first plan's time
         self.screen_levels = levels
-        """The ball radii screened with (motion-check steps); () where screening does not pay on the robot
-        (:meth:`~tpee_ompl.model.clearance_balls.BallScreen.pays`) or was not asked for."""
+        """The ball radii screened with (motion-check steps): ``screen_levels`` as given, or by default (None)
+        :data:`SCREEN_LEVELS` where screening pays on the robot
+        (:meth:`~tpee_ompl.model.clearance_balls.BallScreen.pays`), else () (every state checked)."""
 
     def factor(self) -> int:
         """The space's ``validSegmentCountFactor`` f now: a motion of length d gets ``f * ceil(d / step)``
@@ -248,7 +249,7 @@ def make_simple_setup(
     if certified_options is not None and kind != "certified":
         raise ValueError(f"certified_options needs motion_validator='certified', got {kind!r}")
     if kind in ("batched", "dense"):
-        si.setMotionValidator(BatchedMotionValidator(si, robot, step, SCREEN_LEVELS if kind == "batched" else ()))
+        si.setMotionValidator(BatchedMotionValidator(si, robot, step, None if kind == "batched" else ()))
     elif kind == "certified":
         from .certified import CertifiedMotionValidator  # certified builds on this module
 
