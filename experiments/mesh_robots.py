@@ -1,7 +1,7 @@
 """Mesh robots of example-robot-data: what a check costs, whether the clearance-ball screen pays, and what
 ``convex_meshes=True`` changes.
 
-    PYTHONPATH=. .venv/bin/python experiments/mesh_robots.py          # about 2 min
+    PYTHONPATH=. .venv/bin/python experiments/mesh_robots.py          # about 20 s
 
 For each robot (UR5 with gripper, a Kinova arm, the SO101 arm, the Talos left arm), as a user would set it up:
 continuous joints limited to +-pi in a copy of the URDF (what the refusal says to do), and an SRDF that
