@@ -11,7 +11,7 @@ work and finds the same paths), with the wearer checker's ``n_threads`` 1 and 2:
 alone, then two identical processes started together.  Prints the wall time of each process.  The
 batched checks are OpenMP regions of Pinocchio; with more threads than free cores, a region waits for a
 thread that is not running, which is why campaigns with several workers give each one thread.  The checker
-notices such a stalled call and goes on one thread for a while (``robot_checker.STALL_SECONDS``);
+notices such a stalled call and goes on one thread for a while (``stall_guard.STALL_SECONDS``);
 ``--no-stall-guard`` switches that off, and each process prints how often it went on one thread.
 
 ``--deadline``: how late a solve given 0.1 s ends (``ss.solve(0.1)``, the paper's planner and the library
@@ -35,13 +35,13 @@ def _run(n_threads: int, samples: int, guard: bool) -> tuple[float, int]:
 
     from tpee_ompl import make_simple_setup
     from tpee_ompl.bench.campaign import query_rows, stratified_subset
-    from tpee_ompl.model import robot_checker
+    from tpee_ompl.model import stall_guard
     from tpee_ompl.model.wearer_arm import WearerArm
     from tpee_ompl.planning.tpee import tpee_dimension_rrt
 
     ou.setLogLevel(ou.LOG_NONE)
     if not guard:
-        robot_checker.STALL_SECONDS = (float("inf"), 0.0)
+        stall_guard.STALL_SECONDS = (float("inf"), 0.0)
     robot = WearerArm(n_threads=n_threads)
     _, rows = query_rows("planning_necessary", robot)
     rows = stratified_subset(rows, 24)
@@ -61,14 +61,14 @@ def _deadline(n_threads: int, guard: bool) -> str:
 
     from tpee_ompl import LibraryDimensionRRT, PathLibrary, make_simple_setup
     from tpee_ompl.bench.campaign import query_rows, stratified_subset
-    from tpee_ompl.model import robot_checker
+    from tpee_ompl.model import stall_guard
     from tpee_ompl.model.wearer_arm import WearerArm
     from tpee_ompl.planning.tpee import tpee_dimension_rrt
     from tpee_ompl.resources import default_library_path
 
     ou.setLogLevel(ou.LOG_NONE)
     if not guard:
-        robot_checker.STALL_SECONDS = (float("inf"), 0.0)
+        stall_guard.STALL_SECONDS = (float("inf"), 0.0)
     robot = WearerArm(n_threads=n_threads)
     library = PathLibrary.load(default_library_path(), robot)
     _, rows = query_rows("planning_necessary", robot)

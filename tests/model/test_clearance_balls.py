@@ -183,8 +183,8 @@ def test_the_screens_cost_ratio_counts_no_checks_and_is_unknown_without_free_sta
     from tpee_ompl.model.clearance_balls import BallScreen
 
     screen = BallScreen(robot)
-    before = (robot.collision_checks, robot.stalls, robot._serial_until)
+    before = (robot.collision_checks, robot.stall_guard.state())
     assert screen.cost_ratio(4 * robot.max_joint_step()) > 0
-    assert (robot.collision_checks, robot.stalls, robot._serial_until) == before  # its checks leave no trace
+    assert (robot.collision_checks, robot.stall_guard.state()) == before  # its checks leave no trace
     monkeypatch.setattr(robot, "collision_free", lambda Q, pool=None: np.zeros(len(Q), dtype=bool))
     assert screen.cost_ratio(robot.max_joint_step()) is None and screen.pays(robot.max_joint_step())

@@ -11,7 +11,7 @@ import pytest
 
 from tests.helpers.panda import needs_panda
 from tests.helpers.wearer_configs import valid_and_colliding
-from tpee_ompl.model import robot_checker
+from tpee_ompl.model import robot_checker, stall_guard
 from tpee_ompl.model.obstacles import Obstacle, box
 from tpee_ompl.model.robot_checker import RobotChecker
 from tpee_ompl.model.wearer_arm import WearerArm
@@ -280,14 +280,14 @@ def _slow_parallel_calls(monkeypatch, delay: float) -> list[int]:
 
 def _stall_at(monkeypatch, seconds: float) -> None:
     """A call counts as stalled above ``seconds`` (far above this machine's own hiccups, even under a loaded CI)."""
-    monkeypatch.setattr(robot_checker, "STALL_SECONDS", (seconds, 0.0))
+    monkeypatch.setattr(stall_guard, "STALL_SECONDS", (seconds, 0.0))
 
 
 def test_a_checker_whose_threaded_calls_stall_goes_on_one_thread_for_a_while_with_the_same_answers(robot, rng,
                                                                                                      monkeypatch):
     _stall_at(monkeypatch, 0.05)
-    monkeypatch.setattr(robot_checker, "SERIAL_SECONDS", 0.5)
-    monkeypatch.setattr(robot_checker, "STALL_WINDOW", 0.5)
+    monkeypatch.setattr(stall_guard, "SERIAL_SECONDS", 0.5)
+    monkeypatch.setattr(stall_guard, "STALL_WINDOW", 0.5)
     good, bad = valid_and_colliding(robot, rng, 10)  # the answers from another checker of the model: `two`'s
     Q = np.vstack([good, bad])                        # only calls are the slowed ones below
     want, first = robot.are_valid(Q), robot.first_invalid(np.vstack([good, bad[:1]]))
@@ -304,7 +304,7 @@ def test_a_checker_whose_threaded_calls_stall_goes_on_one_thread_for_a_while_wit
 
 def test_first_invalid_finishes_on_one_thread_once_its_pairs_stall(robot, rng, monkeypatch):
     _stall_at(monkeypatch, 0.05)
-    monkeypatch.setattr(robot_checker, "STALL_WINDOW", 0.5)
+    monkeypatch.setattr(stall_guard, "STALL_WINDOW", 0.5)
     good, bad = valid_and_colliding(robot, rng, 12)
     Q = np.vstack([good, bad[:1], good])  # first invalid row: 12
     two = WearerArm(n_threads=2)

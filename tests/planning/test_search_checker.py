@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from helpers.wearer_configs import valid_and_colliding
 
-from tpee_ompl.model import robot_checker
+from tpee_ompl.model import robot_checker, stall_guard
 from tpee_ompl.model.wearer_arm import WearerArm
 from tpee_ompl.planning.grouped_space import GroupedSpace
 from tpee_ompl.planning.search_checker import _COARSE_STRIDE, Checker
@@ -134,8 +134,8 @@ def test_a_candidate_screen_checks_first_where_the_last_screen_found_a_collision
     rows in pairs: that state and the next), with the same verdict."""
     monkeypatch.setattr(robot_checker, "FIRST_INVALID_PAIRS", pairs)
     # the stall guard (a busy machine) would put the checker on one thread, one row at a time: not what is tested
-    monkeypatch.setattr(robot_checker, "STALL_SECONDS", (math.inf, 0.0))
-    monkeypatch.setattr(robot, "_serial_until", 0.0)
+    monkeypatch.setattr(stall_guard, "STALL_SECONDS", (math.inf, 0.0))
+    monkeypatch.setattr(robot.stall_guard, "serial_until", 0.0)
     expected = 3 if pairs and robot.n_threads > 1 else 2
     si = make_simple_setup(robot).getSpaceInformation()
     checker = Checker(si, GroupedSpace(si, [[0, 1], [2, 3]], 7).layout, batch=True)

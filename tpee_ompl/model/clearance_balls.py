@@ -132,7 +132,7 @@ class BallScreen:
         :data:`PLAIN_CHECK_LIMIT`.  Bounded: the draws stop at 32 free states, and the inflated check is timed on
         one state before the others.  Leaves the checker as it was (``collision_checks``, its stall guard)."""
         robot = self.robot
-        kept = (robot.collision_checks, robot.stalls, robot._serial_until, robot._last_stall)
+        kept = robot.collision_checks, robot.stall_guard.state()
         try:
             rng = np.random.default_rng(0)
             free, fastest, drawn = [], math.inf, 0  # fastest: per state, the quickest block (not an interrupted one)
@@ -159,7 +159,8 @@ class BallScreen:
                     break
             return screened / max(plain, 1e-9)
         finally:
-            robot.collision_checks, robot.stalls, robot._serial_until, robot._last_stall = kept
+            robot.collision_checks = kept[0]
+            robot.stall_guard.restore(kept[1])
 
     def _pool(self, radius: float) -> pin.GeometryPool:
         pool = self._pools.get(radius)

@@ -10,7 +10,6 @@ and how large a joint step keeps every point of the robot within a given displac
 from __future__ import annotations
 
 import logging
-import math
 import os
 import time
 from collections.abc import Mapping, Sequence
@@ -23,6 +22,7 @@ from ..validation import as_float_array, check_bool, check_int, check_number
 from .clearance_balls import BallScreen, separated_pairs
 from .lever_arms import joint_lever_arms, pair_lever_arms
 from .obstacles import Obstacle
+from .stall_guard import StallGuard
 from .urdf_loading import LoadedModel, ModelFiles, bounding_radius, is_prismatic, load_urdf_model
 
 __all__ = ["DEFAULT_SECURITY_MARGIN", "MAX_SECURITY_MARGIN", "RobotChecker", "as_config_batch"]
@@ -37,18 +37,6 @@ FIRST_INVALID_PAIRS = True
 """``first_invalid`` checks its rows two at a time, one per thread, when the checker has two threads (the same
 answer and an exact count; False: one row at a time on one thread, before 2026-11-26; a switch for
 ``experiments/speed_switches.py pair-checks``)."""
-STALL_SECONDS = (1e-3, 2e-5)
-"""A call on several threads that takes longer than ``a + b * N`` seconds for N configurations (normal: 2-8 us
-each) stalled: another process held a core, and each of the call's barriers waited for a descheduled thread.
-Two planning processes on two cores made a 0.1-s solve end up to 0.5 s late that way, and each process 10 times
-slower (``experiments/thread_contention.py``).  After two stalls within :data:`STALL_WINDOW` the checker uses one
-thread for :data:`SERIAL_SECONDS` (a lone slow call, 1-5 ms about twice a second, is the machine's noise)."""
-STALL_WINDOW = 0.1
-"""Seconds within which a second stalled call makes the checker go on one thread."""
-SERIAL_SECONDS = 0.5
-"""How long a checker stays on one thread after stalling (then it tries its threads again)."""
-
-
 def as_config_batch(Q: np.ndarray, nq: int) -> np.ndarray:
     """Q as a float array of shape (N, nq) (one row per configuration), or raise ValueError."""
     if type(Q) is np.ndarray and Q.dtype == np.float64 and Q.ndim == 2 and Q.shape[1] == nq and np.isfinite(Q).all():
@@ -143,10 +131,8 @@ class RobotChecker:
         self._pair_lever_arms: np.ndarray | None = None
         self.collision_checks = 0
         """Configurations checked for collision so far (single and batched)."""
-        self.stalls = 0
-        """Times the checker went on one thread after stalled calls (:data:`STALL_SECONDS`)."""
-        self._serial_until = 0.0
-        self._last_stall = -math.inf
+        self.stall_guard = StallGuard()
+        """When threaded calls stall on a busy machine, the next ones run on one thread for a while."""
         loaded = self._load_model()
         self.model, self.gmodel = loaded.model, loaded.gmodel
         self.model_hash = loaded.model_hash
@@ -434,7 +420,7 @@ class RobotChecker:
             return 0
         Qt = np.asfortranarray(Q[:end].T)  # (nq, end), each configuration a contiguous column
         first, a = end, 0
-        if self._threads() > 1 and end > 1 and FIRST_INVALID_PAIRS:
+        if self.stall_guard.threads(self.n_threads) > 1 and end > 1 and FIRST_INVALID_PAIRS:
             for a in range(0, end, 2):
                 t = time.perf_counter()
                 pair = pin.computeCollisionsInParallel(2, self.pool, Qt[:, a : a + 2], True, False)
@@ -442,7 +428,7 @@ class RobotChecker:
                 if any(pair):
                     first = a if pair[0] else a + 1
                     break
-                if self._stalled(t, 2):  # the rest on one thread
+                if self.stall_guard.stalled(t, 2):  # the rest on one thread
                     a += 2
                     break
             else:
@@ -453,35 +439,22 @@ class RobotChecker:
             self.collision_checks += min(first + 1, end) - a
         return first if first < len(Q) else -1
 
-    def _threads(self) -> int:
-        """Threads for the next call: ``n_threads``, or one for :data:`SERIAL_SECONDS` after a stalled call."""
-        return self.n_threads if self.n_threads == 1 or time.perf_counter() >= self._serial_until else 1
-
-    def _stalled(self, t0: float, n: int) -> bool:
-        """After a call on several threads started at ``t0`` over ``n`` configurations: True when it stalled
-        (:data:`STALL_SECONDS`) within :data:`STALL_WINDOW` of an earlier stall, and the next calls run on one
-        thread for :data:`SERIAL_SECONDS`."""
-        now = time.perf_counter()
-        if now - t0 <= STALL_SECONDS[0] + STALL_SECONDS[1] * n:
-            return False
-        last, self._last_stall = self._last_stall, now
-        if now - last > STALL_WINDOW:
-            return False
-        self.stalls += 1
-        self._serial_until = now + SERIAL_SECONDS
-        return True
+    @property
+    def stalls(self) -> int:
+        """Times the checker went on one thread after stalled calls (:class:`~tpee_ompl.model.stall_guard.StallGuard`)."""
+        return self.stall_guard.stalls
 
     def collision_free(self, Q: np.ndarray, pool: pin.GeometryPool | None = None) -> np.ndarray:
         """:meth:`are_valid` for a float array Q (N >= 1, nq) already known finite and inside the joint
         limits (a motion's states between two checked ends): the collision check alone, no input checks.
         ``pool``: another pool of this model with other margins (default: the checks' own)."""
         self.collision_checks += len(Q)
-        threads = self._threads()
+        threads = self.stall_guard.threads(self.n_threads)
         t = time.perf_counter()
         collides = pin.computeCollisionsInParallel(threads, self.pool if pool is None else pool,
                                                    np.ascontiguousarray(Q.T), True, False)
         if threads > 1:
-            self._stalled(t, len(Q))
+            self.stall_guard.stalled(t, len(Q))
         return ~np.asarray(collides, dtype=bool)
 
     def clearance(self, q: np.ndarray) -> float:
