@@ -337,13 +337,7 @@ def test_joints_it_cannot_plan_are_refused_with_what_to_do_and_locking_them_work
         RobotChecker(mimic)
     assert RobotChecker(mimic, locked={"j2": 0.0}).nq == 1
     continuous = _two_joint_urdf(tmp_path / "continuous.urdf", f'type="continuous">{_J2}')
-    with pytest.raises(ValueError, match="joint 'j2' is continuous.*lock it at an angle"):
-        RobotChecker(continuous)
-    assert RobotChecker(continuous, locked={"j2": 0.3}).nq == 1  # the advice can be followed
-    both = tmp_path / "both.urdf"  # every continuous joint in one message, not one per attempt
-    both.write_text(continuous.read_text().replace('name="j1" type="revolute"', 'name="j1" type="continuous"'))
-    with pytest.raises(ValueError, match="joints 'j1', 'j2' are continuous.*lock them at an angle"):
-        RobotChecker(both)
+    assert RobotChecker(continuous, locked={"j2": 7.0}).nq == 1  # a locked continuous joint takes any angle
     floating = _two_joint_urdf(tmp_path / "floating.urdf", 'type="floating"><parent link="base"/><child link="b"/>')
     with pytest.raises(ValueError, match="'j2' .*7 position values.*fixed joint"):
         RobotChecker(floating)

@@ -7,6 +7,7 @@ every ``<collision>`` element must become a geometry, every URDF cylinder become
 
 from __future__ import annotations
 
+import copy
 import hashlib
 import math
 import numbers
@@ -55,6 +56,8 @@ class LoadedModel:
     model: pin.Model
     gmodel: pin.GeometryModel
     model_hash: str
+    continuous: tuple[str, ...] = ()
+    """The planned joints that are continuous in the URDF (loaded as revolute joints limited to [-pi, pi])."""
 
 
 def _read_text(path: Path, kind: str) -> str:
@@ -178,7 +181,10 @@ def load_urdf_model(
     """Load any URDF (+ SRDF) for collision checking: every ``<collision>`` becomes a geometry.
 
     ``locked`` joints are removed (``pin.buildReducedModel``, fixed at the given values); the
-    remaining joints must be 1-DOF (revolute or prismatic) with finite limits.  With
+    remaining joints must be 1-DOF (revolute, prismatic or continuous) with finite limits.  A continuous
+    joint is loaded as a revolute joint limited to [-pi, pi] (the same kinematics, one coordinate: its angle)
+    and named in :attr:`LoadedModel.continuous`; planners treat that coordinate as an SO2 angle that wraps
+    around (:func:`~tpee_ompl.planning.setup.make_space`).  With
     ``cylinders_as_capsules`` (default, the wearer's rule in ``urdf/README.md``) every URDF cylinder
     becomes a Coal capsule of the same radius and length.  With ``convex_meshes`` every collision mesh of the
     robot becomes its convex hull (Coal's ``buildConvexHull``): a superset of the mesh, so never a collision
@@ -198,6 +204,10 @@ def load_urdf_model(
     if srdf is not None and srdf.is_file():
         digest.update(srdf.read_bytes())
     dirs = [str(d) for d in package_dirs]
+    continuous = tuple(j.get("name") for j in root.iter("joint")
+                       if j.get("type") == "continuous" and j.get("name") not in (locked or {}))
+    if continuous:
+        text = _continuous_as_revolute(root, continuous)
     try:
         model = pin.buildModelFromXML(text)
         gmodel = pin.buildGeomFromUrdfString(model, text, pin.GeometryType.COLLISION, package_dirs=dirs)
@@ -252,7 +262,21 @@ def load_urdf_model(
     gmodel.addAllCollisionPairs()
     if srdf is not None:
         _apply_srdf(model, gmodel, srdf)
-    return LoadedModel(model, gmodel, digest.hexdigest()[:16])
+    return LoadedModel(model, gmodel, digest.hexdigest()[:16], continuous)
+
+
+def _continuous_as_revolute(root: ET.Element, names: Sequence[str]) -> str:
+    """The URDF's text with the named continuous joints written as revolute joints limited to [-pi, pi]."""
+    root = copy.deepcopy(root)
+    for joint in root.iter("joint"):
+        if joint.get("name") in names:
+            joint.set("type", "revolute")
+            limit = joint.find("limit")
+            if limit is None:
+                limit = ET.SubElement(joint, "limit", effort="0", velocity="0")
+            limit.set("lower", repr(-math.pi))
+            limit.set("upper", repr(math.pi))
+    return ET.tostring(root, encoding="unicode")
 
 
 def _solid(mesh: coal.BVHModelBase) -> bool:
@@ -320,14 +344,7 @@ def _lock_joints(model: pin.Model, gmodel: pin.GeometryModel, locked: Mapping[st
 
 
 def _check_joints(model: pin.Model, urdf: Path) -> None:
-    """Every planned joint is 1-DOF (revolute or prismatic) with finite limits."""
-    continuous = [model.names[jid] for jid in range(1, model.njoints) if is_continuous(model.joints[jid])]
-    if continuous:  # all of them in one message: a user fixes them in one pass
-        joints = ", ".join(repr(n) for n in continuous)
-        raise ValueError(f"URDF {urdf}: joint{'s' if len(continuous) > 1 else ''} {joints} "
-                         f"{'are' if len(continuous) > 1 else 'is'} continuous (no limits): give "
-                         f"{'them' if len(continuous) > 1 else 'it'} limits as revolute joints in the URDF, or lock "
-                         f"{'them' if len(continuous) > 1 else 'it'} at an angle (locked={{{continuous[0]!r}: angle}})")
+    """Every planned joint is 1-DOF (revolute or prismatic; continuous ones are revolute by now) with finite limits."""
     for jid in range(1, model.njoints):
         j, name = model.joints[jid], model.names[jid]
         if j.nq != 1 or j.nv != 1:

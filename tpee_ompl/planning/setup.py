@@ -3,6 +3,10 @@ validity checking, motion checking.
 
 The state space is ``ob.RealVectorStateSpace(nq)`` bounded by the URDF joint limits; its metric
 (the Euclidean norm of joint differences, radians) is the path-length metric for every planner.
+A robot with continuous joints gets a compound space instead (:func:`make_space`): each continuous
+joint an ``SO2StateSpace`` (its angle wraps around), the other joints in bounded RealVector runs; the
+metric is then OMPL's compound one, the sum of the subspaces' distances (never below the Euclidean
+norm of the short-way joint differences, so the guarantee below holds as stated).
 
 Motion-check guarantee
 ----------------------
@@ -27,7 +31,8 @@ from ompl import geometric as og
 from ..model.clearance_balls import SCREEN_COST_LIMIT, SCREEN_LEVELS, screened_all_valid, screened_lines_valid
 from ..model.robot_checker import RobotChecker
 from ..validation import check_bool, check_number
-from .paths import MIN_JOINT_STEP, batched_motion_states, set_state, state_to_array, unchecked_motion_states
+from .grouped_space import RealVectorLayout
+from .paths import MIN_JOINT_STEP, batched_motion_states, state_to_array, unchecked_motion_states
 
 if TYPE_CHECKING:
     from .certified import CertifiedMotionOptions
@@ -60,9 +65,13 @@ class RobotValidityChecker(ob.StateValidityChecker):
         super().__init__(si)
         self.robot = robot
         self._indices = range(robot.nq)
+        space = si.getStateSpace()
+        self._read = None if isinstance(space, ob.RealVectorStateSpace) else RealVectorLayout(space).read
 
     def isValid(self, state: ob.State) -> bool:  # noqa: N802 (OMPL override)
         """True if the state is collision-free with the security margin."""
+        if self._read is not None:  # a compound space (continuous joints): its flat values in joint order
+            return self.robot.is_valid_values(self._read(state).tolist())
         return self.robot.is_valid_values([state[i] for i in self._indices])
 
     def are_valid(self, Q: np.ndarray) -> np.ndarray:
@@ -100,6 +109,8 @@ class BatchedMotionValidator(ob.MotionValidator):
         """Radians: the step at validSegmentCountFactor 1 (see :meth:`effective_step`)."""
         self._space = si.getStateSpace()
         self._n = robot.nq
+        self._layout = None if isinstance(self._space, ob.RealVectorStateSpace) else RealVectorLayout(self._space)
+        """The compound space's reader and geodesics (continuous joints as SO2); None for a RealVector space."""
         self.motions_checked = 0
         self.motions_valid = 0
         """Motions checked / found valid (OMPL's own counters stay at 0 under a Python ``checkMotion``:
@@ -126,15 +137,23 @@ class BatchedMotionValidator(ob.MotionValidator):
         """Longest step (radians) between checked states now: ``step / validSegmentCountFactor``."""
         return self.step / self.factor()
 
+    def read_state(self, state: ob.State) -> np.ndarray:
+        """A state of the validator's space as the robot's joint values (nq,)."""
+        return state_to_array(state, self._n) if self._layout is None else self._layout.read(state)
+
     def checkMotion(self, s1: ob.State, s2: ob.State) -> bool:  # noqa: N802 (OMPL override)
         """True if every state along s1 -> s2 (excluding s1) is valid."""
-        a, b = state_to_array(s1, self._n), state_to_array(s2, self._n)
+        a, b = self.read_state(s1), self.read_state(s2)
+        if self._layout is not None:
+            return bool(self.check_motions(a[None], b[None])[0])
         self.motions_checked += 1
         return self._tally(bool(self.all_valid([unchecked_motion_states(a, b, self.step, factor=self.factor())])[0]))
 
     def check_motions(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
         """Validity of many motions A[k] -> B[k] (each excluding its start), batched together."""
         A, B = np.atleast_2d(A), np.atleast_2d(B)
+        if self._layout is not None:
+            return self._check_geodesics(A, B)
         S, counts = batched_motion_states(A, B, self.step, factor=self.factor())
         self.motions_checked += len(counts)
         if len(counts) < 2 or not self.screen_levels:
@@ -144,6 +163,26 @@ class BatchedMotionValidator(ob.MotionValidator):
             ok = screened_lines_valid(self.robot, self.robot.ball_screen(), S, counts, spacing, self.step,
                                       self.screen_levels)
         return self._tally(ok)
+
+    def _check_geodesics(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
+        """:meth:`check_motions` in a compound space: each motion along the space's geodesic (continuous joints
+        the short way round, wrapped into [-pi, pi)), ``f * ceil(d / step)`` segments by the space's metric d,
+        as OMPL's ``DiscreteMotionValidator`` subdivides it."""
+        lay = self._layout
+        D = lay.delta(A, B)
+        counts = self.factor() * np.maximum(1, np.ceil(lay.distance(A, B) / self.step)).astype(np.int64)
+        idx = np.repeat(np.arange(len(A)), counts)
+        j = np.arange(int(counts.sum())) - np.repeat(np.cumsum(counts) - counts, counts) + 1
+        S = lay.wrap(A[idx] + (j / counts[idx])[:, None] * D[idx])
+        self.motions_checked += len(counts)
+        if self.screen_levels:  # the states are evenly spaced along each motion's joint-space line (unwrapped)
+            spacing = np.linalg.norm(D, axis=1) / counts
+            ok = screened_lines_valid(self.robot, self.robot.ball_screen(), S, counts, spacing, self.step,
+                                      self.screen_levels)
+        else:
+            valid = self.robot.are_valid(S)
+            ok = np.array([c.all() for c in np.split(valid, np.cumsum(counts)[:-1])], dtype=bool) if len(counts) else valid
+        return self._tally(np.asarray(ok, dtype=bool))
 
     def _tally(self, ok):
         """Count the valid verdicts among ``ok`` (one bool or an array of them) into ``motions_valid``; return ``ok``."""
@@ -179,13 +218,37 @@ def valid_motion_fraction(before: tuple[int, int] | None, after: tuple[int, int]
     return valid / checked if checked > 0 else None
 
 
-def make_space(robot: RobotChecker) -> ob.RealVectorStateSpace:
-    """A RealVector state space bounded by the URDF joint limits (radians)."""
-    space = ob.RealVectorStateSpace(robot.nq)
-    bounds = ob.RealVectorBounds(robot.nq)
-    for i in range(robot.nq):
-        bounds.setLow(i, float(robot.lower[i]))
-        bounds.setHigh(i, float(robot.upper[i]))
+def make_space(robot: RobotChecker) -> ob.StateSpace:
+    """A RealVector state space bounded by the URDF joint limits (radians, metres for prismatic joints).
+
+    With continuous joints (``robot.circular``): an ``ob.CompoundStateSpace`` whose subspaces follow the joint
+    order, an ``ob.SO2StateSpace`` per continuous joint and a bounded RealVector space per run of other joints,
+    each of weight 1 (the flat values of a state, :class:`~tpee_ompl.planning.grouped_space.RealVectorLayout`,
+    are the joint values in order)."""
+    if not robot.circular.any():
+        return _real_vector(robot.lower, robot.upper)
+    space = ob.CompoundStateSpace()
+    run: list[int] = []
+    for i in range(robot.nq + 1):
+        if i < robot.nq and not robot.circular[i]:
+            run.append(i)
+            continue
+        if run:
+            space.addSubspace(_real_vector(robot.lower[run], robot.upper[run]), 1.0)
+            run = []
+        if i < robot.nq:
+            space.addSubspace(ob.SO2StateSpace(), 1.0)
+    space.lock()
+    return space
+
+
+def _real_vector(lower: np.ndarray, upper: np.ndarray) -> ob.RealVectorStateSpace:
+    """A RealVector space with these bounds."""
+    space = ob.RealVectorStateSpace(len(lower))
+    bounds = ob.RealVectorBounds(len(lower))
+    for i, (lo, hi) in enumerate(zip(lower, upper)):
+        bounds.setLow(i, float(lo))
+        bounds.setHigh(i, float(hi))
     space.setBounds(bounds)
     return space
 
@@ -248,6 +311,10 @@ def make_simple_setup(
     kind = _motion_validator_kind(motion_validator, batched_motion_validator)
     if certified_options is not None and kind != "certified":
         raise ValueError(f"certified_options needs motion_validator='certified', got {kind!r}")
+    if kind == "certified" and robot.circular.any():
+        names = [n for n, c in zip(robot.joint_names, robot.circular) if c]
+        raise ValueError(f"motion_validator='certified' needs a robot without continuous joints (its certificates "
+                         f"bound straight joint motions); continuous: {names}; use 'batched'")
     if kind in ("batched", "dense"):
         si.setMotionValidator(BatchedMotionValidator(si, robot, step, None if kind == "batched" else ()))
     elif kind == "certified":
@@ -260,13 +327,11 @@ def make_simple_setup(
     if start is not None or goal is not None:
         if start is None or goal is None:
             raise ValueError("give both start and goal, or neither")
+        layout = RealVectorLayout(space)  # continuous joints' angles into [-pi, pi), as SO2 states hold them
+        q0, q1 = (layout.wrap(_named_config(robot, q, name)) for q, name in ((start, "start"), (goal, "goal")))
         if check_endpoints:
-            q0, q1 = robot.check_free(start, "start"), robot.check_free(goal, "goal")
-        else:
-            q0, q1 = _named_config(robot, start, "start"), _named_config(robot, goal, "goal")
-        s0, s1 = si.allocState(), si.allocState()
-        set_state(s0, q0)
-        set_state(s1, q1)
+            q0, q1 = robot.check_free(q0, "start"), robot.check_free(q1, "goal")
+        s0, s1 = layout.write(si.allocState(), q0), layout.write(si.allocState(), q1)
         ss.setStartAndGoalStates(s0, s1, 1e-9)
     si.setup()
     return ss
