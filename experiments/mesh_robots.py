@@ -4,7 +4,7 @@
     PYTHONPATH=. .venv/bin/python experiments/mesh_robots.py          # about 20 s
 
 For each robot (UR5 with gripper, a Kinova arm, the SO101 arm, the Talos left arm), as a user would set it up:
-continuous joints limited to +-pi in a copy of the URDF (what the refusal says to do), and an SRDF that
+the shipped URDF (continuous joints are SO2 angles in [-pi, pi]), and an SRDF that
 disables the pairs of links touching in at least 95 % of 300 random configurations (the MoveIt setup
 assistant's "always" pairs; found with the convex hulls, which touch at least as often as the meshes, and used
 for both), plus the shipped SRDF's pairs of links the URDF has.  Prints, with the meshes as
@@ -30,8 +30,10 @@ from tpee_ompl.model.clearance_balls import SCREEN_COST_LIMIT
 ROBOTS = ("ur5_gripper", "kinova", "so101", "talos_arm")
 
 
-def robot_files(name: str, folder: Path) -> tuple[Path, Path | None, list[str]]:
-    """The robot's URDF (continuous joints limited to +-pi, in ``folder``), its SRDF if shipped, its package dir."""
+def robot_files(name: str, folder: Path, limited: bool = False) -> tuple[Path, Path | None, list[str]]:
+    """The robot's URDF, its SRDF if shipped, its package dir.  ``limited``: a copy of the URDF (in ``folder``) with
+    its continuous joints made revolute joints limited to +-pi (the workaround before continuous joints were
+    planned as SO2 angles)."""
     import example_robot_data as erd
     from example_robot_data.robots_loader import ROBOTS as LOADERS
 
@@ -39,15 +41,19 @@ def robot_files(name: str, folder: Path) -> tuple[Path, Path | None, list[str]]:
     sub = loader.path + "/" + (loader.urdf_subpath + "/" if loader.urdf_subpath else "") + loader.urdf_filename
     base = Path(erd.getModelPath(sub))
     srdf = base / loader.path / loader.srdf_subpath / loader.srdf_filename if loader.srdf_filename else None
+    package_dirs = [str((base / "../..").resolve())]
+    shipped = srdf if srdf is not None and srdf.is_file() else None
+    if not limited:
+        return base / sub, shipped, package_dirs
     text = (base / sub).read_text()
 
-    def limited(m: re.Match) -> str:
+    def as_revolute(m: re.Match) -> str:
         j = re.sub(r"<limit[^>]*/>", "", m.group(0).replace('type="continuous"', 'type="revolute"'))
         return j.replace("</joint>", f'<limit effort="10" velocity="1" lower="{-np.pi}" upper="{np.pi}"/></joint>')
 
-    urdf = folder / f"{name}.urdf"
-    urdf.write_text(re.sub(r'<joint[^>]*type="continuous".*?</joint>', limited, text, flags=re.S))
-    return urdf, srdf if srdf is not None and srdf.is_file() else None, [str((base / "../..").resolve())]
+    urdf = folder / f"{name}_limited.urdf"
+    urdf.write_text(re.sub(r'<joint[^>]*type="continuous".*?</joint>', as_revolute, text, flags=re.S))
+    return urdf, shipped, package_dirs
 
 
 def user_srdf(urdf: Path, shipped: Path | None, package_dirs: list[str], out: Path) -> Path:

@@ -132,6 +132,10 @@ class CertifiedMotionValidator(BatchedMotionValidator):
 
     def __init__(self, si: ob.SpaceInformation, robot: RobotChecker, step: float,
                  options: CertifiedMotionOptions | None = None) -> None:
+        if robot.circular.any():
+            names = [n for n, c in zip(robot.joint_names, robot.circular) if c]
+            raise ValueError(f"the certified motion validator needs a robot without continuous joints (its "
+                             f"certificates bound straight joint motions); continuous: {names}; use 'batched'")
         super().__init__(si, robot, step, screen_levels=())  # its own certificates, not the balls' screen
         self.options = options if options is not None else CertifiedMotionOptions()
         if not isinstance(self.options, CertifiedMotionOptions):

@@ -97,9 +97,11 @@ class Checker:
         first_invalid = getattr(svc, "first_invalid", None)
         self._first_invalid = first_invalid if self.batched and callable(first_invalid) else None
         all_valid = getattr(mv, "all_valid", None)
-        # the project's validator screens a motion's evenly spaced states (straight lines only: no SO2 wrap)
-        self._all_valid = all_valid if self.batched and callable(all_valid) and layout.is_plain else None
-        # the project's validators check many straight motions at once, each as its checkMotion would
+        # the project's validator screens a motion's evenly spaced states (straight lines, or in a compound
+        # space of a robot with continuous joints the space's geodesics)
+        geodesic = layout.is_plain or getattr(mv, "checks_geodesics", False) is True
+        self._all_valid = all_valid if self.batched and callable(all_valid) and geodesic else None
+        # the project's validators check many motions at once, each as its checkMotion would
         self._check_motions = mv.check_motions if self._all_valid is not None else None
         if self.step is None:  # only for the coarse screening of motions (si.checkMotion decides)
             factor = max(1, int(si.getStateSpace().getValidSegmentCountFactor()))
@@ -235,7 +237,7 @@ class Checker:
         ``check_motions`` (all motions batched together, each with ``checkMotion``'s verdict)."""
         if self._check_motions is None or len(A) < 2:
             return np.array([self.check_motion(a, b) for a, b in zip(A, B)], dtype=bool)
-        self.own_checks += int(np.maximum(1, np.ceil(np.sqrt(((B - A) ** 2).sum(-1)) / self.step)).sum())  # at most
+        self.own_checks += int(np.maximum(1, np.ceil(self.layout.distance(A, B) / self.step)).sum())  # at most
         ok = np.asarray(self._check_motions(A, B), dtype=bool)
         self.passed.update(segment_key(A[k], B[k]) for k in np.flatnonzero(ok))
         return ok

@@ -128,6 +128,9 @@ class BatchedMotionValidator(ob.MotionValidator):
         :data:`SCREEN_LEVELS` where screening pays on the robot
         (:meth:`~tpee_ompl.model.clearance_balls.BallScreen.pays`), else () (every state checked)."""
 
+    checks_geodesics = True
+    """:meth:`check_motions` follows the space's geodesics in a compound space (continuous joints the short way)."""
+
     def factor(self) -> int:
         """The space's ``validSegmentCountFactor`` f now: a motion of length d gets ``f * ceil(d / step)``
         segments, as OMPL's ``DiscreteMotionValidator`` counts them."""
@@ -311,10 +314,6 @@ def make_simple_setup(
     kind = _motion_validator_kind(motion_validator, batched_motion_validator)
     if certified_options is not None and kind != "certified":
         raise ValueError(f"certified_options needs motion_validator='certified', got {kind!r}")
-    if kind == "certified" and robot.circular.any():
-        names = [n for n, c in zip(robot.joint_names, robot.circular) if c]
-        raise ValueError(f"motion_validator='certified' needs a robot without continuous joints (its certificates "
-                         f"bound straight joint motions); continuous: {names}; use 'batched'")
     if kind in ("batched", "dense"):
         si.setMotionValidator(BatchedMotionValidator(si, robot, step, None if kind == "batched" else ()))
     elif kind == "certified":
