@@ -10,6 +10,7 @@ line placed AFTER its own, so the installed wheel - not the source tree - provid
 from __future__ import annotations
 
 import json
+import math
 import os
 import subprocess
 import sys
@@ -90,3 +91,37 @@ def test_installed_wheel_lists_the_problems_and_benchmarks_a_generic_one(install
                 "--workers", "1", "--no-progress", "--out", str(work / "results")], cwd=work, timeout=600).stdout
     assert "benchmark.db" in out
     assert len(list((work / "results").glob("*/benchmark.db"))) == 1
+
+
+_CONTINUOUS_ARM = """
+import math, sys
+from ompl import base as ob, geometric as og, util as ou
+from tpee_ompl import DimensionRRT, RobotChecker, make_simple_setup
+from tpee_ompl.model.obstacles import box
+from tpee_ompl.planning.grouped_space import RealVectorLayout
+open("arm.urdf", "w").write('''<robot name="arm"><link name="base"/>
+<link name="a"><collision><origin xyz="0.25 0 0"/><geometry><box size="0.36 0.05 0.05"/></geometry></collision></link>
+<link name="b"><collision><origin xyz="0.2 0 0"/><geometry><box size="0.26 0.05 0.05"/></geometry></collision></link>
+<joint name="j1" type="continuous"><parent link="base"/><child link="a"/><axis xyz="0 0 1"/></joint>
+<joint name="j2" type="revolute"><parent link="a"/><child link="b"/><origin xyz="0.5 0 0"/><axis xyz="0 0 1"/>
+<limit lower="-2" upper="2" effort="1" velocity="1"/></joint></robot>''')
+ou.setLogLevel(ou.LOG_NONE)
+robot = RobotChecker("arm.urdf", obstacles=[box("post", (0.05, 0.05, 0.3), (0.3, 0.0, 0.0))])  # no way through 0
+for make in (og.RRTConnect, lambda si: DimensionRRT(si, seed=1, max_samples=300)):
+    ss = make_simple_setup(robot, [3.0, 0.0], [-3.0, 0.0])
+    si = ss.getSpaceInformation()
+    ss.setPlanner(make(si))
+    assert ss.solve(5.0) == ob.PlannerStatus.EXACT_SOLUTION and ss.getSolutionPath().check()
+    ss.simplifySolution(1.0)
+    layout = RealVectorLayout(si.getStateSpace())
+    W = layout.from_path(ss.getSolutionPath())
+    print("space", type(si.getStateSpace()).__name__, round(float(abs(layout.delta(W[:-1], W[1:])[:, 0]).sum()), 3))
+"""
+
+
+def test_installed_wheel_plans_a_continuous_joint_the_short_way_round(installed):
+    py, work = installed
+    rows = [line.split()[1:] for line in _run([str(py), "-c", _CONTINUOUS_ARM], cwd=work).stdout.splitlines()
+            if line.startswith("space ")]
+    assert [r[0] for r in rows] == ["CompoundStateSpace"] * 2
+    assert all(float(r[1]) < math.pi for r in rows)  # the first joint's travel: the short way round is 0.28 rad
