@@ -14,7 +14,7 @@ from ompl import geometric as og
 from tpee_ompl import DimensionRRT, RobotChecker, make_simple_setup
 from tpee_ompl.model.obstacles import box
 from tpee_ompl.planning.grouped_space import RealVectorLayout
-from tpee_ompl.planning.paths import path_passes_motion_checks
+from tpee_ompl.planning.paths import path_passes_motion_checks, path_to_array
 from tpee_ompl.planning.setup import make_space
 
 LENGTHS = (0.5, 0.4, 0.3, 0.2)
@@ -59,29 +59,50 @@ def test_continuous_joints_are_so2_subspaces_in_joint_order_and_other_joints_sta
 
 @pytest.mark.parametrize("validator", ["batched", "dense"])
 @pytest.mark.parametrize("factor", [1, 4])
-def test_the_batched_motion_validator_agrees_with_ompls_discrete_validator_on_random_motions(tmp_path, validator,
-                                                                                            factor):
+def test_the_batched_motion_validator_checks_the_states_ompls_discrete_validator_checks(tmp_path, validator, factor):
+    """At factor 1 the segment counts are the compound space's own (``validSegmentCount``) and the verdicts OMPL's;
+    at factor 4 (ot.Benchmark's strict check) 4x the segments, a superset of the states: never a motion OMPL's
+    validator rejects (OMPL's own does not pass the factor to a compound's subspaces)."""
     robot = RobotChecker(_chain(tmp_path, MIXED), obstacles=_post(-0.7, 0.3))
     ours = make_simple_setup(robot, motion_validator=validator).getSpaceInformation()
     ompl = make_simple_setup(robot, motion_validator="discrete").getSpaceInformation()
     for si in (ours, ompl):
         si.getStateSpace().setValidSegmentCountFactor(factor)
-    layout = RealVectorLayout(ours.getStateSpace())
+    space, mv = ours.getStateSpace(), ours.getMotionValidator()
+    layout = RealVectorLayout(space)
     rng = np.random.default_rng(3)
-    verdicts, A, B = [], [], []
+    verdicts, theirs, A, B = [], [], [], []
     while len(verdicts) < 150:
         a, b = rng.uniform(robot.lower, robot.upper, (2, robot.nq))
         s1, s2 = layout.write(ours.allocState(), a), layout.write(ours.allocState(), b)
         if not robot.is_valid(a):
             continue
-        mine = ours.checkMotion(s1, s2)
-        assert mine == ompl.checkMotion(s1, s2), (a, b)
-        verdicts.append(mine)
+        assert mv.segment_counts(a[None], b[None])[0] == factor * max(1, space.validSegmentCount(s1, s2))
+        verdicts.append(ours.checkMotion(s1, s2))
+        theirs.append(ompl.checkMotion(s1, s2))
         A.append(a)
         B.append(b)
+    if factor == 1:
+        assert verdicts == theirs
+    else:
+        assert not any(v and not t for v, t in zip(verdicts, theirs))
     assert 20 < sum(verdicts) < 130  # both verdicts are tested
-    batch = ours.getMotionValidator().check_motions(np.array(A), np.array(B))
+    batch = mv.check_motions(np.array(A), np.array(B))
     assert batch.tolist() == verdicts  # many motions in one call: the same verdicts
+
+
+def test_half_a_turn_goes_the_way_ompls_so2_interpolation_goes(tmp_path):
+    """From -pi/2 to +pi/2 both ways round are as short: OMPL's SO2StateSpace goes the + way (through 0)."""
+    robot = RobotChecker(_chain(tmp_path, MIXED), obstacles=_post(0.7, 0.0))  # at angle 0
+    start, goal = [-math.pi / 2, 0.0, 0.0, 0.0], [math.pi / 2, 0.0, 0.0, 0.0]
+    for validator in ("batched", "dense", "discrete"):
+        si = make_simple_setup(robot, start, goal, motion_validator=validator).getSpaceInformation()
+        layout = RealVectorLayout(si.getStateSpace())
+        s1, s2, mid = layout.write(si.allocState(), start), layout.write(si.allocState(), goal), si.allocState()
+        si.getStateSpace().interpolate(s1, s2, 0.5, mid)
+        np.testing.assert_allclose(layout.interpolate(np.array(start), np.array(goal), 0.5), layout.read(mid),
+                                   atol=1e-12)
+        assert not si.checkMotion(s1, s2), validator  # through the post
 
 
 def test_a_motion_across_pi_is_checked_the_short_way_round(tmp_path):
@@ -139,6 +160,14 @@ def test_path_checks_of_a_compound_space_give_ompls_verdicts(tmp_path):
         assert verdict == all(si.checkMotion(path.getState(k), path.getState(k + 1)) for k in range(3))
         seen.add(verdict)
     assert seen == {True, False}
+
+
+def test_reading_a_compound_path_as_real_vector_states_is_refused_with_the_way_out(tmp_path):
+    robot = RobotChecker(_chain(tmp_path, MIXED))
+    si = make_simple_setup(robot).getSpaceInformation()
+    path = RealVectorLayout(si.getStateSpace()).to_path(si, np.zeros((2, robot.nq)))
+    with pytest.raises(ValueError, match="CompoundStateSpace.s need read=RealVectorLayout"):
+        path_to_array(path, robot.nq)  # was a segfault: s[3] past the compound's three subspaces
 
 
 def test_the_certified_validator_refuses_continuous_joints_by_name(tmp_path):

@@ -204,7 +204,7 @@ def load_urdf_model(
     if srdf is not None and srdf.is_file():
         digest.update(srdf.read_bytes())
     dirs = [str(d) for d in package_dirs]
-    continuous = tuple(j.get("name") for j in root.iter("joint")
+    continuous = tuple(j.get("name") for j in root.findall("joint")
                        if j.get("type") == "continuous" and j.get("name") not in (locked or {}))
     if continuous:
         text = _continuous_as_revolute(root, continuous)
@@ -268,7 +268,7 @@ def load_urdf_model(
 def _continuous_as_revolute(root: ET.Element, names: Sequence[str]) -> str:
     """The URDF's text with the named continuous joints written as revolute joints limited to [-pi, pi]."""
     root = copy.deepcopy(root)
-    for joint in root.iter("joint"):
+    for joint in root.findall("joint"):
         if joint.get("name") in names:
             joint.set("type", "revolute")
             limit = joint.find("limit")

@@ -288,12 +288,16 @@ class RealVectorLayout:
         return X
 
     def delta(self, A: np.ndarray, B: np.ndarray, dims: np.ndarray | None = None) -> np.ndarray:
-        """B - A, with SO2 entries taken the short way round (in [-pi, pi)).  ``dims``: A and B hold only
+        """B - A, with SO2 entries taken the short way round (in [-pi, pi]; exactly half a turn keeps its sign, as
+        ``SO2StateSpace`` interpolates).  ``dims``: A and B hold only
         these entries of the flat vector, in this order (default: all of them)."""
         D = np.asarray(B, dtype=float) - np.asarray(A, dtype=float)
         if self.has_circular:
             circular = self.circular if dims is None else self.circular[dims]
-            D[..., circular] = np.mod(D[..., circular] + math.pi, 2.0 * math.pi) - math.pi
+            raw = D[..., circular]
+            short = np.mod(raw + math.pi, 2.0 * math.pi) - math.pi
+            short[(short == -math.pi) & (raw > 0)] = math.pi  # half a turn: the + way, as SO2StateSpace.interpolate
+            D[..., circular] = short
         return D
 
     def interpolate(self, A: np.ndarray, B: np.ndarray, t: np.ndarray | float) -> np.ndarray:
@@ -308,6 +312,11 @@ class RealVectorLayout:
         if self.is_plain:
             return np.sqrt(np.einsum("...i,...i->...", D, D))
         return sum(w * np.linalg.norm(D[..., sl], axis=-1) for w, sl in zip(self._weights, self._slices))
+
+    def leaf_distances(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
+        """Per subspace (leaf), its own distance between rows of A and B: shape (..., leaves), unweighted."""
+        D = self.delta(A, B)
+        return np.stack([np.linalg.norm(D[..., sl], axis=-1) for sl in self._slices], axis=-1)
 
     def path_length(self, W: np.ndarray) -> float:
         """Length of the polyline through waypoints W (K, n) in the space's metric."""

@@ -59,6 +59,9 @@ def path_to_array(
     """
     states = path.getStates()
     if read is None:
+        if len(states) and isinstance(states[0], ob.CompoundState):  # s[i] would read past its subspaces
+            raise ValueError("path_to_array reads RealVector states; a CompoundStateSpace's need "
+                             "read=RealVectorLayout(space).read")
         return np.array([[s[i] for i in range(n)] for s in states], dtype=float)
     return np.array([read(s) for s in states], dtype=float).reshape(-1, n)
 
@@ -149,11 +152,11 @@ def path_passes_motion_checks(
     if check_first and not si.isValid(states[0]):
         return False
     ks = range(len(states) - 1) if segments is None else list(segments)
-    batched = getattr(si.getMotionValidator(), "check_motions", None)
-    if batched is not None and isinstance(si.getStateSpace(), ob.RealVectorStateSpace):
+    mv = si.getMotionValidator()
+    batched, read = getattr(mv, "check_motions", None), getattr(mv, "read_state", None)
+    if callable(batched) and callable(read):
         # the project's BatchedMotionValidator: the same states checkMotion checks, in one batched call
-        n = int(si.getStateSpace().getDimension())
-        W = np.array([[s[i] for i in range(n)] for s in states], dtype=float)
+        W = np.array([read(s) for s in states], dtype=float)
         idx = np.fromiter(ks, dtype=np.intp)
         return bool(batched(W[idx], W[idx + 1]).all()) if len(idx) else True
     return all(si.checkMotion(states[k], states[k + 1]) for k in ks)

@@ -93,7 +93,10 @@ class BatchedMotionValidator(ob.MotionValidator):
     The verdict is that of OMPL's ``DiscreteMotionValidator`` at the same resolution (every state a
     step apart valid); native planners call it through ``si.checkMotion``.  Like that validator it
     honours the space's ``validSegmentCountFactor``: OMPL's Benchmark sets it to 4 for its
-    ``correct_solution_strict`` column, which then really checks 4x more densely.
+    ``correct_solution_strict`` column, which then really checks 4x more densely.  In the compound space of a
+    robot with continuous joints (:func:`make_space`) a motion follows the space's geodesic (SO2 the short way)
+    with the compound's own segment count (:meth:`segment_counts`; there OMPL's validator ignores the factor,
+    this one applies it).
 
     By default the states are screened first where that pays on the robot (``screen_levels``,
     :func:`~tpee_ompl.model.clearance_balls.screened_all_valid`): one state checked at margins
@@ -111,6 +114,10 @@ class BatchedMotionValidator(ob.MotionValidator):
         self._n = robot.nq
         self._layout = None if isinstance(self._space, ob.RealVectorStateSpace) else RealVectorLayout(self._space)
         """The compound space's reader and geodesics (continuous joints as SO2); None for a RealVector space."""
+        if self._layout is not None:  # OMPL's rule: each subspace's own segment length, a share of its extent
+            total = float(self._space.getMaximumExtent())
+            self._leaf_steps = np.array([self.step * float(self._space.getSubspace(k).getMaximumExtent()) / total
+                                         for k in range(self._space.getSubspaceCount())])
         self.motions_checked = 0
         self.motions_valid = 0
         """Motions checked / found valid (OMPL's own counters stay at 0 under a Python ``checkMotion``:
@@ -167,13 +174,21 @@ class BatchedMotionValidator(ob.MotionValidator):
                                       self.screen_levels)
         return self._tally(ok)
 
+    def segment_counts(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
+        """Segments of each motion A[k] -> B[k] in a compound space: as OMPL's ``CompoundStateSpace`` counts them
+        (the most any subspace needs, each subspace's segment its share ``step * extent_i / extent`` of the
+        step; at most ``step`` apart in the Euclidean joint metric), times the space's ``validSegmentCountFactor``
+        (which OMPL's own validator does not apply to a compound space's subspaces: this one is stricter there)."""
+        need = np.ceil(self._layout.leaf_distances(A, B) / self._leaf_steps).max(axis=-1)
+        return self.factor() * np.maximum(1, need).astype(np.int64)
+
     def _check_geodesics(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
         """:meth:`check_motions` in a compound space: each motion along the space's geodesic (continuous joints
-        the short way round, wrapped into [-pi, pi)), ``f * ceil(d / step)`` segments by the space's metric d,
-        as OMPL's ``DiscreteMotionValidator`` subdivides it."""
+        the short way round, wrapped into [-pi, pi)), the states ``DiscreteMotionValidator`` checks at
+        ``validSegmentCountFactor`` 1 (:meth:`segment_counts`)."""
         lay = self._layout
         D = lay.delta(A, B)
-        counts = self.factor() * np.maximum(1, np.ceil(lay.distance(A, B) / self.step)).astype(np.int64)
+        counts = self.segment_counts(A, B)
         idx = np.repeat(np.arange(len(A)), counts)
         j = np.arange(int(counts.sum())) - np.repeat(np.cumsum(counts) - counts, counts) + 1
         S = lay.wrap(A[idx] + (j / counts[idx])[:, None] * D[idx])
