@@ -108,9 +108,13 @@ def test_one_goal_state_as_goal_states_gives_the_goal_state_path() -> None:
             goal.setState(set_state(ss.getSpaceInformation().allocState(), (0.9, 0.5)))
         status, planner = _solve(ss, goal, max_samples=800)
         assert status == ob.PlannerStatus.EXACT_SOLUTION
-        paths.append((_proven(ss), planner.last_run_stats()["progress"]))
+        stats = planner.last_run_stats()
+        paths.append((_proven(ss), stats["progress"][-1][1:], stats["samples"]))
     np.testing.assert_array_equal(paths[0][0], paths[1][0])
-    assert [(c, n) for _, c, n in paths[0][1]] == [(c, n) for _, c, n in paths[1][1]]
+    # the same search: its last progress row (cost, samples) and sample count; the rows between depend on the
+    # clock (a row every progress period, improvements posted within a share of the time), so a loaded machine
+    # adds or moves some
+    assert paths[0][1:] == paths[1][1:]
 
 
 def test_with_several_goals_stall_samples_count_per_goal() -> None:
