@@ -234,7 +234,7 @@ def test_released_wearer_search_gives_one_path_whatever_the_call_sizes_and_the_h
     """The released search on the wearer (one group of every DOF, the lone candidates' screens, the hits'
     states checked ahead, sweeps): the same capped path with one sample per call, with sample checkpoints
     every 37 samples and with the hits' check off."""
-    from tpee_ompl.planning import dimension_rrt, search_draws
+    from tpee_ompl.planning import goal_loop, search_draws
 
     q = load_queries("planning_necessary")[1]
     ss = make_simple_setup(robot, q.start, q.goal)
@@ -256,7 +256,7 @@ def test_released_wearer_search_gives_one_path_whatever_the_call_sizes_and_the_h
         m.setattr(search_draws.SampleDraws, "_hit_states", lambda self, S, last: {})
         np.testing.assert_array_equal(path(), ref)
     with monkeypatch.context() as m:
-        m.setattr(dimension_rrt, "_PASS_BATCH", 1)
+        m.setattr(goal_loop, "PASS_BATCH", 1)
         np.testing.assert_array_equal(path(), ref)
 
 

@@ -116,7 +116,8 @@ from ompl import geometric as og
 from ..validation import check_int
 from .dimension_rrt_options import RELEASE_AFTER, DimensionRRTOptions, resolve_options, shortcuts_on
 from .dimension_search import Search
-from .goal_runs import GOAL_TURN, GoalRun, goal_states
+from .goal_loop import GoalLoop, LoopLimits
+from .goal_runs import GoalRun, goal_states
 from .grouped_space import GroupedSpace, RealVectorLayout
 from .planner_base import PythonPlanner, planner_status
 from .search_checker import Checker
@@ -136,18 +137,6 @@ printed "leaked instances" warnings; :func:`_drop_callbacks` breaks it first."""
 def _drop_callbacks() -> None:
     for planner in list(_WITH_CALLBACKS):
         planner._callback = None
-
-_REFINE_AFTER = 500
-"""Samples without a first path after which ``h`` is raised (when ``max_h`` allows; see "Raising h")."""
-
-_PROGRESS_PERIOD = 0.01
-"""Seconds between progress-trace entries (OMPL's benchmark records progress about as often)."""
-
-_PASS_BATCH = 64
-"""Most samples per :meth:`Search.iterate` call on a valid path (those the cost test rejects are passed
-over in one vectorised step; the termination condition is asked between calls) or in the connect
-trees (which ask it before each sample, as RRTConnect does)."""
-
 
 class DimensionRRT(PythonPlanner):
     """Dimension-RRT (paper sec. 4.1.2): anytime, fake-time, DOF-grouped path optimisation.
@@ -295,6 +284,9 @@ class DimensionRRT(PythonPlanner):
         """Samples drawn so far in the current (or last) solve: what the termination condition sees."""
         return self._samples_drawn
 
+    def _set_samples_drawn(self, n: int) -> None:
+        self._samples_drawn = n
+
     def _notify(self, path: og.PathGeometric, cost: float) -> None:
         cb = self._callback
         if cb is None or self._callback_failed:
@@ -359,12 +351,9 @@ class DimensionRRT(PythonPlanner):
         self._samples_drawn = 0
         self._callback_failed = False
 
-    def _solve(self, ptc: ob.PlannerTerminationCondition) -> ob.PlannerStatus:
-        t0 = time.perf_counter()
-        moved = self._follow_bounds()
-        if moved is not None:
-            return moved
-        si, pdef = self.getSpaceInformation(), self.getProblemDefinition()
+    def _ends(self, ptc: ob.PlannerTerminationCondition) -> tuple[np.ndarray, list[np.ndarray]] | ob.PlannerStatus:
+        """The start and the goal states to plan to (on the prescribed trajectory, nearest first), or the status
+        saying why there are none."""
         layout, grouped = self.grouped.layout, self.grouped
         start = self._start()
         Q1 = start if isinstance(start, ob.PlannerStatus) else goal_states(self, ptc, self.options.max_goals, layout.read)
@@ -379,6 +368,19 @@ class DimensionRRT(PythonPlanner):
         if len(fits) < len(Q1):
             log.info("DimensionRRT: %d of %d goal states are off the prescribed trajectory", len(Q1) - len(fits), len(Q1))
         fits.sort(key=lambda q1: float(layout.distance(q0, q1)))  # nearest first (stable: one goal as given)
+        return q0, fits
+
+    def _solve(self, ptc: ob.PlannerTerminationCondition) -> ob.PlannerStatus:
+        t0 = time.perf_counter()
+        moved = self._follow_bounds()
+        if moved is not None:
+            return moved
+        ends = self._ends(ptc)
+        if isinstance(ends, ob.PlannerStatus):
+            return ends
+        q0, fits = ends
+        si, pdef = self.getSpaceInformation(), self.getProblemDefinition()
+        layout, grouped = self.grouped.layout, self.grouped
         checker = Checker(si, layout, self.batch)
         checks0 = checker.counter()
         release = self.options.release_after if grouped.prescribed and grouped.planned else None
@@ -393,96 +395,16 @@ class DimensionRRT(PythonPlanner):
             if runs and ptc():
                 break
             runs.append(GoalRun(q1, grouped, new_search(grouped, q1, self._initial), release, float(layout.distance(q0, q1))))
-        runs[0].turn_end = GOAL_TURN
         poster = SolutionPoster(self, si, pdef, t0, grouped.to_path, self._notify, checker.passed)
+        limits = LoopLimits(self.max_samples if grouped.planned else 0, self.options.max_h or 0,
+                            self.options.stall_samples, self._sample_checkpoints)
+        loop = GoalLoop(runs, poster, new_search, q0, limits, self._stats, t0, self._set_samples_drawn)
+        loop.run(ptc)
         stats = self._stats
-        progress = stats["progress"]
-        cap = self.max_samples if grouped.planned else 0
-        max_h = self.options.max_h or 0
-        last_log = -math.inf
-        several = len(runs) > 1
-        drawn = 0  # samples of every goal's searches
-
-        def record(now: float) -> None:
-            progress.append((now - t0, poster.found_cost, drawn))
-
-        for run in runs:
-            if run.best < poster.found_cost:
-                poster.offer(run.search.W, run.best, time.perf_counter())
-        record(time.perf_counter())
-        stall = self.options.stall_samples
-        stops = self._sample_checkpoints
-        turn = 0
-        while not poster.satisfied and not ptc() and (cap is None or drawn < cap):
-            run = runs[turn]
-            search = run.search
-            if several:  # a goal no path to which beats the best found (its start-goal distance is no shorter) stops
-                run.stopped |= run.bound >= poster.found_cost - 1e-12
-            if several and (run.stopped or run.samples >= run.turn_end):  # another goal's turn
-                active = [k for k in range(len(runs)) if not runs[k].stopped]
-                if not active:
-                    break
-                turn = next((k for k in active if k > turn), active[0])
-                runs[turn].turn_end = runs[turn].samples + GOAL_TURN
-                continue
-            if run.release is not None and search.valid and search.samples - run.improved_at >= run.release:
-                # converged on the prescribed rows: from this path on, every DOF in one group, around one waypoint
-                # (``improved_at`` shifted so that ``stall`` counts on across the release)
-                released = run.grouped.released()
-                run.restart(released, new_search(released, run.goal, search.W, local=True))
-                run.release = None
-                run.improved_at -= search.samples
-                if stats["released_at"] is None:
-                    stats["released_at"] = drawn
-                log.info("DimensionRRT: prescribed rows released after %d samples", drawn)
-                continue
-            if stall is not None and math.isfinite(poster.found_cost) and search.samples - run.improved_at >= stall:
-                run.stopped = True  # converged: nothing shorter in the last ``stall`` samples
-                if all(r.stopped for r in runs):
-                    break
-                continue
-            if (not search.valid and 2 * run.grouped.h - 1 <= max_h
-                    and (search.samples >= _REFINE_AFTER or search.unfitted is not None)):
-                # no path yet, or a connect path with more turns than steps: twice the steps, the
-                # trees start again (that path is fitted to the new steps first)
-                refined = run.grouped.refined(q0, run.goal)
-                run.restart(refined, new_search(refined, run.goal, None, search.unfitted))
-                run.best = run.search.cost if run.search.valid else math.inf
-                if run.best < poster.found_cost:
-                    poster.offer(run.search.W, run.best, time.perf_counter())
-                    record(time.perf_counter())
-                log.info("DimensionRRT: no path after %d samples, h raised to %d", run.done, run.grouped.h)
-                continue
-            limit = _PASS_BATCH if cap is None else min(_PASS_BATCH, cap - drawn)
-            if stall is not None:
-                limit = min(limit, stall - (search.samples - run.improved_at))
-            if run.release is not None and search.valid:
-                limit = min(limit, run.release - (search.samples - run.improved_at))
-            if stops and drawn < stops[-1]:
-                limit = min(limit, next(s for s in stops if s > drawn) - drawn)
-            if several:
-                limit = min(limit, run.turn_end - run.samples)
-            before = search.samples
-            accepted = search.iterate(max(1, limit), ptc)
-            drawn += search.samples - before
-            self._samples_drawn = drawn
-            now = time.perf_counter()
-            if accepted and search.valid and search.cost < run.best:
-                run.best, run.improved_at = search.cost, search.samples
-                if search.cost < poster.found_cost:
-                    poster.offer(search.W, search.cost, now)
-                    record(now)
-                    last_log = now
-                    continue
-            if now - last_log >= _PROGRESS_PERIOD:
-                record(now)
-                last_log = now
-        poster.flush()
-        record(time.perf_counter())
         stats.update(
             h=max(run.grouped.h for run in runs),
-            samples=drawn,
-            iterations=drawn,
+            samples=loop.drawn,
+            iterations=loop.drawn,
             collision_checks=checker.counter() - checks0,
             first_solution_time=poster.first_time,
             best_cost=poster.best_cost,

@@ -1,0 +1,170 @@
+"""One dimension-RRT solve after its set-up: the goal runs' turns, releasing the prescribed rows, raising ``h``,
+stopping on a stall, and each pass of samples with its improvements posted to OMPL.
+
+:class:`~tpee_ompl.planning.dimension_rrt.DimensionRRT` builds the runs (one per goal state), the
+:class:`~tpee_ompl.planning.solution_posting.SolutionPoster` and the way a new search is made, then hands them to
+:class:`GoalLoop`; what each rule does and why is in the planner's module docstring ("Several goal states",
+"Raising h", "Stopping", the release of the prescribed rows).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from ompl import base as ob
+
+from .dimension_search import Search
+from .goal_runs import GOAL_TURN, GoalRun
+from .grouped_space import GroupedSpace
+from .solution_posting import SolutionPoster
+
+__all__ = ["GoalLoop", "LoopLimits", "NewSearch"]
+
+log = logging.getLogger("tpee_ompl.planning.dimension_rrt")
+
+REFINE_AFTER = 500
+"""Samples without a first path after which ``h`` is raised (when ``max_h`` allows; see "Raising h")."""
+PROGRESS_PERIOD = 0.01
+"""Seconds between progress-trace entries (OMPL's benchmark records progress about as often)."""
+PASS_BATCH = 64
+"""Most samples per :meth:`Search.iterate` call on a valid path (those the cost test rejects are passed
+over in one vectorised step; the termination condition is asked between calls) or in the connect
+trees (which ask it before each sample, as RRTConnect does)."""
+
+NewSearch = Callable[..., Search]
+"""``new_search(grouped, goal, initial, turns=None, local=False)``: a search of the solve's start to ``goal``."""
+
+
+@dataclass(frozen=True)
+class LoopLimits:
+    """What ends a solve or a pass, besides the termination condition: ``cap`` samples of all goals (None: no
+    cap), ``max_h`` fake-time steps at most when raising ``h``, ``stall`` samples without a shorter path (None:
+    never), and the ``stops`` (sample counts) a pass ends at exactly."""
+
+    cap: int | None
+    max_h: int
+    stall: int | None
+    stops: tuple[int, ...]
+
+
+class GoalLoop:
+    """The loop of one solve over its goal runs (nearest goal first, in turns of :data:`GOAL_TURN` samples when
+    there are several), until the objective is satisfied, the termination condition holds, the cap is reached or
+    every goal has stopped."""
+
+    def __init__(self, runs: list[GoalRun], poster: SolutionPoster, new_search: NewSearch, q0: np.ndarray,
+                 limits: LoopLimits, stats: dict[str, Any], t0: float,
+                 on_drawn: Callable[[int], None]) -> None:
+        self.runs, self.poster, self.new_search, self.q0 = runs, poster, new_search, q0
+        self.limits, self.stats, self.t0, self.on_drawn = limits, stats, t0, on_drawn
+        self.several = len(runs) > 1
+        self.drawn = 0
+        """Samples of every goal's searches so far."""
+        self.turn = 0
+        self._last_log = -math.inf
+        runs[0].turn_end = GOAL_TURN
+
+    def record(self, now: float) -> None:
+        """A progress row: (seconds since the solve began, best cost found, samples)."""
+        self.stats["progress"].append((now - self.t0, self.poster.found_cost, self.drawn))
+
+    def run(self, ptc: ob.PlannerTerminationCondition) -> None:
+        """Offer the runs' initial paths, loop, post what is pending."""
+        poster = self.poster
+        for run in self.runs:
+            if run.best < poster.found_cost:
+                poster.offer(run.search.W, run.best, time.perf_counter())
+        self.record(time.perf_counter())
+        cap = self.limits.cap
+        while not poster.satisfied and not ptc() and (cap is None or self.drawn < cap):
+            if not self.step(ptc):
+                break
+        poster.flush()
+        self.record(time.perf_counter())
+
+    def step(self, ptc: ob.PlannerTerminationCondition) -> bool:
+        """One step of the loop on the current goal's run; False when every goal has stopped."""
+        run = self.runs[self.turn]
+        if self.several:  # a goal no path to which beats the best found (its start-goal distance is no shorter) stops
+            run.stopped |= run.bound >= self.poster.found_cost - 1e-12
+            if run.stopped or run.samples >= run.turn_end:
+                return self._next_turn()
+        search, stall = run.search, self.limits.stall
+        if run.release is not None and search.valid and search.samples - run.improved_at >= run.release:
+            self._release(run)
+        elif stall is not None and math.isfinite(self.poster.found_cost) and search.samples - run.improved_at >= stall:
+            run.stopped = True  # converged: nothing shorter in the last ``stall`` samples
+            return not all(r.stopped for r in self.runs)
+        elif (not search.valid and 2 * run.grouped.h - 1 <= self.limits.max_h
+              and (search.samples >= REFINE_AFTER or search.unfitted is not None)):
+            self._raise_h(run)
+        else:
+            self._pass(run, ptc)
+        return True
+
+    def _next_turn(self) -> bool:
+        """Another goal's turn; False when none is left."""
+        active = [k for k in range(len(self.runs)) if not self.runs[k].stopped]
+        if not active:
+            return False
+        self.turn = next((k for k in active if k > self.turn), active[0])
+        self.runs[self.turn].turn_end = self.runs[self.turn].samples + GOAL_TURN
+        return True
+
+    def _release(self, run: GoalRun) -> None:
+        """Converged on the prescribed rows: from this path on, every DOF in one group, around one waypoint
+        (``improved_at`` shifted so that ``stall`` counts on across the release)."""
+        search = run.search
+        released = run.grouped.released()
+        run.restart(released, self.new_search(released, run.goal, search.W, local=True))
+        run.release = None
+        run.improved_at -= search.samples
+        if self.stats["released_at"] is None:
+            self.stats["released_at"] = self.drawn
+        log.info("DimensionRRT: prescribed rows released after %d samples", self.drawn)
+
+    def _raise_h(self, run: GoalRun) -> None:
+        """No path yet, or a connect path with more turns than steps: twice the steps, the trees start again
+        (that path is fitted to the new steps first)."""
+        refined: GroupedSpace = run.grouped.refined(self.q0, run.goal)
+        run.restart(refined, self.new_search(refined, run.goal, None, run.search.unfitted))
+        run.best = run.search.cost if run.search.valid else math.inf
+        if run.best < self.poster.found_cost:
+            self.poster.offer(run.search.W, run.best, time.perf_counter())
+            self.record(time.perf_counter())
+        log.info("DimensionRRT: no path after %d samples, h raised to %d", run.done, run.grouped.h)
+
+    def _pass(self, run: GoalRun, ptc: ob.PlannerTerminationCondition) -> None:
+        """Samples until the next limit (a batch, the cap, the stall, the release, a stop, the goal's turn); a
+        shorter path is offered to OMPL at once."""
+        search, lim = run.search, self.limits
+        limit = PASS_BATCH if lim.cap is None else min(PASS_BATCH, lim.cap - self.drawn)
+        if lim.stall is not None:
+            limit = min(limit, lim.stall - (search.samples - run.improved_at))
+        if run.release is not None and search.valid:
+            limit = min(limit, run.release - (search.samples - run.improved_at))
+        if lim.stops and self.drawn < lim.stops[-1]:
+            limit = min(limit, next(s for s in lim.stops if s > self.drawn) - self.drawn)
+        if self.several:
+            limit = min(limit, run.turn_end - run.samples)
+        before = search.samples
+        accepted = search.iterate(max(1, limit), ptc)
+        self.drawn += search.samples - before
+        self.on_drawn(self.drawn)
+        now = time.perf_counter()
+        if accepted and search.valid and search.cost < run.best:
+            run.best, run.improved_at = search.cost, search.samples
+            if search.cost < self.poster.found_cost:
+                self.poster.offer(search.W, search.cost, now)
+                self.record(now)
+                self._last_log = now
+                return
+        if now - self._last_log >= PROGRESS_PERIOD:
+            self.record(now)
+            self._last_log = now
