@@ -11,7 +11,7 @@ from helpers.planning_spaces import box_problem
 from ompl import base as ob
 
 from tpee_ompl.planning import search_draws
-from tpee_ompl.planning.dimension_search import Search
+from tpee_ompl.planning.dimension_search import Search, SearchSettings
 from tpee_ompl.planning.grouped_space import GroupedSpace
 from tpee_ompl.planning.paths import path_passes_motion_checks, set_state
 from tpee_ompl.planning.search_checker import Checker, segment_key
@@ -92,7 +92,8 @@ def test_search_finds_a_valid_path_around_the_box_and_only_shortens_it(batch: bo
     grouped = GroupedSpace(si, [[0, 1]], 7)
     start, goal = np.array([-0.8, 0.0]), np.array([0.8, 0.0])
     search = Search(grouped, Checker(si, grouped.layout, batch), np.random.default_rng(3), start, goal,
-                    narrow_after=200, narrowing=0.5, range_={0: np.full(2, 0.04)}, connect=connect)
+                    settings=SearchSettings(narrow_after=200, narrowing=0.5, connect=connect),
+                    range_={0: np.full(2, 0.04)})
     assert not search.valid and search.cost == pytest.approx(1.6)
     while not search.valid and search.samples < 3000:
         search.iterate()
@@ -117,8 +118,8 @@ def test_iterate_in_blocks_matches_one_sample_per_call(limit: int, batch: bool, 
 
     def search() -> Search:
         return Search(grouped, Checker(si, grouped.layout, batch), np.random.default_rng(5), start, goal,
-                      narrow_after=50, narrowing=0.5, range_={0: np.full(1, 0.02), 1: np.full(1, 0.02)},
-                      shortcuts=shortcuts)
+                      settings=SearchSettings(narrow_after=50, narrowing=0.5, shortcuts=shortcuts),
+                      range_={0: np.full(1, 0.02), 1: np.full(1, 0.02)})
 
     one, many = search(), search()
     trace_one, trace_many = [], []
@@ -150,7 +151,8 @@ def test_cost_test_run_ahead_passes_over_the_same_samples_as_one_sample_per_call
 
     def search() -> Search:
         return Search(grouped, Checker(si, grouped.layout, True), np.random.default_rng(3), start, goal,
-                      narrow_after=50, narrowing=0.5, range_={0: np.full(2, 0.02)}, local=local, shortcuts=shortcuts)
+                      settings=SearchSettings(narrow_after=50, narrowing=0.5, shortcuts=shortcuts),
+                      range_={0: np.full(2, 0.02)}, local=local)
 
     one, many = search(), search()
     trace_one, trace_many = [], []
@@ -193,7 +195,8 @@ def test_hits_checked_together_give_the_paths_of_hits_checked_one_by_one(
 
     def trace(limits: Iterator[int]) -> tuple[list[tuple[int, bytes]], int]:
         search = Search(grouped, Checker(si, grouped.layout, True), np.random.default_rng(5), start, goal,
-                        narrow_after=50, narrowing=0.5, range_={0: np.full(2, 0.02)}, local=local, shortcuts=True)
+                        settings=SearchSettings(narrow_after=50, narrowing=0.5, shortcuts=True),
+                        range_={0: np.full(2, 0.02)}, local=local)
         out, calls = [], 0
         while search.samples < 3000:
             search.iterate(min(next(limits), 3000 - search.samples))
@@ -224,7 +227,8 @@ def test_released_search_draws_its_narrowed_samples_around_one_waypoint_at_a_tim
     si, _ = box_problem()
     grouped = GroupedSpace(si, [[0, 1]], 7)
     search = Search(grouped, Checker(si, grouped.layout, True), np.random.default_rng(0), np.array([-0.8, -0.9]),
-                    np.array([0.8, 0.9]), narrow_after=0, narrowing=1e-3, range_={0: np.full(2, 0.02)}, local=local)
+                    np.array([0.8, 0.9]),
+                    settings=SearchSettings(narrow_after=0, narrowing=1e-3), range_={0: np.full(2, 0.02)}, local=local)
     U = np.random.default_rng(1).random((3000, 3))
     C, _ = search._group_draws(0, U)
     late = np.arange(len(U)) >= 400  # narrowing ** 4: the padding is range_ from here on
@@ -246,7 +250,8 @@ def test_narrowing_paddings_are_those_of_pythons_power_bit_for_bit(narrowing: fl
     grouped = GroupedSpace(si, [[0, 1]], 5)
     range_ = np.array([0.04, 0.01])
     search = Search(grouped, Checker(si, grouped.layout, True), np.random.default_rng(0), np.array([-0.8, 0.0]),
-                    np.array([0.8, 0.0]), narrow_after=0, narrowing=narrowing, range_={0: range_})
+                    np.array([0.8, 0.0]),
+                    settings=SearchSettings(narrow_after=0, narrowing=narrowing), range_={0: range_})
     lo, hi = grouped.group_bounds(0)
     for k in (np.array([3]), np.arange(0, 40), np.array([17, 900, 901]), np.arange(2500, 5000, 7), np.array([200_000])):
         got = np.maximum(range_, (hi - lo) * search._scale(k)[:, None])
@@ -260,8 +265,8 @@ def test_a_block_of_connect_samples_ends_when_stop_says_so() -> None:
     si, _ = box_problem(lo=(-0.05, -1.0), hi=(0.05, 1.0))  # a full wall: the trees never meet
     grouped = GroupedSpace(si, [[0, 1]], 7)
     search = Search(grouped, Checker(si, grouped.layout, False), np.random.default_rng(0),
-                    np.array([-0.8, 0.0]), np.array([0.8, 0.0]), narrow_after=50, narrowing=0.5,
-                    range_={0: np.full(2, 0.02)})
+                    np.array([-0.8, 0.0]), np.array([0.8, 0.0]),
+                    settings=SearchSettings(narrow_after=50, narrowing=0.5), range_={0: np.full(2, 0.02)})
     asked: list[int] = []
 
     def stop() -> bool:
@@ -300,7 +305,8 @@ def test_with_a_prescribed_group_a_sample_joins_the_trees_at_every_step_it_can()
     h = 9
     grouped = GroupedSpace(si, [[0, 1], [2]], h, {1: np.linspace(-0.5, 0.5, h)[:, None]})
     search = Search(grouped, Checker(si, grouped.layout, True), np.random.default_rng(6), np.array([-0.8, 0, -0.5]),
-                    np.array([0.8, 0, 0.5]), narrow_after=100, narrowing=0.5, range_={0: np.full(2, 0.02)})
+                    np.array([0.8, 0, 0.5]),
+                    settings=SearchSettings(narrow_after=100, narrowing=0.5), range_={0: np.full(2, 0.02)})
     z = np.linspace(-0.5, 0.5, h)  # the prescribed DOF at each step
     checked = 0
     while not search.valid and search.samples < 400:
@@ -394,7 +400,9 @@ def test_trees_over_continuous_joints_with_a_prescribed_group_find_a_valid_path(
     si.setup()
     grouped = GroupedSpace(si, groups, 7, {3: np.zeros((7, 1))})  # the last DOF prescribed: the trees hold 3 of 4
     search = Search(grouped, Checker(si, grouped.layout, True), np.random.default_rng(0), np.array([-1.0, 3.0, -0.8, 0.0]),
-                    np.array([1.0, -3.0, 0.8, 0.0]), narrow_after=200, narrowing=0.5,
+                    np.array([1.0, -3.0, 0.8, 0.0]),
+
+                    settings=SearchSettings(narrow_after=200, narrowing=0.5),
                     range_={gi: np.full(1, 0.02) for gi in grouped.planned})
     assert not search.valid
     while not search.valid and search.samples < 3000:
@@ -422,7 +430,9 @@ def _two_walls_search(h: int, seed: int) -> tuple[ob.SpaceInformation, Search]:
     si.setup()
     grouped = GroupedSpace(si, [[0], [1]], h)
     return si, Search(grouped, Checker(si, grouped.layout, False), np.random.default_rng(seed), np.array([-0.9, -0.9]),
-                      np.array([0.9, 0.9]), narrow_after=200, narrowing=0.5, range_={0: np.full(1, 0.04), 1: np.full(1, 0.04)})
+                      np.array([0.9, 0.9]),
+                      settings=SearchSettings(narrow_after=200, narrowing=0.5),
+                      range_={0: np.full(1, 0.04), 1: np.full(1, 0.04)})
 
 
 def test_connect_path_is_fitted_to_the_steps_with_every_step_on_it_after_the_next_sample() -> None:

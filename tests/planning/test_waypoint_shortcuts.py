@@ -11,7 +11,7 @@ from ompl import geometric as og
 from tpee_ompl.model.wearer_arm import WearerArm
 from tpee_ompl.planning import waypoint_shortcuts
 from tpee_ompl.planning.dimension_rrt import DimensionRRT
-from tpee_ompl.planning.dimension_search import Search
+from tpee_ompl.planning.dimension_search import Search, SearchSettings
 from tpee_ompl.planning.grouped_space import GroupedSpace
 from tpee_ompl.planning.paths import path_passes_motion_checks, path_to_array
 from tpee_ompl.planning.search_checker import Checker
@@ -211,8 +211,9 @@ def test_the_released_search_respreads_collapsed_waypoints_into_a_valid_shorter_
     grouped = GroupedSpace(si, [[0], [1]], 7)
     start, goal = np.array([-0.9, 0.0]), np.array([0.9, 0.0])
     W = np.array([start, [-0.5, 0.5], [0.0, 0.5], [0.001, 0.5], [0.4, 0.5], [0.6, 0.3], goal])
-    search = Search(grouped, Checker(si, grouped.layout, True), np.random.default_rng(0), start, goal, narrow_after=200,
-                    narrowing=0.5, range_={0: np.full(1, 0.02), 1: np.full(1, 0.02)}, initial=W, shortcuts=True)
+    search = Search(grouped, Checker(si, grouped.layout, True), np.random.default_rng(0), start, goal,
+                    settings=SearchSettings(narrow_after=200, narrowing=0.5, shortcuts=True),
+                    range_={0: np.full(1, 0.02), 1: np.full(1, 0.02)}, initial=W)
     assert search.valid
     before = search.cost
     assert search._respread() == 1

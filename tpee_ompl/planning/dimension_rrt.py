@@ -115,7 +115,7 @@ from ompl import geometric as og
 
 from ..validation import check_int
 from .dimension_rrt_options import RELEASE_AFTER, DimensionRRTOptions, resolve_options, shortcuts_on
-from .dimension_search import Search
+from .dimension_search import Search, SearchSettings
 from .goal_loop import GoalLoop, LoopLimits
 from .goal_runs import GoalRun, goal_states
 from .grouped_space import GroupedSpace, RealVectorLayout
@@ -385,10 +385,13 @@ class DimensionRRT(PythonPlanner):
         checks0 = checker.counter()
         release = self.options.release_after if grouped.prescribed and grouped.planned else None
 
+        settings = SearchSettings(self.narrow_after, self.narrowing, self.options.connect, self.shortcuts,
+                                  settle=release is None)
+
         def new_search(grouped_: GroupedSpace, goal: np.ndarray, initial: np.ndarray | None,
                        turns: np.ndarray | None = None, local: bool = False) -> Search:
-            return Search(grouped_, checker, self._rng, q0, goal, self.narrow_after, self.narrowing, self._ranges(grouped_),
-                          initial, self.options.connect, turns, self.shortcuts, local, settle=release is None)
+            return Search(grouped_, checker, self._rng, q0, goal, settings, self._ranges(grouped_), initial, turns,
+                          local=local)
 
         runs = []  # each search checks its initial path: the termination condition is asked between them
         for q1 in fits[: self.options.max_goals]:

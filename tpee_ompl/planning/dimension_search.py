@@ -8,6 +8,8 @@ groups, :class:`LayeredTrees` with them or when a connect path does not fit the 
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import functools
 from collections.abc import Callable
 
@@ -20,18 +22,32 @@ from .search_checker import Checker, segment_key
 from .search_draws import GROUP_BLOCK, SampleDraws
 from .waypoint_shortcuts import respread_candidate, sweep_until_settled
 
-__all__ = ["Search"]
+__all__ = ["Search", "SearchSettings"]
+
+
+@dataclass(frozen=True)
+class SearchSettings:
+    """What every search of one solve shares: ``narrow_after`` and ``narrowing`` (the narrowing region,
+    :mod:`~tpee_ompl.planning.search_draws`), ``connect`` (connect trees for a first path without prescribed
+    groups), ``shortcuts`` (the shortcut sweeps on a valid path), ``settle`` (the rows will not be released, so
+    with a prescribed group the sweeps repeat until settled)."""
+
+    narrow_after: int
+    narrowing: float
+    connect: bool = True
+    shortcuts: bool = False
+    settle: bool = False
 
 
 class Search(SampleDraws):
-    """The dimension-RRT iteration on a waypoint array; OMPL-free apart from the checker.  ``local``: narrowed
-    samples around one waypoint at a time (the released search; :meth:`SampleDraws._group_draws`).  ``settle``:
-    the rows will not be released, so with a prescribed group the shortcut sweeps repeat until settled."""
+    """The dimension-RRT iteration on a waypoint array; OMPL-free apart from the checker.  ``range_``: per planned
+    group, the least padding of its narrowed region; ``initial``: a first guess of the waypoints; ``turns``: a
+    connect path's turning points to fit (``h`` raised); ``local``: narrowed samples around one waypoint at a time
+    (the released search; :meth:`SampleDraws._group_draws`)."""
 
     def __init__(self, grouped: GroupedSpace, checker: Checker, rng: np.random.Generator, start: np.ndarray,
-                 goal: np.ndarray, narrow_after: int, narrowing: float, range_: dict[int, np.ndarray],
-                 initial: np.ndarray | None = None, connect: bool = True, turns: np.ndarray | None = None,
-                 shortcuts: bool = False, local: bool = False, settle: bool = False) -> None:
+                 goal: np.ndarray, settings: SearchSettings, range_: dict[int, np.ndarray],
+                 initial: np.ndarray | None = None, turns: np.ndarray | None = None, local: bool = False) -> None:
         self.checker = checker
         self.dist = grouped.layout.distance
         W = grouped.initial_waypoints(start, goal)
@@ -50,10 +66,10 @@ class Search(SampleDraws):
             # in full at once: the initial path is often valid, and then screening a coarse subset first only costs
             self.E[self.E] = checker.check_motions(W[:-1][self.E], W[1:][self.E])
         self.L = self.dist(W[:-1], W[1:])
-        self._init_draws(grouped, rng, narrow_after, narrowing, range_, local)
+        self._init_draws(grouped, rng, settings.narrow_after, settings.narrowing, range_, local)
         self._tree: LayeredTrees | None = None
         self._connect: ConnectTrees | None = None
-        self._use_connect = connect
+        self._use_connect = settings.connect
         self._guess = initial is not None
         self.unfitted: np.ndarray | None = None
         """Turning points of a connect-tree path that did not fit the h steps (None: no such path)."""
@@ -68,8 +84,8 @@ class Search(SampleDraws):
         self._fbounds = (grouped.layout.lower[self._fdims], grouped.layout.upper[self._fdims])
         self._hold = not grouped.prescribed
         self.delta = grouped.layout.delta
-        self._shortcuts = shortcuts
-        self._settle = settle and bool(grouped.prescribed)  # rows kept to the end: sweeps until settled
+        self._shortcuts = settings.shortcuts
+        self._settle = settings.settle and bool(grouped.prescribed)  # rows kept to the end: sweeps until settled
         self._shortcut_due = self.valid  # the valid path changed since the last sweep (or is new)
         if turns is not None and not self.valid:  # a connect path found with fewer steps (h raised)
             self._use_connect = False
