@@ -96,7 +96,8 @@ Spaces: bounded RealVector, SO2 (the short way round, like ``SO2StateSpace``) an
 the bounds are read again at each solve (as OMPL's samplers read them).  No approximate solutions: a
 solve without an exact path ends with TIMEOUT and adds nothing to the problem definition.
 Here: the planner; its settings (:class:`DimensionRRTOptions`) are in :mod:`tpee_ompl.planning.dimension_rrt_options`,
-the search in :mod:`tpee_ompl.planning.dimension_search`, the goal states in :mod:`tpee_ompl.planning.goal_runs`.
+the search in :mod:`tpee_ompl.planning.dimension_search`, the goal states in :mod:`tpee_ompl.planning.goal_runs`,
+the solve's loop over them in :mod:`tpee_ompl.planning.goal_loop`.
 """
 
 from __future__ import annotations
