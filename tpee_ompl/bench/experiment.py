@@ -16,6 +16,7 @@ the raw planner output: lengths (:func:`group_lengths`), dense validity, iterati
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import logging
 import math
@@ -24,9 +25,11 @@ import socket
 import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from ompl import base as ob
+from ompl import geometric as og
 from ompl import tools as ot
 from ompl import util as ou
 
@@ -38,7 +41,7 @@ from ..validation import sub_seed
 from .database import failed_run_properties, log_text, pad_aborted_runs, patch_recorded_data
 from .ladder import DeriveContext
 from .planners import SINGLE_USE_PLANNERS, PlannerContext, RecordingPlanner, planner_factory
-from .problems import get_problem
+from .problems import Problem, get_problem
 from .results import format_value
 
 __all__ = ["experiment_name", "experiment_specs", "group_lengths", "log_name", "run_query_task"]
@@ -232,6 +235,24 @@ def _run_separately(cfg: dict, task: dict, spec: dict, planners: list[str]) -> t
     return sink["planners"], extras, error
 
 
+@dataclasses.dataclass(frozen=True)
+class _Setup:
+    """One experiment's problem and OMPL set-up, shared by its planners, run events and ladder; ``checker``
+    is the problem's (it counts ``collision_checks`` and has ``model_hash``)."""
+
+    problem: Problem
+    ss: og.SimpleSetup
+    si: ob.SpaceInformation
+    checker: Any
+    layout: RealVectorLayout
+    start: np.ndarray
+    goal: np.ndarray
+
+    def path_properties(self, si, rec: dict, start: np.ndarray, goal: np.ndarray) -> dict:
+        """:func:`_path_properties` with this problem's first group and state layout."""
+        return _path_properties(si, rec, start, goal, self.problem.groups[0], self.layout)
+
+
 def _run_experiment(cfg: dict, task: dict, spec: dict, ladder=None, only: list[str] | None = None,
                     sink: dict | None = None) -> tuple[str, dict, str | None]:
     """One OMPL experiment; returns (log text, {planner: [run properties]}, benchmark error or None).
@@ -246,83 +267,106 @@ def _run_experiment(cfg: dict, task: dict, spec: dict, ladder=None, only: list[s
     only these planners (same seeds as in the full experiment); ``sink["planners"]`` then receives detached
     copies of the recorded planners.
     """
-    query, qpos = task["query"], int(task["qpos"])
-    problem = get_problem(cfg.get("problem", "wearer"))
-    start, goal = np.asarray(query["start"], float), np.asarray(query["goal"], float)
-    ss, checker = problem.make_setup(query, spec["checker"], task.get("n_threads"))
-    si = ss.getSpaceInformation()
-    layout = RealVectorLayout(si.getStateSpace())
-    straight = si.distance(layout.write(si.allocState(), start), layout.write(si.allocState(), goal))
-    cap, budget = spec["cap"], spec["budget"]
+    setup = _make_setup(cfg, task, spec)
     name = experiment_name(task["query_set"], spec)
-    bench = ot.Benchmark(ss, name)
-    for k, v in _experiment_parameters(cfg, task, spec, straight, checker.model_hash).items():
+    bench = _make_benchmark(cfg, task, spec, setup, name)
+    wrappers = _add_planners(cfg, task, spec, setup, bench, ladder, only)
+    records: dict[str, list[dict]] = {n: [] for n in wrappers}
+    _set_run_events(bench, setup, wrappers, records)
+    error = _benchmark(bench, _request(cfg, spec), name)
+    if error is not None:
+        pad_aborted_runs(bench, records, int(cfg["runs"]), error)
+    patch_recorded_data(bench, wrappers, records, spec["cap"])
+    text = log_text(bench)
+    if sink is not None:
+        from .anytime_ladder import copy_planner
+
+        sink["planners"] = [copy_planner(pl) for pl in bench.getRecordedExperimentData().planners]
+    if ladder is not None:
+        _derive_ladder(cfg, setup, ladder, bench, name, records)
+    extras = {n: [{k.rsplit(" ", 1)[0]: v for k, v in r["props"].items()} for r in recs] for n, recs in records.items()}
+    return text, extras, error
+
+
+def _make_setup(cfg: dict, task: dict, spec: dict) -> _Setup:
+    """The problem's ``SimpleSetup`` for the query and the experiment's motion validator."""
+    problem = get_problem(cfg.get("problem", "wearer"))
+    start, goal = np.asarray(task["query"]["start"], float), np.asarray(task["query"]["goal"], float)
+    ss, checker = problem.make_setup(task["query"], spec["checker"], task.get("n_threads"))
+    si = ss.getSpaceInformation()
+    return _Setup(problem, ss, si, checker, RealVectorLayout(si.getStateSpace()), start, goal)
+
+
+def _make_benchmark(cfg: dict, task: dict, spec: dict, setup: _Setup, name: str) -> ot.Benchmark:
+    """The experiment's ``ot.Benchmark``, with its parameters (:func:`_experiment_parameters`) and no planner yet."""
+    si, layout = setup.si, setup.layout
+    straight = si.distance(layout.write(si.allocState(), setup.start), layout.write(si.allocState(), setup.goal))
+    bench = ot.Benchmark(setup.ss, name)
+    for k, v in _experiment_parameters(cfg, task, spec, straight, setup.checker.model_hash).items():
         pname, ptype = k.rsplit(" ", 1)
         bench.addExperimentParameter(pname, ptype, v)
+    return bench
 
+
+def _add_planners(cfg: dict, task: dict, spec: dict, setup: _Setup, bench: ot.Benchmark, ladder,
+                  only: list[str] | None) -> dict:
+    """Add the comparison's planners (only those in ``only``, if given) to ``bench``; returns their wrappers by name.
+
+    A planner's seed depends on its position in the comparison's full list, so it is the same with ``only``.
+    """
+    cap, budget = spec["cap"], spec["budget"]
     planners = cfg["iteration_planners"] if spec["comparison"] == "iterations" else cfg["anytime_planners"]
-    wrappers = {}
     tag = cap if cap is not None else int(round(budget * 1000))
     tag = spec.get("seed_tag", tag)  # a separate run with a ladder's planner seeds (tests/bench/test_ladder.py)
+    wrappers: dict = {}
     for k, pname in enumerate(planners):
         if only is not None and pname not in only:
             continue
-        ctx = PlannerContext(query=query, max_samples=cap, seed=sub_seed(cfg["seed"], qpos, k, tag),
-                             problem=problem.name)
-        factory = planner_factory(pname)
-        inner = factory(si, ctx)
-        if not isinstance(inner, ob.Planner):
-            raise ValueError(f"planner factory {pname!r} returned {type(inner).__name__}, not an ompl.base.Planner")
-        if inner.getName() in {n.removeprefix("geometric_") for n in wrappers} | set(wrappers):
-            raise ValueError(f"planner factory {pname!r} makes a planner named {inner.getName()!r} like an earlier one "
-                             "of the experiment: the log keys runs by name (give it another name, setName)")
-        read = None if layout.is_plain else layout.read
-        renew = functools.partial(factory, si, ctx) if pname in SINGLE_USE_PLANNERS else None
-        w = (RecordingPlanner(si, inner, max_iterations=cap, read=read, checker=checker, renew=renew, deadline=budget)
-             if ladder is None else ladder.wrap(si, inner, cap, pname, ctx, checker=checker, read=read, renew=renew))
+        ctx = PlannerContext(query=task["query"], max_samples=cap, seed=sub_seed(cfg["seed"], int(task["qpos"]), k, tag),
+                             problem=setup.problem.name)
+        w = _wrap_planner(pname, ctx, spec, setup, ladder, wrappers)
         wrappers[w.getName()] = w
         bench.addPlanner(w)
+    return wrappers
 
-    records: dict[str, list[dict]] = {n: [] for n in wrappers}
-    counter = {"before": 0}
-    pdef = ss.getProblemDefinition()
+
+def _wrap_planner(pname: str, ctx: PlannerContext, spec: dict, setup: _Setup, ladder, earlier: dict) -> ob.Planner:
+    """Planner ``pname``'s recording wrapper (the ladder's, with a ladder).
+
+    Raises ValueError when its factory returns no ``ob.Planner`` or one named like a planner in ``earlier``.
+    """
+    factory = planner_factory(pname)
+    inner = factory(setup.si, ctx)
+    if not isinstance(inner, ob.Planner):
+        raise ValueError(f"planner factory {pname!r} returned {type(inner).__name__}, not an ompl.base.Planner")
+    if inner.getName() in {n.removeprefix("geometric_") for n in earlier} | set(earlier):
+        raise ValueError(f"planner factory {pname!r} makes a planner named {inner.getName()!r} like an earlier one "
+                         "of the experiment: the log keys runs by name (give it another name, setName)")
+    read = None if setup.layout.is_plain else setup.layout.read
+    renew = functools.partial(factory, setup.si, ctx) if pname in SINGLE_USE_PLANNERS else None
+    if ladder is None:
+        return RecordingPlanner(setup.si, inner, max_iterations=spec["cap"], read=read, checker=setup.checker,
+                                renew=renew, deadline=spec["budget"])
+    return ladder.wrap(setup.si, inner, spec["cap"], pname, ctx, checker=setup.checker, read=read, renew=renew)
+
+
+def _set_run_events(bench: ot.Benchmark, setup: _Setup, wrappers: dict, records: dict[str, list[dict]]) -> None:
+    """Set ``bench``'s run events: before each run, reset the objective's cost threshold and note the collision
+    checks so far; after it, append its properties and progress (:func:`_run_properties`) to ``records``."""
+    checks_before = {"value": 0}
+    pdef = setup.ss.getProblemDefinition()
     objective = pdef.getOptimizationObjective() if pdef.hasOptimizationObjective() else None
     threshold = objective.getCostThreshold().value() if objective is not None else None
 
     def pre_run(planner) -> None:
-        counter["before"] = checker.collision_checks
+        checks_before["value"] = setup.checker.collision_checks
         if objective is not None:  # AORRTC lowers the shared objective's threshold to its own cost as it runs:
             objective.setCostThreshold(ob.Cost(threshold))  # the next planner (BIT*) then stopped once it beat that
 
-    def post_run_props(planner) -> dict:
-        rec = wrappers[planner.getName()].last
-        # the run's own checks: not those of OMPL's simplification and path checks after it
-        end = rec.get("checks_end")
-        checks = (end if end is not None else checker.collision_checks) - counter["before"]
-        props = {
-            "collision_checks INTEGER": checks,
-            "iterations INTEGER": rec["iterations"],
-            "samples INTEGER": rec["samples"],
-            "first_solution_time REAL": rec["first_solution_time"],
-            "best_cost REAL": None,
-            "length_dof12 REAL": None,
-            "length_dof34 REAL": None,
-            "raw_length REAL": None,
-            "path_valid_dense INTEGER": None,  # no path: NULL (0 is a path that failed the check)
-            "reaches_goal INTEGER": 0,
-            "planner_error INTEGER": int(rec["error"] is not None),
-        }
-        # OMPL's own columns, which it cannot fill through the wrapper: NULL where unknown (a Python planner's graph),
-        # and the valid share of the run's motions (OMPL's counters stay at 0 under a Python motion validator)
-        props["graph states INTEGER"] = rec.get("graph_states")
-        props["graph motions INTEGER"] = rec.get("graph_motions")
-        props["valid segment fraction REAL"] = rec.get("valid_fraction")
-        props.update(_path_properties(si, rec, start, goal, problem.groups[0], layout))
-        return {"props": props, "progress": rec["progress"]}
-
     def post_run(planner, run) -> None:
         try:
-            rec = post_run_props(planner)
+            last = wrappers[planner.getName()].last
+            rec = {"props": _run_properties(setup, last, checks_before["value"]), "progress": last["progress"]}
         except Exception as exc:  # noqa: BLE001 (would abort benchmark())
             log.exception("post-run event failed for %s", planner.getName())
             rec = {"props": failed_run_properties(repr(exc)), "progress": []}
@@ -330,8 +374,39 @@ def _run_experiment(cfg: dict, task: dict, spec: dict, ladder=None, only: list[s
 
     bench.setPreRunEvent(lambda p: _guarded(pre_run, p))
     bench.setPostRunEvent(post_run)
-    req = ot.Request(
-        maxTime=float(cfg["max_time"] if cap is not None else budget),
+
+
+def _run_properties(setup: _Setup, rec: dict, checks_before: int) -> dict:
+    """The columns of one run from its RecordingPlanner record: counts, then the raw path's (:func:`_path_properties`)."""
+    # the run's own checks: not those of OMPL's simplification and path checks after it
+    end = rec.get("checks_end")
+    checks = (end if end is not None else setup.checker.collision_checks) - checks_before
+    props = {
+        "collision_checks INTEGER": checks,
+        "iterations INTEGER": rec["iterations"],
+        "samples INTEGER": rec["samples"],
+        "first_solution_time REAL": rec["first_solution_time"],
+        "best_cost REAL": None,
+        "length_dof12 REAL": None,
+        "length_dof34 REAL": None,
+        "raw_length REAL": None,
+        "path_valid_dense INTEGER": None,  # no path: NULL (0 is a path that failed the check)
+        "reaches_goal INTEGER": 0,
+        "planner_error INTEGER": int(rec["error"] is not None),
+    }
+    # OMPL's own columns, which it cannot fill through the wrapper: NULL where unknown (a Python planner's graph),
+    # and the valid share of the run's motions (OMPL's counters stay at 0 under a Python motion validator)
+    props["graph states INTEGER"] = rec.get("graph_states")
+    props["graph motions INTEGER"] = rec.get("graph_motions")
+    props["valid segment fraction REAL"] = rec.get("valid_fraction")
+    props.update(setup.path_properties(setup.si, rec, setup.start, setup.goal))
+    return props
+
+
+def _request(cfg: dict, spec: dict) -> ot.Request:
+    """The benchmark request: the safety time limit under an iteration cap, else the time budget."""
+    return ot.Request(
+        maxTime=float(cfg["max_time"] if spec["cap"] is not None else spec["budget"]),
         maxMem=4096.0,
         runCount=int(cfg["runs"]),
         timeBetweenUpdates=0.05,
@@ -339,6 +414,10 @@ def _run_experiment(cfg: dict, task: dict, spec: dict, ladder=None, only: list[s
         saveConsoleOutput=False,
         simplify=bool(cfg["simplify"]),
     )
+
+
+def _benchmark(bench: ot.Benchmark, req: ot.Request, name: str) -> str | None:
+    """Run ``bench``; returns None, or the exception that aborted it (OMPL's output then restored)."""
     handler = ou.getOutputHandler()
     error = None
     try:
@@ -350,20 +429,17 @@ def _run_experiment(cfg: dict, task: dict, spec: dict, ladder=None, only: list[s
     finally:
         _restore_ompl_output(handler)
         ou.setLogLevel(ou.LOG_WARN)
-    if error is not None:
-        pad_aborted_runs(bench, records, int(cfg["runs"]), error)
-    patch_recorded_data(bench, wrappers, records, cap)
-    text = log_text(bench)
-    if sink is not None:
-        from .anytime_ladder import copy_planner
+    return error
 
-        sink["planners"] = [copy_planner(pl) for pl in bench.getRecordedExperimentData().planners]
-    if ladder is not None:
-        try:
-            ctx = DeriveContext(ss, start, goal, bool(cfg["simplify"]), float(cfg["max_time"]),
-                                lambda si_, rec, s0, s1: _path_properties(si_, rec, s0, s1, problem.groups[0], layout))
-            ladder.derived = ladder.derive(bench, name, records, ctx)
-        except Exception:  # noqa: BLE001 (the smaller caps then run separately)
-            log.exception("checkpoint rows of %s failed; running its smaller caps (budgets) separately", name)
-    extras = {n: [{k.rsplit(" ", 1)[0]: v for k, v in r["props"].items()} for r in recs] for n, recs in records.items()}
-    return text, extras, error
+
+def _derive_ladder(cfg: dict, setup: _Setup, ladder, bench: ot.Benchmark, name: str, records: dict) -> None:
+    """Set ``ladder.derived`` to the logs of its smaller caps (shorter budgets), read from this run.
+
+    On failure it stays as it was, and the caller runs those experiments separately.
+    """
+    try:
+        ctx = DeriveContext(setup.ss, setup.start, setup.goal, bool(cfg["simplify"]), float(cfg["max_time"]),
+                            setup.path_properties)
+        ladder.derived = ladder.derive(bench, name, records, ctx)
+    except Exception:  # noqa: BLE001 (the smaller caps then run separately)
+        log.exception("checkpoint rows of %s failed; running its smaller caps (budgets) separately", name)
