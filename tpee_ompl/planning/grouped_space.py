@@ -209,6 +209,7 @@ class RealVectorLayout:
         bounds = np.cumsum([0] + [d for _, d, _, _ in self._leaves])
         self._slices = [slice(int(bounds[i]), int(bounds[i + 1])) for i in range(len(self._leaves))]
         self._weights = np.array([w for _, _, w, _ in self._leaves])
+        self._leaf_starts = np.array([sl.start for sl in self._slices], dtype=np.intp)
         self.circular = np.zeros(self.n, dtype=bool)
         """True for the SO2 (wrap-around) entries of the flat vector."""
         for (_, _, _, so2), sl in zip(self._leaves, self._slices):
@@ -311,12 +312,15 @@ class RealVectorLayout:
         D = self.delta(A, B)
         if self.is_plain:
             return np.sqrt(np.einsum("...i,...i->...", D, D))
-        return sum(w * np.linalg.norm(D[..., sl], axis=-1) for w, sl in zip(self._weights, self._slices))
+        return self._leaf_norms(D) @ self._weights
+
+    def _leaf_norms(self, D: np.ndarray) -> np.ndarray:
+        """Per leaf, the Euclidean norm of its entries of D (..., n): shape (..., leaves)."""
+        return np.sqrt(np.add.reduceat(D * D, self._leaf_starts, axis=-1))
 
     def leaf_distances(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
         """Per subspace (leaf), its own distance between rows of A and B: shape (..., leaves), unweighted."""
-        D = self.delta(A, B)
-        return np.stack([np.linalg.norm(D[..., sl], axis=-1) for sl in self._slices], axis=-1)
+        return self._leaf_norms(self.delta(A, B))
 
     def path_length(self, W: np.ndarray) -> float:
         """Length of the polyline through waypoints W (K, n) in the space's metric."""
