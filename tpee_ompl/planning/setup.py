@@ -381,7 +381,9 @@ def motion_check_step(setup: og.SimpleSetup | ob.SpaceInformation) -> float:
     validator (OMPL's ``DiscreteMotionValidator``) it is the space's longest valid segment length,
     ``si.getStateValidityCheckingResolution() * space.getMaximumExtent()`` (equal up to rounding).
     While the space's ``validSegmentCountFactor`` is f > 1 (``ot.Benchmark``'s strict check), motions
-    are checked at ``step / f``.
+    are checked at ``step / f``.  In the compound space of a robot with continuous joints the checked states are
+    at most this far apart in the Euclidean joint metric (closer: each subspace is subdivided at its share of the
+    step, :meth:`BatchedMotionValidator.segment_counts`).
     """
     si = setup.getSpaceInformation() if isinstance(setup, og.SimpleSetup) else setup
     if not isinstance(si, ob.SpaceInformation):
