@@ -434,6 +434,21 @@ def test_a_collision_between_neighbouring_links_points_to_the_srdf(tmp_path):
         RobotChecker(urdf, srdf, obstacles=[table]).check_free(np.zeros(2), "start")
 
 
+def test_an_srdf_of_a_larger_robot_is_refused_unless_its_other_links_are_skipped(tmp_path):
+    limits = '<limit lower="-1" upper="1" effort="1" velocity="1"/>'
+    urdf = _two_joint_urdf(tmp_path / "arm.urdf", f'type="revolute">{_J2}{limits}')
+    srdf = tmp_path / "humanoid.srdf"  # one pair of this arm's links, two naming links of the rest of the robot
+    srdf.write_text('<robot name="h"><disable_collisions link1="a" link2="b" reason="Never"/>'
+                    '<disable_collisions link1="a" link2="head"/><disable_collisions link1="leg" link2="b"/></robot>')
+    with pytest.raises(ValueError, match=r"unknown link 'head' \(2 of its 3 .*srdf_unknown_links='skip'"):
+        RobotChecker(urdf, srdf)
+    every = len(RobotChecker(urdf).gmodel.collisionPairs)
+    robot = RobotChecker(urdf, srdf, srdf_unknown_links="skip")
+    assert len(robot.gmodel.collisionPairs) == every - 1  # the arm's own pair is disabled
+    with pytest.raises(ValueError, match="srdf_unknown_links must be 'error' or 'skip', got 'ignore'"):
+        RobotChecker(urdf, srdf_unknown_links="ignore")
+
+
 def _l_shaped_stl(path) -> None:
     """An ASCII STL of an L-shaped prism (0.4 x 0.4 x 0.1 m, the square [0.1, 0.4]^2 cut out of its corner)."""
     outline = [(0, 0), (0.4, 0), (0.4, 0.1), (0.1, 0.1), (0.1, 0.4), (0, 0.4)]

@@ -82,6 +82,9 @@ class RobotChecker:
         False keeps true cylinders.  Obstacles are never converted.
     extra_points : sequence of frame names
         Frames whose origins count as robot points in :meth:`lever_arms` (e.g. a tool tip).
+    srdf_unknown_links : {"error", "skip"}
+        An SRDF pair naming a link the URDF lacks is an error (default: a typo would leave the pair checked), or
+        is passed over (``"skip"``: the SRDF of a larger robot, e.g. a humanoid's for one of its arms).
     convex_meshes : bool
         Check every robot mesh as its convex hull (never a collision missed; cheap near contact, where a
         detailed mesh at a positive margin can cost milliseconds per pair).  Off by default.
@@ -101,6 +104,7 @@ class RobotChecker:
         cylinders_as_capsules: bool = True,
         extra_points: Sequence[str] = (),
         convex_meshes: bool = False,
+        srdf_unknown_links: str = "error",
     ) -> None:
         for what, value in (("urdf_path", urdf_path), ("srdf_path", srdf_path)):
             if value is not None and not isinstance(value, (str, os.PathLike)) or isinstance(value, bool):
@@ -117,7 +121,8 @@ class RobotChecker:
             raise ValueError(f"package_dirs must be a path or a list of paths, got {package_dirs!r}")
         self._options = {"package_dirs": tuple(package_dirs), "locked": dict(locked or {}), "obstacles": tuple(obstacles),
                          "cylinders_as_capsules": check_bool("cylinders_as_capsules", cylinders_as_capsules),
-                         "convex_meshes": check_bool("convex_meshes", convex_meshes)}
+                         "convex_meshes": check_bool("convex_meshes", convex_meshes),
+                         "srdf_unknown_links": srdf_unknown_links}
         self._setup(ModelFiles(Path(urdf_path), Path(srdf_path) if srdf_path is not None else None),
                     security_margin, n_threads, link_margins, extra_points)
 

@@ -8,6 +8,7 @@ every ``<collision>`` element must become a geometry, every URDF cylinder become
 from __future__ import annotations
 
 import copy
+import logging
 import hashlib
 import math
 import numbers
@@ -34,6 +35,8 @@ __all__ = [
     "load_urdf_model",
     "load_wearer_model",
 ]
+
+log = logging.getLogger(__name__)
 
 ARM_JOINTS = ("j1", "j2", "j3", "j4")
 """Joint names in configuration order: DOF1 (about x), DOF2 (about -y), pan, tilt."""
@@ -177,6 +180,7 @@ def load_urdf_model(
     locked: Mapping[str, float] | None = None,
     obstacles: Sequence[Obstacle] = (),
     convex_meshes: bool = False,
+    srdf_unknown_links: str = "error",
 ) -> LoadedModel:
     """Load any URDF (+ SRDF) for collision checking: every ``<collision>`` becomes a geometry.
 
@@ -193,10 +197,14 @@ def load_urdf_model(
     Collision pairs: every pair of geometries on different joints (so never obstacle-obstacle or
     obstacle-base), minus the SRDF's disabled link pairs.  The model hash covers the URDF and SRDF
     texts and, when given, the locked values, obstacles, a ``cylinders_as_capsules=False`` and the meshes made
-    convex hulls (``convex_meshes``; a flat mesh, which has none, stays a mesh).
+    convex hulls (``convex_meshes``; a flat mesh, which has none, stays a mesh).  An SRDF pair naming a link the
+    URDF lacks is refused (a typo would leave that pair checked), or with ``srdf_unknown_links="skip"`` passed
+    over (the SRDF of a larger robot, e.g. a whole humanoid's for one arm: its other pairs apply).
 
     Raises FileNotFoundError (a missing file) or ValueError (anything that would load wrongly).
     """
+    if srdf_unknown_links not in ("error", "skip"):
+        raise ValueError(f"srdf_unknown_links must be 'error' or 'skip', got {srdf_unknown_links!r}")
     root = _parse_urdf(urdf)
     text = _read_text(urdf, "URDF")
     n_collision_elements = sum(1 for _ in root.iter("collision"))
@@ -261,7 +269,7 @@ def load_urdf_model(
         digest.update(("\n" + e).encode())
     gmodel.addAllCollisionPairs()
     if srdf is not None:
-        _apply_srdf(model, gmodel, srdf)
+        _apply_srdf(model, gmodel, srdf, srdf_unknown_links)
     return LoadedModel(model, gmodel, digest.hexdigest()[:16], continuous)
 
 
@@ -380,15 +388,19 @@ def is_prismatic(joint: pin.JointModel) -> bool:
     return joint.shortname().startswith("JointModelP")
 
 
-def _apply_srdf(model: pin.Model, gmodel: pin.GeometryModel, srdf: Path) -> None:
-    """Remove the SRDF's disabled pairs, after checking that it names only links of the model."""
+def _apply_srdf(model: pin.Model, gmodel: pin.GeometryModel, srdf: Path, unknown_links: str = "error") -> None:
+    """Remove the SRDF's disabled pairs, after checking that it names only links of the model (``unknown_links``
+    "error"), or passing over the pairs that name other links ("skip"; Pinocchio applies the rest)."""
     root = _read_robot_xml(srdf, "SRDF")
     links = {f.name for f in model.frames}
     pairs = [(dc.get("link1"), dc.get("link2")) for dc in root.iter("disable_collisions")]
     foreign = [p for p in pairs if p[0] not in links or p[1] not in links]
-    if foreign:
+    if foreign and unknown_links == "skip":
+        log.info("SRDF %s: %d of its %d disabled pairs name links the URDF lacks; passed over", srdf, len(foreign),
+                 len(pairs))
+    elif foreign:
         name = next(n for n in foreign[0] if n not in links)
         raise ValueError(f"SRDF {srdf} names unknown link {name!r} ({len(foreign)} of its {len(pairs)} disabled pairs "
                          "name links the URDF lacks: an SRDF of another or a larger robot? keep only the pairs of "
-                         "this URDF's links)")
+                         "this URDF's links, or pass srdf_unknown_links='skip')")
     pin.removeCollisionPairs(model, gmodel, str(srdf))
