@@ -41,7 +41,8 @@ bench-full: $(STAMP)
 
 # The generic problems (plain OMPL + numpy set-ups), each in its own campaign with short settings:
 # all 10 queries, 500 samples, anytime 0.1/0.5/1 s (tpee-ompl bench --list-problems lists them).
-# panda-shelf (7 joints, hard: shelf compartments) runs last, on 6 queries at 1 and 5 s.
+# panda-shelf (7 joints, hard: shelf compartments) runs next, on 6 queries at 1 and 5 s, then kinova-posts
+# (6 joints, 3 continuous) on 10 queries at 0.5 and 1 s.
 GENERIC_PROBLEMS := arm4 arm6 arm7 arm8 arm5-so2 point4-hole narrow3
 bench-generic: $(STAMP)
 	for p in $(GENERIC_PROBLEMS); do \
@@ -50,6 +51,8 @@ bench-generic: $(STAMP)
 	done
 	MPLBACKEND=Agg $(PY) experiments/run_benchmark.py --problem panda-shelf --name panda-shelf --max-queries 6 \
 		--samples 500 --anytime 1 5 --workers 2 --no-progress
+	MPLBACKEND=Agg $(PY) experiments/run_benchmark.py --problem kinova-posts --name kinova-posts --max-queries 10 \
+		--samples 500 --anytime 0.5 1 --workers 2 --no-progress
 
 # Default cross-sector DMP path library (12 pairs x <= 20 dimension-RRT demos, ~3.5 min on 2 cores).
 # --force: this target rebuilds the packaged library on purpose (library build never replaces a file without it).

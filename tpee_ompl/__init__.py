@@ -23,7 +23,7 @@ from .model.joint_queries import JointQuery, load_joint_query_set
 from .model.obstacles import Obstacle
 from .model.queries import Query, QuerySetError, load_queries
 from .model.robot_checker import RobotChecker
-from .model.robots import panda_shelf
+from .model.robots import kinova_posts, panda_shelf
 from .model.sectors import (
     CROSS_SECTOR_TRAJECTORIES,
     POSTURE_PRESETS,
@@ -62,6 +62,7 @@ __all__ = [
     # any URDF robot among obstacles
     "RobotChecker",
     "Obstacle",
+    "kinova_posts",
     "panda_shelf",
     "JointQuery",
     "load_joint_query_set",

@@ -19,13 +19,14 @@ from tpee_ompl.bench.problems import DEFAULT_PROBLEM, PROBLEM_NAMES, get_problem
 from tpee_ompl.planning.grouped_space import RealVectorLayout
 from tests.helpers.panda import needs_panda
 
-BUILDABLE = [pytest.param(n, marks=needs_panda) if n == "panda-shelf" else n for n in PROBLEM_NAMES]
+ROBOT_PROBLEMS = ("panda-shelf", "kinova-posts")  # their robots come from the optional 'robots' extra
+BUILDABLE = [pytest.param(n, marks=needs_panda) if n in ROBOT_PROBLEMS else n for n in PROBLEM_NAMES]
 STRAIGHT_MAY_BE_FREE = {"wearer-random"}  # the paper's random queries: most straight motions are free
 
 
 def test_registry_lists_the_wearer_first_then_generic_and_robot_problems():
     assert PROBLEM_NAMES[0] == DEFAULT_PROBLEM == CampaignConfig().problem == "wearer"
-    assert {"wearer-random", "panda-shelf", *GENERIC_PROBLEMS} <= set(PROBLEM_NAMES)
+    assert {"wearer-random", *ROBOT_PROBLEMS, *GENERIC_PROBLEMS} <= set(PROBLEM_NAMES)
     assert len(set(PROBLEM_NAMES)) == len(PROBLEM_NAMES)
     for name in GENERIC_PROBLEMS:
         p = get_problem(name)
@@ -138,10 +139,18 @@ def test_robot_problem_without_the_robots_extra_fails_with_one_line_naming_it():
 
 
 @needs_panda
-def test_the_panda_problem_groups_are_the_robot_modules_groups():
-    from tpee_ompl.model.robots import PANDA_GROUPS
+def test_the_robot_problems_groups_are_the_robot_modules_groups():
+    from tpee_ompl.model.robots import KINOVA_GROUPS, PANDA_GROUPS
 
     assert get_problem("panda-shelf").groups == PANDA_GROUPS
+    assert get_problem("kinova-posts").groups == KINOVA_GROUPS
+
+
+def test_the_continuous_joint_arm_leaves_out_what_an_so2_compound_cannot_take():
+    p = get_problem("kinova-posts")
+    assert "certified" not in p.checkers and p.checkers[0] == "batched"
+    assert {"AORRTC", "BITstar", "InformedRRTstar"} <= set(p.unsupported)
+    assert not {"AORRTC", "BITstar"} & set(p.planners) and "DimensionRRT" in p.planners
 
 
 def test_group_lengths_of_an_so2_path_go_the_short_way_round():

@@ -1,4 +1,4 @@
-"""The Panda shelf problem: it loads, its scene matters, and a missing extra is named."""
+"""The Panda shelf and Kinova posts problems: they load, their scenes matter, and a missing extra is named."""
 
 from __future__ import annotations
 
@@ -34,6 +34,21 @@ def test_a_missing_robots_extra_is_named_in_one_line(monkeypatch):
     monkeypatch.setattr(builtins, "__import__", no_erd)
     with pytest.raises(ImportError, match=r"^the Panda needs the optional 'robots' extra: pip install 'tpee-ompl\[robots\]'$"):
         robots.panda_shelf()
+    with pytest.raises(ImportError, match=r"^the Kinova arm needs the optional 'robots' extra"):
+        robots.kinova_posts()
+
+
+@needs_panda
+def test_the_kinova_posts_arm_plans_its_continuous_joints_as_angles_and_its_queries_are_its_own():
+    from tpee_ompl.model.joint_queries import load_joint_query_set
+
+    c = robots.kinova_posts(n_threads=1)
+    assert c.nq == 6 and c.circular.tolist() == [True, False, False, True, False, True]
+    assert {"post_front", "post_back"} <= set(c.geometry_names(0))
+    queries, header = load_joint_query_set("kinova_posts", c)  # the packaged set was made for this model
+    assert len(queries) == 30 and header["labels"] == {"across-pi": 17, "within": 13}
+    assert all(c.is_valid(q.start) and c.is_valid(q.goal) for q in queries)
+    assert sum(bool((np.abs(q.goal - q.start)[c.circular] > np.pi).any()) for q in queries) == 17
 
 
 @needs_panda

@@ -174,10 +174,11 @@ def _generic_queries(name: str) -> list[dict]:
 
 # ----------------------------------------------------------------- robot-checker problems (hook)
 def _robot_problem(name: str, dimension: int, description: str, robot: str, query_set: str, groups_name: str,
-                   ) -> Problem:
+                   groups: tuple[tuple[int, ...], ...], continuous: bool = False) -> Problem:
     """A problem on a :class:`~tpee_ompl.model.robot_checker.RobotChecker` made by a function of
     :mod:`tpee_ompl.model.robots`, its joint query set and ``make_simple_setup``: one entry per robot in
-    :data:`PROBLEMS`."""
+    :data:`PROBLEMS`.  ``groups``: the value of ``robots.<groups_name>`` (the module needs the optional extra);
+    ``continuous``: the robot has continuous joints (an SO2 compound: no certified validator, no informed sampler)."""
 
     def modules():
         from ..model import joint_queries, robots  # lazy: the robots need the optional 'robots' extra
@@ -209,9 +210,15 @@ def _robot_problem(name: str, dimension: int, description: str, robot: str, quer
         return DimensionRRT(si, groups=getattr(robots, groups_name), max_samples=ctx.max_samples, seed=ctx.seed,
                             stall_samples=ctx.stall_samples, **dict(ctx.dimension_rrt_overrides))
 
+    extra: dict[str, Any] = {}
+    if continuous:
+        extra = {"unsupported": _NEEDS_INFORMED_SAMPLER, "unsupported_reason": "OMPL's informed sampler does not "
+                 "support compound SO2 spaces", "planners": tuple(n for n in _GENERIC_PLANNERS
+                                                                  if n not in _NEEDS_INFORMED_SAMPLER)}
+    checkers = ("batched", "discrete", "dense") if continuous else ("batched", "discrete", "certified", "dense")
     return Problem(name=name, description=description, dimension=dimension, load_queries=load, build=build,
-                   build_dimension_rrt=dimension_rrt, groups=((0, 1, 2), (3, 4, 5, 6)),
-                   checkers=("batched", "discrete", "certified", "dense"), query_sets=True, default_queries=query_set)
+                   build_dimension_rrt=dimension_rrt, groups=groups, checkers=checkers, query_sets=True,
+                   default_queries=query_set, **extra)
 
 
 PROBLEMS: dict[str, Problem] = {p.name: p for p in (
@@ -219,7 +226,11 @@ PROBLEMS: dict[str, Problem] = {p.name: p for p in (
     _wearer("wearer-random", "paper_random", "the paper's random queries"),
     *(_generic(spec) for spec in GENERIC_PROBLEMS.values()),
     _robot_problem("panda-shelf", 7, "Franka Panda reaching into a shelf (Pinocchio + Coal checker)",
-                   robot="panda_shelf", query_set="panda_shelf", groups_name="PANDA_GROUPS"),
+                   robot="panda_shelf", query_set="panda_shelf", groups_name="PANDA_GROUPS",
+                   groups=((0, 1, 2), (3, 4, 5, 6))),
+    _robot_problem("kinova-posts", 6, "Kinova Jaco2 arm, 3 continuous joints (SO2), between two posts (convex hulls)",
+                   robot="kinova_posts", query_set="kinova_posts", groups_name="KINOVA_GROUPS",
+                   groups=((0, 1, 2), (3, 4, 5)), continuous=True),
 )}
 """Every problem by name; the wearer first (the default)."""
 PROBLEM_NAMES: tuple[str, ...] = tuple(PROBLEMS)

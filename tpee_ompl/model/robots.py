@@ -1,4 +1,5 @@
-"""Robots beyond the wearer: the Franka Panda among a table and a shelf.
+"""Robots beyond the wearer: the Franka Panda among a table and a shelf, and a Kinova arm with continuous joints
+between two posts.
 
 The Panda's files come from the optional ``robots`` extra (``example-robot-data``):
 ``panda_collision.urdf`` (spheres and cylinders, loaded as capsules; fast) with ``panda.srdf``,
@@ -6,6 +7,12 @@ both fingers locked.  Its base (z = 0, the world frame) stands on a 12 cm pedest
 (top at z = -0.12: link 1's collision spheres reach 9 cm below the base); a shelf stands on the
 table in front of it (+x), two compartments high with a divider, so that going from one compartment to another, or from the table beside the
 shelf into it, needs planning.
+
+The Kinova Jaco2 6-DOF arm (``kinova.urdf`` of ``example-robot-data``: joints 1, 4 and 6 continuous, planned as
+SO2 angles; meshes checked as their convex hulls, as MoveIt users' convex collision meshes) stands between two
+posts; its SRDF (packaged: ``kinova_posts.srdf``, from ``experiments/make_kinova_queries.py``) disables the link
+pairs touching in at least 95 % of random configurations, as the MoveIt setup assistant's "always" pairs (the
+shipped SRDF disables none, so every configuration collided).
 """
 
 from __future__ import annotations
@@ -14,10 +21,11 @@ from pathlib import Path
 
 import numpy as np
 
+from ..resources import model_file
 from .obstacles import Obstacle, box
 from .robot_checker import RobotChecker
 
-__all__ = ["PANDA_GROUPS", "PANDA_LOCKED", "PANDA_SHELF_OBSTACLES", "PANDA_SHELF_REGIONS", "PANDA_TOOL_FRAME",
+__all__ = ["KINOVA_GROUPS", "KINOVA_POSTS", "kinova_files", "kinova_posts", "PANDA_GROUPS", "PANDA_LOCKED", "PANDA_SHELF_OBSTACLES", "PANDA_SHELF_REGIONS", "PANDA_TOOL_FRAME",
            "panda_files", "panda_region", "panda_shelf"]
 
 PANDA_GROUPS = ((0, 1, 2), (3, 4, 5, 6))
@@ -94,3 +102,37 @@ def panda_region(checker: RobotChecker, q: np.ndarray) -> str | None:
         if np.all(p >= lo) and np.all(p <= hi):
             return label
     return None
+
+
+KINOVA_GROUPS = ((0, 1, 2), (3, 4, 5))
+"""Joint groups for dimension-RRT: shoulder and elbow (reach), then the wrist (orientation)."""
+KINOVA_POSTS: tuple[Obstacle, ...] = (
+    box("post_front", (0.06, 0.06, 1.2), (0.3, 0.0, 0.4)),
+    box("post_back", (0.06, 0.06, 1.2), (-0.3, 0.0, 0.4)),
+)
+"""Two posts 0.3 m either side of the base (63 % of random configurations free; the straight motion between two
+free configurations collides about two times in three)."""
+KINOVA_SRDF = "kinova_posts.srdf"
+"""The packaged SRDF of :func:`kinova_posts` (``experiments/make_kinova_queries.py`` writes it)."""
+_KINOVA_EXTRA_MESSAGE = "the Kinova arm needs the optional 'robots' extra: pip install 'tpee-ompl[robots]'"
+
+
+def kinova_files() -> tuple[Path, list[str]]:
+    """The Kinova Jaco2 6-DOF arm's URDF from ``example-robot-data`` and the package folder its meshes are in.
+
+    Raises ImportError naming the ``robots`` extra when it is not installed."""
+    try:
+        import example_robot_data
+    except ImportError as exc:
+        raise ImportError(_KINOVA_EXTRA_MESSAGE) from exc
+    sub = "kinova_description/robots/kinova.urdf"
+    robots = Path(example_robot_data.getModelPath(sub))
+    return robots / sub, [str((robots / "../..").resolve())]
+
+
+def kinova_posts(n_threads: int | None = None, srdf: str | Path | None = None) -> RobotChecker:
+    """The Kinova arm (3 continuous joints, convex hulls) between :data:`KINOVA_POSTS`, with the packaged SRDF
+    (or ``srdf``)."""
+    urdf, dirs = kinova_files()
+    return RobotChecker(urdf, model_file(KINOVA_SRDF) if srdf is None else srdf, n_threads=n_threads,
+                        obstacles=KINOVA_POSTS, package_dirs=dirs, convex_meshes=True)
