@@ -87,6 +87,7 @@ def test_installed_wheel_lists_the_problems_and_benchmarks_a_generic_one(install
     listing = _run([cli, "bench", "--list-problems"], cwd=work).stdout
     rows = {line.split()[0]: line.split()[2] for line in listing.splitlines()[1:] if line.strip()}
     assert rows["wearer"] == "120" and rows["arm6"] == "10" and rows["panda-shelf"] == "30"  # packaged sets
+    assert rows["kinova-posts"] == "30"  # its packaged SRDF and query set
     out = _run([cli, "bench", "--problem", "arm4", "--max-queries", "1", "--samples", "200", "--anytime", "0.1",
                 "--workers", "1", "--no-progress", "--out", str(work / "results")], cwd=work, timeout=600).stdout
     assert "benchmark.db" in out
