@@ -400,9 +400,7 @@ def test_trees_over_continuous_joints_with_a_prescribed_group_find_a_valid_path(
     si.setup()
     grouped = GroupedSpace(si, groups, 7, {3: np.zeros((7, 1))})  # the last DOF prescribed: the trees hold 3 of 4
     search = Search(grouped, Checker(si, grouped.layout, True), np.random.default_rng(0), np.array([-1.0, 3.0, -0.8, 0.0]),
-                    np.array([1.0, -3.0, 0.8, 0.0]),
-
-                    settings=SearchSettings(narrow_after=200, narrowing=0.5),
+                    np.array([1.0, -3.0, 0.8, 0.0]), settings=SearchSettings(narrow_after=200, narrowing=0.5),
                     range_={gi: np.full(1, 0.02) for gi in grouped.planned})
     assert not search.valid
     while not search.valid and search.samples < 3000:

@@ -156,3 +156,16 @@ def test_plain_layout_writes_and_reads_a_state_exactly() -> None:
     assert lay.write(x, q) is x
     np.testing.assert_array_equal(lay.read(x), q)
     assert [x[i] for i in range(5)] == q.tolist()
+
+
+def test_a_zero_dimensional_real_vector_subspace_holds_no_value_and_adds_nothing_to_the_metric():
+    space = ob.CompoundStateSpace()
+    rv = ob.RealVectorStateSpace(2)
+    rv.setBounds(-1.0, 1.0)
+    for sub in (rv, ob.RealVectorStateSpace(0), ob.SO2StateSpace(), ob.RealVectorStateSpace(0)):
+        space.addSubspace(sub, 1.0)
+    layout = RealVectorLayout(space)
+    assert layout.n == 3 and layout.circular.tolist() == [False, False, True]
+    A, B = np.zeros((2, 3)), np.array([[0.3, 0.4, 1.0], [0.0, 0.0, -3.0]])
+    np.testing.assert_allclose(layout.distance(A, B), [0.5 + 1.0, 3.0])
+    np.testing.assert_allclose(layout.leaf_distances(A, B), [[0.5, 1.0], [0.0, 3.0]])

@@ -222,6 +222,8 @@ class RealVectorLayout:
 
     def _collect(self, space: ob.StateSpace, path: tuple[int, ...], weight: float, lows: list, highs: list) -> None:
         if isinstance(space, ob.RealVectorStateSpace):
+            if space.getDimension() == 0:
+                return  # holds no value (and would give an empty leaf to the metric's reduceat)
             b = space.getBounds()
             lo, hi = [float(v) for v in b.low], [float(v) for v in b.high]
             bad = [i for i in range(len(lo)) if not (math.isfinite(lo[i]) and math.isfinite(hi[i]) and lo[i] < hi[i])]
