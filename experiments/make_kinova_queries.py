@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+from make_panda_queries import rrtconnect_solved  # noqa: E402
 from mesh_robots import user_srdf  # noqa: E402
 
 from tpee_ompl.model.joint_queries import JointQuery, save_joint_queries  # noqa: E402
@@ -46,20 +47,6 @@ def make_queries(checker, rng: np.random.Generator, n: int) -> list[JointQuery]:
             across = bool((np.abs(b - a)[checker.circular] > np.pi).any())
             queries.append(JointQuery(len(queries), a, b, "across-pi" if across else "within"))
     return queries
-
-
-def rrtconnect_solved(checker, queries: list[JointQuery], seconds: float) -> list[bool]:
-    """Whether OMPL's RRTConnect solves each query within ``seconds`` with make_simple_setup."""
-    from ompl import geometric as og
-    from ompl import util as ou
-
-    ou.setLogLevel(ou.LOG_WARN)
-    solved = []
-    for q in queries:
-        ss = make_simple_setup(checker, q.start, q.goal)
-        ss.setPlanner(og.RRTConnect(ss.getSpaceInformation()))
-        solved.append(bool(ss.solve(seconds)) and ss.haveExactSolutionPath())
-    return solved
 
 
 def main() -> None:

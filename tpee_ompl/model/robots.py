@@ -79,13 +79,18 @@ def panda_files() -> tuple[Path, Path]:
     """The Panda's collision URDF and SRDF from ``example-robot-data``.
 
     Raises ImportError naming the ``robots`` extra when it is not installed."""
+    sub = "panda_description/urdf/panda_collision.urdf"
+    robots = _robots_folder(sub, _EXTRA_MESSAGE)
+    return robots / sub, robots / "panda_description/srdf/panda.srdf"
+
+
+def _robots_folder(sub: str, missing: str) -> Path:
+    """``example-robot-data``'s folder holding ``sub``; ImportError with the message ``missing`` without it."""
     try:
         import example_robot_data
     except ImportError as exc:
-        raise ImportError(_EXTRA_MESSAGE) from exc
-    sub = "panda_description/urdf/panda_collision.urdf"
-    robots = Path(example_robot_data.getModelPath(sub))
-    return robots / sub, robots / "panda_description/srdf/panda.srdf"
+        raise ImportError(missing) from exc
+    return Path(example_robot_data.getModelPath(sub))
 
 
 def panda_shelf(n_threads: int | None = None, security_margin: float = PANDA_SECURITY_MARGIN) -> RobotChecker:
@@ -121,12 +126,8 @@ def kinova_files() -> tuple[Path, list[str]]:
     """The Kinova Jaco2 6-DOF arm's URDF from ``example-robot-data`` and the package folder its meshes are in.
 
     Raises ImportError naming the ``robots`` extra when it is not installed."""
-    try:
-        import example_robot_data
-    except ImportError as exc:
-        raise ImportError(_KINOVA_EXTRA_MESSAGE) from exc
     sub = "kinova_description/robots/kinova.urdf"
-    robots = Path(example_robot_data.getModelPath(sub))
+    robots = _robots_folder(sub, _KINOVA_EXTRA_MESSAGE)
     return robots / sub, [str((robots / "../..").resolve())]
 
 
