@@ -320,6 +320,11 @@ class RealVectorLayout:
         """Per leaf, the Euclidean norm of its entries of D (..., n): shape (..., leaves)."""
         return np.sqrt(np.add.reduceat(D * D, self._leaf_starts, axis=-1))
 
+    def leaf_extents(self) -> np.ndarray:
+        """Per subspace (leaf), its ``getMaximumExtent()``: the diagonal of a RealVector leaf's bounds, pi for SO2."""
+        return np.array([math.pi if so2 else float(np.linalg.norm(self.upper[sl] - self.lower[sl]))
+                         for (_, _, _, so2), sl in zip(self._leaves, self._slices)])
+
     def leaf_distances(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
         """Per subspace (leaf), its own distance between rows of A and B: shape (..., leaves), unweighted."""
         return self._leaf_norms(self.delta(A, B))

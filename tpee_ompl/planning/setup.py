@@ -115,9 +115,7 @@ class BatchedMotionValidator(ob.MotionValidator):
         self._layout = None if isinstance(self._space, ob.RealVectorStateSpace) else RealVectorLayout(self._space)
         """The compound space's reader and geodesics (continuous joints as SO2); None for a RealVector space."""
         if self._layout is not None:  # OMPL's rule: each subspace's own segment length, a share of its extent
-            total = float(self._space.getMaximumExtent())
-            self._leaf_steps = np.array([self.step * float(self._space.getSubspace(k).getMaximumExtent()) / total
-                                         for k in range(self._space.getSubspaceCount())])
+            self._leaf_steps = self.step * self._layout.leaf_extents() / float(self._space.getMaximumExtent())
         self.motions_checked = 0
         self.motions_valid = 0
         """Motions checked / found valid (OMPL's own counters stay at 0 under a Python ``checkMotion``:
