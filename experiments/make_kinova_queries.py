@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from make_panda_queries import rrtconnect_solved  # noqa: E402
+from make_panda_queries import report_rrtconnect  # noqa: E402
 from mesh_robots import user_srdf  # noqa: E402
 
 from tpee_ompl.model.joint_queries import JointQuery, save_joint_queries  # noqa: E402
@@ -65,10 +65,7 @@ def main() -> None:
     extra = {"robot": "kinova_posts", "security_margin": checker.security_margin,
              "labels": {label: sum(q.label == label for q in queries) for label in ("across-pi", "within")}}
     if args.check_time > 0:
-        solved = rrtconnect_solved(checker, queries, args.check_time)
-        extra["rrtconnect_solved"] = {"seconds": args.check_time, "solved": sum(solved), "of": len(solved)}
-        print(f"RRTConnect solved {sum(solved)} of {len(solved)} within {args.check_time} s; unsolved ids "
-              f"{[q.id for q, s in zip(queries, solved) if not s]}")
+        extra["rrtconnect_solved"] = report_rrtconnect(checker, queries, args.check_time)
     save_joint_queries(args.out, queries, name="kinova_posts", seed=args.seed, checker=checker, extra=extra)
     print(f"wrote {len(queries)} queries to {args.out} ({extra['labels']})")
 

@@ -95,6 +95,14 @@ def rrtconnect_solved(checker, queries: list[JointQuery], seconds: float) -> lis
     return solved
 
 
+def report_rrtconnect(checker, queries: list[JointQuery], seconds: float) -> dict:
+    """:func:`rrtconnect_solved`, printed, and as the query set's ``rrtconnect_solved`` entry."""
+    solved = rrtconnect_solved(checker, queries, seconds)
+    print(f"RRTConnect solved {sum(solved)} of {len(solved)} within {seconds} s; unsolved ids "
+          f"{[q.id for q, s in zip(queries, solved) if not s]}")
+    return {"seconds": seconds, "solved": sum(solved), "of": len(solved)}
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", type=Path, default=query_set_path("panda_shelf"))
@@ -112,10 +120,7 @@ def main() -> None:
     extra = {"robot": "panda_shelf", "security_margin": checker.security_margin,
              "regions": {k: [list(lo), list(hi)] for k, (lo, hi) in PANDA_SHELF_REGIONS.items()}}
     if args.check_time > 0:
-        solved = rrtconnect_solved(checker, queries, args.check_time)
-        extra["rrtconnect_solved"] = {"seconds": args.check_time, "solved": sum(solved), "of": len(solved)}
-        print(f"RRTConnect solved {sum(solved)} of {len(solved)} within {args.check_time} s; unsolved ids "
-              f"{[q.id for q, s in zip(queries, solved) if not s]}")
+        extra["rrtconnect_solved"] = report_rrtconnect(checker, queries, args.check_time)
     save_joint_queries(args.out, queries, name="panda_shelf", seed=args.seed, checker=checker, extra=extra)
     print(f"wrote {len(queries)} queries to {args.out}")
 
