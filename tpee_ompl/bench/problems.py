@@ -149,17 +149,19 @@ def _generic(spec: GenericProblem) -> Problem:
         return DimensionRRT(si, groups=spec.groups, max_samples=ctx.max_samples, seed=ctx.seed,
                             stall_samples=ctx.stall_samples, **dict(ctx.dimension_rrt_overrides))
 
-    extra: dict[str, Any] = {}
-    if spec.kind == "arm-so2":
-        extra = {"unsupported": _NEEDS_INFORMED_SAMPLER, "unsupported_reason": "OMPL's informed sampler does not "
-                 "support compound SO2 spaces", "planners": tuple(n for n in _GENERIC_PLANNERS
-                                                                  if n not in _NEEDS_INFORMED_SAMPLER)}
+    extra = _SO2_COMPOUND if spec.kind == "arm-so2" else {}
     return Problem(name=name, description=spec.description, dimension=spec.n, load_queries=load, build=build,
                    build_dimension_rrt=dimension_rrt, groups=spec.groups, **extra)
 
 
 _NEEDS_INFORMED_SAMPLER = ("InformedRRTstar", "AORRTC", "BITstar")
 """OMPL planners whose set-up needs ``PathLengthDirectInfSampler`` (RealVector, SE2, SE3, Dubins, Reeds-Shepp only)."""
+_SO2_COMPOUND: dict[str, Any] = {
+    "unsupported": _NEEDS_INFORMED_SAMPLER,
+    "unsupported_reason": "OMPL's informed sampler does not support compound SO2 spaces",
+    "planners": tuple(n for n in _GENERIC_PLANNERS if n not in _NEEDS_INFORMED_SAMPLER),
+}
+"""The :class:`Problem` fields of a problem on a compound space with SO2 joints: the planners it leaves out."""
 
 
 @functools.lru_cache(maxsize=None)
@@ -210,11 +212,7 @@ def _robot_problem(name: str, dimension: int, description: str, robot: str, quer
         return DimensionRRT(si, groups=getattr(robots, groups_name), max_samples=ctx.max_samples, seed=ctx.seed,
                             stall_samples=ctx.stall_samples, **dict(ctx.dimension_rrt_overrides))
 
-    extra: dict[str, Any] = {}
-    if continuous:
-        extra = {"unsupported": _NEEDS_INFORMED_SAMPLER, "unsupported_reason": "OMPL's informed sampler does not "
-                 "support compound SO2 spaces", "planners": tuple(n for n in _GENERIC_PLANNERS
-                                                                  if n not in _NEEDS_INFORMED_SAMPLER)}
+    extra = _SO2_COMPOUND if continuous else {}
     checkers = ("batched", "discrete", "dense") if continuous else ("batched", "discrete", "certified", "dense")
     return Problem(name=name, description=description, dimension=dimension, load_queries=load, build=build,
                    build_dimension_rrt=dimension_rrt, groups=groups, checkers=checkers, query_sets=True,

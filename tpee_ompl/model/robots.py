@@ -25,8 +25,20 @@ from ..resources import model_file
 from .obstacles import Obstacle, box
 from .robot_checker import RobotChecker
 
-__all__ = ["KINOVA_GROUPS", "KINOVA_POSTS", "kinova_files", "kinova_posts", "PANDA_GROUPS", "PANDA_LOCKED", "PANDA_SHELF_OBSTACLES", "PANDA_SHELF_REGIONS", "PANDA_TOOL_FRAME",
-           "panda_files", "panda_region", "panda_shelf"]
+__all__ = [
+    "kinova_files",
+    "KINOVA_GROUPS",
+    "KINOVA_POSTS",
+    "kinova_posts",
+    "panda_files",
+    "PANDA_GROUPS",
+    "PANDA_LOCKED",
+    "panda_region",
+    "panda_shelf",
+    "PANDA_SHELF_OBSTACLES",
+    "PANDA_SHELF_REGIONS",
+    "PANDA_TOOL_FRAME",
+]
 
 PANDA_GROUPS = ((0, 1, 2), (3, 4, 5, 6))
 """Joint groups for dimension-RRT: shoulder and upper arm (reach), then elbow and wrist (orientation)."""
