@@ -5,6 +5,8 @@
     PYTHONPATH=. .venv/bin/python experiments/first_path.py --skip-overhead --reps 5   # medians over 5 runs per query
     PYTHONPATH=. .venv/bin/python experiments/first_path.py --skip-home           # overhead only
     PYTHONPATH=. .venv/bin/python experiments/first_path.py --skip-overhead --split   # + time in Pinocchio vs the rest
+    PYTHONPATH=. .venv/bin/python experiments/first_path.py --skip-overhead --reps 3 --ompl-seed 1 --save /tmp/fp/1.json
+        # every run's time, for experiments/first_path_pooled.py (many of RRTConnect's seeds pooled)
 
 Home: for every query of each named set (the wearer, ``make_simple_setup`` with its batched motion
 validator), RRTConnect and dimension-RRT (``tpee_dimension_rrt``, seed = query index) run one after the
@@ -21,6 +23,7 @@ from __future__ import annotations
 
 import argparse
 import gc
+import json
 import math
 import statistics
 import time
@@ -31,6 +34,7 @@ from ompl import base as ob
 from ompl import geometric as og
 from ompl import util as ou
 
+from tpee_ompl.files import atomic_write_text, check_output_path
 from tpee_ompl.model.queries import load_queries
 from tpee_ompl.model.wearer_arm import WearerArm
 from tpee_ompl.planning.dimension_rrt import DimensionRRT
@@ -52,6 +56,9 @@ def get_argument_parser() -> argparse.ArgumentParser:
                    help="OMPL's global seed, so RRTConnect's runs repeat (0: unseeded, as by default)")
     p.add_argument("--split", action="store_true",
                    help="time the collision calls (pinocchio.computeCollisions*) apart from the rest of each run")
+    p.add_argument("--save", default=None, metavar="FILE",
+                   help="write every home run (set, query, repetition, planner, seconds or null, checks) to this JSON file")
+    p.add_argument("--force", action="store_true", help="replace the --save file if it exists")
     return p
 
 
@@ -81,9 +88,11 @@ class _CollisionTimer:
         return timed
 
 
-def home(args: argparse.Namespace) -> None:
+def home(args: argparse.Namespace) -> list[dict]:
+    """Both planners on every query of each set; prints the summary per set and returns every run."""
     timer = _CollisionTimer() if args.split else None
     robot = WearerArm()
+    runs: list[dict] = []
     for name in args.queries:
         qs = load_queries(name, robot)[: args.max_queries]
         rc, dr, rc_checks, dr_checks = [], [], [], []
@@ -92,13 +101,15 @@ def home(args: argparse.Namespace) -> None:
         for k, q in enumerate(qs):
             ss = make_simple_setup(robot, q.start, q.goal)
             si = ss.getSpaceInformation()
-            for _ in range(args.reps):  # alternating, so both planners see the same machine state
+            for rep in range(args.reps):  # alternating, so both planners see the same machine state
                 for who, times, checks in (("R", rc, rc_checks), ("D", dr, dr_checks)):
                     planner = (og.RRTConnect(si) if who == "R"
                                else tpee_dimension_rrt(si, q.from_sector, q.to_sector, seed=k))
                     c0, n0 = robot.collision_checks, timer.spent if timer else 0.0
                     times.append(first_path_time(ss, planner, args.limit))
                     checks.append(robot.collision_checks - c0)
+                    runs.append({"set": name, "query": k, "rep": rep, "planner": who, "seconds": times[-1],
+                                 "checks": checks[-1]})
                     if timer and times[-1] is not None:
                         native[who].append(timer.spent - n0)
                         outside[who].append(times[-1] - native[who][-1])
@@ -115,6 +126,7 @@ def home(args: argparse.Namespace) -> None:
                   f"R {1e3 * statistics.median(native['R']):5.2f} ms;  outside them D "
                   f"{1e3 * statistics.median(outside['D']):5.2f} ms  R {1e3 * statistics.median(outside['R']):5.2f} ms",
                   flush=True)
+    return runs
 
 
 def overhead(args: argparse.Namespace) -> None:
@@ -167,12 +179,24 @@ def overhead(args: argparse.Namespace) -> None:
 
 
 def main(argv: list[str] | None = None) -> None:
-    args = get_argument_parser().parse_args(argv)
+    ap = get_argument_parser()
+    args = ap.parse_args(argv)
+    if args.save and args.skip_home:
+        ap.error("--save records the home runs; it cannot go with --skip-home")
+    if args.save:
+        try:
+            check_output_path(args.save, force=args.force, what="--save file")
+        except (FileExistsError, OSError, ValueError) as e:
+            ap.error(str(e))
     ou.setLogLevel(ou.LOG_NONE)
     if args.ompl_seed:
         ou.RNG.setSeed(args.ompl_seed)
     if not args.skip_home:
-        home(args)
+        runs = home(args)
+        if args.save:
+            meta = {"ompl_seed": args.ompl_seed, "reps": args.reps, "limit": args.limit}
+            atomic_write_text(args.save, json.dumps({"meta": meta, "runs": runs}), force=args.force)
+            print(f"runs written to {args.save}", flush=True)
     if not args.skip_overhead:
         overhead(args)
 

@@ -98,6 +98,31 @@ def test_other_space_types_are_refused_by_name(make) -> None:
         RealVectorLayout(cs)
 
 
+def test_layout_tells_when_the_space_bounds_changed() -> None:
+    space = _space(3, bound=1.0)
+    lay = RealVectorLayout(space)
+    assert not lay.bounds_changed(space)
+    space.setBounds(-1.0, 1.5)
+    assert lay.bounds_changed(space)
+    space.setBounds(-1.0, 1.0)
+    assert not lay.bounds_changed(space)
+    cs = ob.CompoundStateSpace()
+    cs.addSubspace(ob.SO2StateSpace(), 1.0)
+    r = _space(2, bound=1.0)
+    cs.addSubspace(r, 1.0)
+    lay = RealVectorLayout(cs)
+    assert not lay.bounds_changed(cs)
+    r.setBounds(-0.5, 1.0)
+    assert lay.bounds_changed(cs)
+
+
+def test_group_dims_are_read_only() -> None:
+    gs = GroupedSpace(_space(), [[0, 1], [2, 3]], 7)
+    np.testing.assert_array_equal(gs.group_dims(1), [2, 3])
+    with pytest.raises(ValueError, match="read-only"):
+        gs.group_dims(1)[0] = 0
+
+
 def test_real_vector_space_without_bounds_is_refused() -> None:
     with pytest.raises(ValueError, match="bounds"):
         RealVectorLayout(ob.RealVectorStateSpace(3))

@@ -119,7 +119,7 @@ from .dimension_rrt_options import RELEASE_AFTER, DimensionRRTOptions, resolve_o
 from .dimension_search import Search, SearchSettings
 from .goal_loop import GoalLoop, LoopLimits
 from .goal_runs import GoalRun, goal_states
-from .grouped_space import GroupedSpace, RealVectorLayout
+from .grouped_space import GroupedSpace
 from .planner_base import PythonPlanner, planner_status
 from .search_checker import Checker
 from .solution_posting import SolutionPoster
@@ -233,8 +233,7 @@ class DimensionRRT(PythonPlanner):
     def _regrouped(self) -> GroupedSpace | None:
         """The grouped space for the space's bounds as they are now, or None when they have not changed."""
         space, old = self.getSpaceInformation().getStateSpace(), self.grouped
-        layout = RealVectorLayout(space)
-        if np.array_equal(layout.lower, old.layout.lower) and np.array_equal(layout.upper, old.layout.upper):
+        if not old.layout.bounds_changed(space):
             return None
         return GroupedSpace(space, old.groups, old.h, old.prescribed)
 
@@ -368,7 +367,8 @@ class DimensionRRT(PythonPlanner):
             return planner_status(ob.PlannerStatus.INVALID_START if mismatch == "start" else ob.PlannerStatus.INVALID_GOAL)
         if len(fits) < len(Q1):
             log.info("DimensionRRT: %d of %d goal states are off the prescribed trajectory", len(Q1) - len(fits), len(Q1))
-        fits.sort(key=lambda q1: float(layout.distance(q0, q1)))  # nearest first (stable: one goal as given)
+        if len(fits) > 1:
+            fits.sort(key=lambda q1: float(layout.distance(q0, q1)))  # nearest first (stable)
         return q0, fits
 
     def _solve(self, ptc: ob.PlannerTerminationCondition) -> ob.PlannerStatus:

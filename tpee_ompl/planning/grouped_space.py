@@ -219,6 +219,16 @@ class RealVectorLayout:
         self.is_plain = (len(self._leaves) == 1 and self._leaves[0][0] == () and self._weights[0] == 1.0
                          and not self.has_circular)
         """A single RealVector space: the metric is the plain Euclidean norm."""
+        self._bound_lists = (lows, highs)
+
+    def bounds_changed(self, space: ob.StateSpace) -> bool:
+        """Whether ``space``'s bounds differ from those this layout was built with (OMPL's planners read them at
+        each solve).  For a single RealVector space a read of its bounds; otherwise a new layout compared."""
+        if self.is_plain and isinstance(space, ob.RealVectorStateSpace):
+            b = space.getBounds()
+            return list(b.low) != self._bound_lists[0] or list(b.high) != self._bound_lists[1]
+        layout = RealVectorLayout(space)
+        return not (np.array_equal(layout.lower, self.lower) and np.array_equal(layout.upper, self.upper))
 
     def _collect(self, space: ob.StateSpace, path: tuple[int, ...], weight: float, lows: list, highs: list) -> None:
         if isinstance(space, ob.RealVectorStateSpace):
@@ -378,6 +388,10 @@ class GroupedSpace:
         self.prescribed = validate_prescribed(prescribed, self.groups, self.h, self.layout)
         self.planned = [g for g in range(len(self.groups)) if g not in self.prescribed]
         """Indices of the groups to plan, in planning order."""
+        self._dims = [np.array(g, dtype=int) for g in self.groups]
+        for d in self._dims:
+            d.setflags(write=False)
+        self._steps = np.linspace(0.0, 1.0, self.h)  # the fake-time steps' fractions of the straight start -> goal
 
     @property
     def n(self) -> int:
@@ -385,8 +399,8 @@ class GroupedSpace:
         return self.layout.n
 
     def group_dims(self, g: int) -> np.ndarray:
-        """DOF indices of group g, int array (k_g,)."""
-        return np.array(self.groups[g], dtype=int)
+        """DOF indices of group g, int array (k_g,), read-only."""
+        return self._dims[g]
 
     def group_bounds(self, g: int) -> tuple[np.ndarray, np.ndarray]:
         """Lower and upper bounds (k_g,) of group g."""
@@ -412,17 +426,18 @@ class GroupedSpace:
 
     def endpoint_mismatch(self, start: np.ndarray, goal: np.ndarray, tol: float = 1e-6) -> str | None:
         """None if start/goal lie on every prescribed trajectory, else "start" or "goal"."""
+        start, goal = np.asarray(start), np.asarray(goal)
         for g, traj in self.prescribed.items():
-            d = self.group_dims(g)
-            if np.max(np.abs(traj[0] - np.asarray(start)[d])) > tol:
+            d = self._dims[g]
+            if abs(traj[0] - start[d]).max() > tol:
                 return "start"
-            if np.max(np.abs(traj[-1] - np.asarray(goal)[d])) > tol:
+            if abs(traj[-1] - goal[d]).max() > tol:
                 return "goal"
         return None
 
     def initial_waypoints(self, start: np.ndarray, goal: np.ndarray) -> np.ndarray:
         """Initial path (h, n): prescribed groups as given, the others linear from start to goal."""
-        W = self.layout.interpolate(start, goal, np.linspace(0.0, 1.0, self.h))
+        W = self.layout.interpolate(start, goal, self._steps)
         for g, traj in self.prescribed.items():
             W[:, self.group_dims(g)] = traj
         W[0], W[-1] = start, goal

@@ -76,8 +76,8 @@ def array_to_path(
     """
     write = set_state if write is None else write
     path = og.PathGeometric(si)
-    for w in np.asarray(waypoints, dtype=float):
-        s = si.allocState()
+    s = si.allocState()  # one state written for each waypoint: PathGeometric.append keeps a copy
+    for w in np.asarray(waypoints, dtype=float).tolist():
         write(s, w)
         path.append(s)
     return path
@@ -152,13 +152,18 @@ def path_passes_motion_checks(
     if check_first and not si.isValid(states[0]):
         return False
     ks = range(len(states) - 1) if segments is None else list(segments)
+    if not ks:
+        return True
     mv = si.getMotionValidator()
     batched, read = getattr(mv, "check_motions", None), getattr(mv, "read_state", None)
     if callable(batched) and callable(read):
-        # the project's BatchedMotionValidator: the same states checkMotion checks, in one batched call
-        W = np.array([read(s) for s in states], dtype=float)
-        idx = np.fromiter(ks, dtype=np.intp)
-        return bool(batched(W[idx], W[idx + 1]).all()) if len(idx) else True
+        # the project's BatchedMotionValidator: the same states checkMotion checks, in one batched call; only the
+        # waypoints of the segments asked for are read (k and k + 1 stay neighbours in ``need``, which is sorted)
+        need = sorted(set(ks).union(k + 1 for k in ks))
+        row = {k: i for i, k in enumerate(need)}
+        W = np.array([read(states[k]) for k in need], dtype=float)
+        idx = np.array([row[k] for k in ks], dtype=np.intp)
+        return bool(batched(W[idx], W[idx + 1]).all())
     return all(si.checkMotion(states[k], states[k + 1]) for k in ks)
 
 

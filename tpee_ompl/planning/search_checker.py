@@ -237,7 +237,8 @@ class Checker:
         ``check_motions`` (all motions batched together, each with ``checkMotion``'s verdict)."""
         if self._check_motions is None or len(A) < 2:
             return np.array([self.check_motion(a, b) for a, b in zip(A, B)], dtype=bool)
-        self.own_checks += int(np.maximum(1, np.ceil(self.layout.distance(A, B) / self.step)).sum())  # at most
+        if self._counter_owner is None:  # else counter() reads the robot's exact count
+            self.own_checks += int(np.maximum(1, np.ceil(self.layout.distance(A, B) / self.step)).sum())  # at most
         ok = np.asarray(self._check_motions(A, B), dtype=bool)
         self.passed.update(segment_key(A[k], B[k]) for k in np.flatnonzero(ok))
         return ok
