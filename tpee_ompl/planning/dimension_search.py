@@ -79,8 +79,7 @@ class Search(SampleDraws):
         """Segment (two waypoint rows as bytes) -> motion valid, for every motion checked so far."""
         # feasibility phase: all planned groups vary jointly (with one planned group: that group), their DOFs in
         # index order, so that its samples, and so the first path, do not depend on how the DOFs are grouped
-        self._fdims = np.sort(np.concatenate([self._dims[gi] for gi in grouped.planned])) if grouped.planned \
-            else np.zeros(0, int)
+        self._fdims = grouped.planned_dims
         self._fbounds = (grouped.layout.lower[self._fdims], grouped.layout.upper[self._fdims])
         self._hold = not grouped.prescribed
         self.delta = grouped.layout.delta

@@ -389,8 +389,16 @@ class GroupedSpace:
         self.planned = [g for g in range(len(self.groups)) if g not in self.prescribed]
         """Indices of the groups to plan, in planning order."""
         self._dims = [np.array(g, dtype=int) for g in self.groups]
+        self._bounds = [(self.layout.lower[d], self.layout.upper[d]) for d in self._dims]
         for d in self._dims:
             d.setflags(write=False)
+        for lo, hi in self._bounds:
+            lo.setflags(write=False)
+            hi.setflags(write=False)
+        planned = [self._dims[g] for g in self.planned]
+        self.planned_dims = np.sort(np.concatenate(planned)) if planned else np.zeros(0, int)
+        """The planned groups' DOF indices together, in index order (read-only)."""
+        self.planned_dims.setflags(write=False)
         self._steps = np.linspace(0.0, 1.0, self.h)  # the fake-time steps' fractions of the straight start -> goal
 
     @property
@@ -403,9 +411,8 @@ class GroupedSpace:
         return self._dims[g]
 
     def group_bounds(self, g: int) -> tuple[np.ndarray, np.ndarray]:
-        """Lower and upper bounds (k_g,) of group g."""
-        d = self.group_dims(g)
-        return self.layout.lower[d], self.layout.upper[d]
+        """Lower and upper bounds (k_g,) of group g, read-only."""
+        return self._bounds[g]
 
     def check_initial(self, W: np.ndarray | None) -> np.ndarray | None:
         """A first guess of the path, W (h, n), as a float array: finite and within the bounds (None passes)."""
