@@ -85,3 +85,18 @@ def test_killed_dask_worker_has_its_task_retried_and_nothing_is_lost_or_doubled(
                           "ON runs.experimentid = experiments.id GROUP BY experiments.id").fetchall()
     con.close()
     assert len(per_exp) == 3 and all(n == 2 for _, n in per_exp)
+
+
+@pytest.mark.slow
+def test_hung_dask_task_is_run_twice_then_reported_not_retried_by_dask(tmp_path, dask_executor):
+    import functools
+
+    from tpee_ompl.bench.executors import run_task_in_subprocess
+
+    starts = tmp_path / "starts.txt"
+    tests_dir = str(Path(__file__).resolve().parents[1])
+    task = {"qpos": 0, "seconds": 60, "time_limit_s": 5.0, "sys_path": [tests_dir], "starts": str(starts)}
+    ex = DaskExecutor(client=dask_executor.client, retries=2)
+    out = list(ex.run(functools.partial(run_task_in_subprocess, fn_path="helpers.bench_tasks:sleep"), [task]))
+    assert len(out) == 1 and out[0]["failed"].startswith("no result within its time limit") and out[0]["attempts"] == 2
+    assert starts.read_text().splitlines() == ["start", "start"]  # Dask's 2 retries did not run it 4 or 6 times

@@ -31,6 +31,9 @@ def boom(task: dict) -> dict:
 
 
 def sleep(task: dict) -> dict:
-    """Sleep ``task["seconds"]``, then echo."""
+    """Sleep ``task["seconds"]``, then echo; with ``task["starts"]`` (a file) first append a line to it."""
+    if task.get("starts"):
+        with open(task["starts"], "a", encoding="utf-8") as f:
+            f.write("start\n")
     time.sleep(float(task["seconds"]))
     return echo(task)

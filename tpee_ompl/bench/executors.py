@@ -12,7 +12,8 @@ task the same seed whichever machine runs it.  The executors differ only in who 
   scheduler ``tcp://host:port`` or a :class:`distributed.LocalCluster`); each Dask task runs the
   query in a fresh Python subprocess (:func:`run_task_in_subprocess`) and returns its OMPL logs as
   text plus per-run extras, so workers need no shared filesystem.  A worker that dies mid-task has
-  its task rescheduled by the scheduler; ``retries`` covers tasks that raise.
+  its task rescheduled by the scheduler; ``retries`` covers tasks that raise; a task that outlives its
+  time limit is run once more, then reported as failed (as in the local pool).
 
 Every executor yields each task's result (a plain dict) exactly once, in completion order; a task
 it could not finish is yielded as :func:`task_failure` (a dict with ``failed``, the reason).
@@ -252,9 +253,23 @@ def run_task_in_subprocess(task: dict, fn_path: str = "tpee_ompl.bench.experimen
 
     ``task["sys_path"]`` entries that exist here are put on the child's ``sys.path`` (so planner
     factories given as ``module:function`` resolve as on the client).  Raises ``RuntimeError`` with
-    the child's stderr tail when it fails, or when it gives no result within ``task["time_limit_s"]`` (then
-    it is killed, as a local pool's worker is).
+    the child's stderr tail when it fails (Dask's ``retries`` then run it again).  A child that gives no
+    result within ``task["time_limit_s"]`` is killed and run once more in a fresh process, then the task is
+    returned as a failure (:func:`task_failure`, 2 attempts) instead of raised: as a local pool treats a hung
+    task, where Dask's retries would hold the campaign for three time limits.
     """
+    limit = task.get("time_limit_s")
+    for attempt in (1, 2):
+        try:
+            return _run_child(task, fn_path)
+        except subprocess.TimeoutExpired:  # (subprocess.run kills the child) as the local pool does
+            log.warning("task %s gave no result within its time limit (%g s): killed%s", task.get("qpos"),
+                        float(limit), ", running it again in a fresh process" if attempt == 1 else "")
+    return task_failure(task, f"no result within its time limit ({float(limit):g} s): killed", 2)
+
+
+def _run_child(task: dict, fn_path: str) -> dict:
+    """One fresh Python process running ``fn(task)``; raises ``subprocess.TimeoutExpired`` at the time limit."""
     with tempfile.TemporaryDirectory(prefix="tpee_task_") as tmp:
         src, dst = Path(tmp) / "task.json", Path(tmp) / "result.json"
         src.write_text(json.dumps(task))
@@ -263,14 +278,11 @@ def run_task_in_subprocess(task: dict, fn_path: str = "tpee_ompl.bench.experimen
         if extra:
             env["PYTHONPATH"] = os.pathsep.join(extra + [env.get("PYTHONPATH", "")]).rstrip(os.pathsep)
         limit = task.get("time_limit_s")
-        try:
-            proc = subprocess.run(
-                [sys.executable, "-m", "tpee_ompl.bench.executors", fn_path, str(src), str(dst)],
-                env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, check=False,
-                timeout=None if limit is None else float(limit),
-            )
-        except subprocess.TimeoutExpired:  # (subprocess.run kills the child) as the local pool does
-            raise RuntimeError(f"no result within its time limit ({float(limit):.0f} s): killed") from None
+        proc = subprocess.run(
+            [sys.executable, "-m", "tpee_ompl.bench.executors", fn_path, str(src), str(dst)],
+            env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, check=False,
+            timeout=None if limit is None else float(limit),
+        )
         if proc.returncode != 0 or not dst.is_file():
             tail = "\n".join(proc.stderr.splitlines()[-20:])
             raise RuntimeError(f"task subprocess exited with {proc.returncode}:\n{tail}")
