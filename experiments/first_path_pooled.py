@@ -18,10 +18,28 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 from collections import defaultdict
 
 import numpy as np
+
+
+def _fail(msg: str) -> SystemExit:
+    return SystemExit(f"first_path_pooled: {msg}")
+
+
+def _run_time(r: object, limit: float) -> tuple[str, int, str, float]:
+    """(set, query, planner, seconds) of one run record; ValueError when it is not one ``first_path.py`` writes."""
+    if not isinstance(r, dict) or r.get("planner") not in ("D", "R") or not isinstance(r.get("set"), str):
+        raise ValueError(f"a run is not {{set, query, planner D or R, seconds}}: {r!r:.80}")
+    q, t = r.get("query"), r.get("seconds")
+    if isinstance(q, bool) or not isinstance(q, int):
+        raise ValueError(f"a run's query is not an integer: {q!r}")
+    t = limit if t is None else t
+    if isinstance(t, bool) or not isinstance(t, (int, float)) or not 0 <= t < float("inf"):
+        raise ValueError(f"a run's seconds is not a finite number >= 0 or null: {t!r}")
+    return r["set"], q, r["planner"], float(t)
 
 
 def load(files: list[str]) -> tuple[dict[str, dict[int, dict[str, list[float]]]], list[dict[str, float]]]:
@@ -29,18 +47,23 @@ def load(files: list[str]) -> tuple[dict[str, dict[int, dict[str, list[float]]]]
     pooled: dict[str, dict[int, dict[str, list[float]]]] = defaultdict(lambda: defaultdict(lambda: {"D": [], "R": []}))
     per_file: list[dict[str, float]] = []
     for f in files:
+        own: dict[str, dict[str, list[float]]] = defaultdict(lambda: {"D": [], "R": []})
         try:
             with open(f, encoding="utf-8") as fh:
                 data = json.load(fh)
             limit, runs = float(data["meta"]["limit"]), data["runs"]
+            if not isinstance(runs, list) or not runs:
+                raise ValueError("no runs")
+            for r in runs:
+                name, q, who, t = _run_time(r, limit)
+                pooled[name][q][who].append(t)
+                own[name][who].append(t)
         except (OSError, ValueError, KeyError, TypeError) as e:
-            raise SystemExit(f"first_path_pooled: {f}: not a file written by first_path.py --save ({e})") from None
-        own: dict[str, dict[str, list[float]]] = defaultdict(lambda: {"D": [], "R": []})
-        for r in runs:
-            t = limit if r["seconds"] is None else float(r["seconds"])
-            pooled[r["set"]][int(r["query"])][r["planner"]].append(t)
-            own[r["set"]][r["planner"]].append(t)
-        per_file.append({s: float(np.median(v["D"]) / np.median(v["R"])) for s, v in own.items()})
+            raise _fail(f"{f}: not a file written by first_path.py --save ({e})") from None
+        for name, v in own.items():
+            if not v["D"] or not v["R"]:
+                raise _fail(f"{f}: set {name} has no runs of {'dimension-RRT' if not v['D'] else 'RRTConnect'}")
+        per_file.append({name: float(np.median(v["D"]) / np.median(v["R"])) for name, v in own.items()})
     return pooled, per_file
 
 
@@ -64,6 +87,8 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     if args.draws < 100:
         ap.error(f"--draws must be at least 100, got {args.draws}")
+    if len(set(map(os.path.realpath, args.files))) < len(args.files):
+        ap.error("a file is given twice (its runs would count twice)")
     pooled, per_file = load(args.files)
     rng = np.random.default_rng(args.seed)
     for name, by_query in pooled.items():

@@ -116,11 +116,16 @@ def test_layout_tells_when_the_space_bounds_changed() -> None:
     assert lay.bounds_changed(cs)
 
 
-def test_group_dims_are_read_only() -> None:
-    gs = GroupedSpace(_space(), [[0, 1], [2, 3]], 7)
-    np.testing.assert_array_equal(gs.group_dims(1), [2, 3])
-    with pytest.raises(ValueError, match="read-only"):
-        gs.group_dims(1)[0] = 0
+def test_group_dims_bounds_and_planned_dims_are_shared_read_only() -> None:
+    T = cross_sector_trajectory(1, 4)
+    gs = GroupedSpace(_space(bound=3.2), [[0, 1], [3, 2]], 7, {0: T})
+    np.testing.assert_array_equal(gs.group_dims(1), [3, 2])
+    np.testing.assert_array_equal(gs.planned_dims, [2, 3])  # in index order
+    lo, hi = gs.group_bounds(1)
+    np.testing.assert_array_equal(lo, [-3.2, -3.2])
+    for arr in (gs.group_dims(1), lo, hi, gs.planned_dims):
+        with pytest.raises(ValueError, match="read-only"):
+            arr[0] = 0
 
 
 def test_real_vector_space_without_bounds_is_refused() -> None:

@@ -55,6 +55,20 @@ def test_read_and_write_hooks_handle_a_compound_space() -> None:
     assert path.length() == pytest.approx(layout.path_length(W))  # the weighted metric, not path_length's
 
 
+def test_array_to_path_gives_a_user_writer_array_rows_and_keeps_a_copy_of_each_state() -> None:
+    si, _ = box_problem()
+    seen = []
+
+    def write(state, w):
+        seen.append(type(w))
+        return set_state(state, 0.5 * w)  # array arithmetic on the row
+
+    W = np.array([[0.0, 0.0], [0.2, 0.4], [-0.6, 0.8]])
+    path = array_to_path(si, W, write=write)
+    assert seen == [np.ndarray] * 3
+    np.testing.assert_array_equal(path_to_array(path, 2), 0.5 * W)  # three distinct states, not the last one thrice
+
+
 # ------------------------------------------------------------------------------- motion states
 def test_motion_states_match_ompl_subdivision() -> None:
     s = motion_states(np.zeros(4), np.array([1.0, 0, 0, 0]), 0.3)

@@ -400,6 +400,7 @@ class GroupedSpace:
         """The planned groups' DOF indices together, in index order (read-only)."""
         self.planned_dims.setflags(write=False)
         self._steps = np.linspace(0.0, 1.0, self.h)  # the fake-time steps' fractions of the straight start -> goal
+        self._steps.setflags(write=False)
 
     @property
     def n(self) -> int:

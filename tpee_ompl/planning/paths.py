@@ -72,12 +72,13 @@ def array_to_path(
     """An ``og.PathGeometric`` through the given (K, n) waypoints.
 
     ``write(state, values)`` writes other state types (e.g. :meth:`RealVectorLayout.write`); the
-    default is :func:`set_state` (RealVector states).
+    default is :func:`set_state` (RealVector states).  It is given one state for every waypoint in turn
+    (the path keeps a copy of each), and the waypoint as an array (n,).
     """
     write = set_state if write is None else write
     path = og.PathGeometric(si)
     s = si.allocState()  # one state written for each waypoint: PathGeometric.append keeps a copy
-    for w in np.asarray(waypoints, dtype=float).tolist():
+    for w in np.asarray(waypoints, dtype=float):
         write(s, w)
         path.append(s)
     return path

@@ -112,6 +112,8 @@ class Checker:
         counter_owner = getattr(svc, "robot", svc)
         self._counter_owner = counter_owner if isinstance(getattr(counter_owner, "collision_checks", None), int) else None
         self.own_checks = 0
+        """Configurations checked, counted here (an upper bound) for a validity checker without an exact counter
+        of its own; with one (:meth:`counter` reads it) this count is not kept up to date."""
         self._longest = float(si.getStateSpace().getLongestValidSegmentLength())
         self._s1, self._s2 = si.allocState(), si.allocState()
         self.passed: set[bytes] = set()
