@@ -34,7 +34,7 @@ from ompl import util as ou
 
 from tpee_ompl import DimensionRRT, RobotChecker, make_simple_setup
 from tpee_ompl.model.obstacles import box
-from tpee_ompl.planning.grouped_space import RealVectorLayout
+from tpee_ompl.planning.space_layout import RealVectorLayout
 
 ROBOT = "kinova"
 POSTS = (box("post1", (0.06, 0.06, 1.2), (0.3, 0.0, 0.4)), box("post2", (0.06, 0.06, 1.2), (-0.3, 0.0, 0.4)))

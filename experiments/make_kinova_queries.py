@@ -26,7 +26,7 @@ from mesh_robots import user_srdf  # noqa: E402
 
 from tpee_ompl.model.joint_queries import JointQuery, save_joint_queries  # noqa: E402
 from tpee_ompl.model.robots import KINOVA_SRDF, kinova_files, kinova_posts  # noqa: E402
-from tpee_ompl.planning.grouped_space import RealVectorLayout  # noqa: E402
+from tpee_ompl.planning.space_layout import RealVectorLayout  # noqa: E402
 from tpee_ompl.planning.setup import make_simple_setup  # noqa: E402
 from tpee_ompl.resources import data_path, query_set_path  # noqa: E402
 

@@ -99,7 +99,7 @@ import math, sys
 from ompl import base as ob, geometric as og, util as ou
 from tpee_ompl import DimensionRRT, RobotChecker, make_simple_setup
 from tpee_ompl.model.obstacles import box
-from tpee_ompl.planning.grouped_space import RealVectorLayout
+from tpee_ompl.planning.space_layout import RealVectorLayout
 open("arm.urdf", "w").write('''<robot name="arm"><link name="base"/>
 <link name="a"><collision><origin xyz="0.25 0 0"/><geometry><box size="0.36 0.05 0.05"/></geometry></collision></link>
 <link name="b"><collision><origin xyz="0.2 0 0"/><geometry><box size="0.26 0.05 0.05"/></geometry></collision></link>

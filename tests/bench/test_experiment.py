@@ -61,7 +61,7 @@ def test_a_one_state_answer_short_of_the_goal_has_no_path_columns_and_one_at_the
     """AORRTC answers a timeout with its start state alone, which OMPL records as a correct solution of length 0."""
     from tpee_ompl.bench.experiment import _path_properties
     from tpee_ompl.model.sectors import posture_preset
-    from tpee_ompl.planning.grouped_space import RealVectorLayout
+    from tpee_ompl.planning.space_layout import RealVectorLayout
     from tpee_ompl.planning.setup import make_simple_setup
 
     start, goal = np.r_[posture_preset(1), 0.0, 0.0], np.r_[posture_preset(4), 0.0, 0.0]

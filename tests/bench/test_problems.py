@@ -16,7 +16,7 @@ from tpee_ompl.bench.config import CampaignConfig
 from tpee_ompl.bench.experiment import group_lengths
 from tpee_ompl.bench.generic_problems import GENERIC_PROBLEMS
 from tpee_ompl.bench.problems import DEFAULT_PROBLEM, PROBLEM_NAMES, get_problem
-from tpee_ompl.planning.grouped_space import RealVectorLayout
+from tpee_ompl.planning.space_layout import RealVectorLayout
 from tests.helpers.panda import needs_panda
 
 ROBOT_PROBLEMS = ("panda-shelf", "kinova-posts")  # their robots come from the optional 'robots' extra

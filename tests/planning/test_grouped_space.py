@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 from ompl import base as ob
 
-from tpee_ompl.planning.grouped_space import GroupedSpace, RealVectorLayout, default_groups, interpolate_waypoints
+from tpee_ompl.planning.grouped_space import GroupedSpace, default_groups, interpolate_waypoints
+from tpee_ompl.planning.space_layout import RealVectorLayout
 from tpee_ompl.model.sectors import cross_sector_trajectory
 
 

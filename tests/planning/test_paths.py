@@ -9,7 +9,7 @@ from ompl import base as ob
 from ompl import geometric as og
 
 from tpee_ompl.model.wearer_arm import WearerArm
-from tpee_ompl.planning.grouped_space import RealVectorLayout
+from tpee_ompl.planning.space_layout import RealVectorLayout
 from tpee_ompl.planning.paths import (
     array_to_path,
     batched_motion_states,

@@ -38,7 +38,7 @@ from ompl import base as ob
 from ompl import geometric as og
 from ompl import tools as ot
 
-from ..planning.grouped_space import RealVectorLayout
+from ..planning.space_layout import RealVectorLayout
 from ..planning.setup import motion_counts, valid_motion_fraction
 from .database import log_text
 from .planners import PlannerContext, RecordingPlanner, planner_factory

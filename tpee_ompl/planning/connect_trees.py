@@ -25,7 +25,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from .grouped_space import RealVectorLayout
+from .space_layout import RealVectorLayout
 from .layered_trees import Tree, valid_ends
 
 __all__ = ["ConnectTrees", "RANGE_FRACTION"]

@@ -343,6 +343,6 @@ def planned_waypoints(W: object, nq: int, who: str = "the planner") -> np.ndarra
 def path_length(path: np.ndarray) -> float:
     """Euclidean joint-space length of a polyline (K, n), radians (the setups' path-length objective).
 
-    For a compound space's weighted metric see :meth:`~tpee_ompl.planning.grouped_space.RealVectorLayout.path_length`.
+    For a compound space's weighted metric see :meth:`~tpee_ompl.planning.space_layout.RealVectorLayout.path_length`.
     """
     return float(np.linalg.norm(np.diff(np.asarray(path, dtype=float), axis=0), axis=1).sum())

@@ -15,7 +15,7 @@ import math
 import numpy as np
 from ompl import base as ob
 
-from .grouped_space import RealVectorLayout
+from .space_layout import RealVectorLayout
 from .paths import motion_interior_states
 
 __all__ = ["Checker", "segment_key"]

@@ -31,7 +31,7 @@ from ompl import geometric as og
 from ..model.clearance_balls import SCREEN_COST_LIMIT, SCREEN_LEVELS, screened_all_valid, screened_lines_valid
 from ..model.robot_checker import RobotChecker
 from ..validation import check_bool, check_number
-from .grouped_space import RealVectorLayout
+from .space_layout import RealVectorLayout
 from .paths import MIN_JOINT_STEP, batched_motion_states, state_to_array, unchecked_motion_states
 
 if TYPE_CHECKING:
@@ -239,7 +239,7 @@ def make_space(robot: RobotChecker) -> ob.StateSpace:
 
     With continuous joints (``robot.circular``): an ``ob.CompoundStateSpace`` whose subspaces follow the joint
     order, an ``ob.SO2StateSpace`` per continuous joint and a bounded RealVector space per run of other joints,
-    each of weight 1 (the flat values of a state, :class:`~tpee_ompl.planning.grouped_space.RealVectorLayout`,
+    each of weight 1 (the flat values of a state, :class:`~tpee_ompl.planning.space_layout.RealVectorLayout`,
     are the joint values in order)."""
     if not robot.circular.any():
         return _real_vector(robot.lower, robot.upper)

@@ -32,7 +32,7 @@ import numpy as np
 from .layered_trees import spread_waypoints
 
 if TYPE_CHECKING:  # pragma: no cover
-    from .grouped_space import RealVectorLayout
+    from .space_layout import RealVectorLayout
     from .search_checker import Checker
 
 __all__ = ["COLLAPSED_FRACTION", "MAX_SWEEPS", "SHORTCUT_FRACTIONS", "SWEEP_MIN_GAIN", "respread_candidate",
