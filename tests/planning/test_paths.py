@@ -9,7 +9,6 @@ from ompl import base as ob
 from ompl import geometric as og
 
 from tpee_ompl.model.wearer_arm import WearerArm
-from tpee_ompl.planning.space_layout import RealVectorLayout
 from tpee_ompl.planning.paths import (
     array_to_path,
     batched_motion_states,
@@ -25,6 +24,7 @@ from tpee_ompl.planning.paths import (
     state_to_array,
 )
 from tpee_ompl.planning.setup import make_simple_setup, motion_check_step
+from tpee_ompl.planning.space_layout import RealVectorLayout
 
 
 # ------------------------------------------------------------------------------- states <-> arrays

@@ -13,9 +13,9 @@ from ompl import geometric as og
 
 from tpee_ompl import DimensionRRT, RobotChecker, make_simple_setup
 from tpee_ompl.model.obstacles import box
-from tpee_ompl.planning.space_layout import RealVectorLayout
 from tpee_ompl.planning.paths import path_passes_motion_checks, path_to_array
 from tpee_ompl.planning.setup import make_space
+from tpee_ompl.planning.space_layout import RealVectorLayout
 
 LENGTHS = (0.5, 0.4, 0.3, 0.2)
 

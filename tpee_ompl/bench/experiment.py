@@ -35,8 +35,8 @@ from ompl import util as ou
 
 from .._version import __version__
 from ..files import write_new_file
-from ..planning.space_layout import RealVectorLayout
 from ..planning.paths import path_length, path_passes_motion_checks
+from ..planning.space_layout import RealVectorLayout
 from ..validation import sub_seed
 from .database import failed_run_properties, log_text, pad_aborted_runs, patch_recorded_data
 from .ladder import DeriveContext

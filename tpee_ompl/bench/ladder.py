@@ -38,8 +38,8 @@ from ompl import base as ob
 from ompl import geometric as og
 from ompl import tools as ot
 
-from ..planning.space_layout import RealVectorLayout
 from ..planning.setup import motion_counts, valid_motion_fraction
+from ..planning.space_layout import RealVectorLayout
 from .database import log_text
 from .planners import PlannerContext, RecordingPlanner, planner_factory
 from .results import format_value

@@ -25,8 +25,8 @@ from collections.abc import Callable
 
 import numpy as np
 
-from .space_layout import RealVectorLayout
 from .layered_trees import Tree, valid_ends
+from .space_layout import RealVectorLayout
 
 __all__ = ["ConnectTrees", "RANGE_FRACTION"]
 

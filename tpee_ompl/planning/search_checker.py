@@ -15,8 +15,8 @@ import math
 import numpy as np
 from ompl import base as ob
 
-from .space_layout import RealVectorLayout
 from .paths import motion_interior_states
+from .space_layout import RealVectorLayout
 
 __all__ = ["Checker", "segment_key"]
 

@@ -31,8 +31,8 @@ from ompl import geometric as og
 from ..model.clearance_balls import SCREEN_COST_LIMIT, SCREEN_LEVELS, screened_all_valid, screened_lines_valid
 from ..model.robot_checker import RobotChecker
 from ..validation import check_bool, check_number
-from .space_layout import RealVectorLayout
 from .paths import MIN_JOINT_STEP, batched_motion_states, state_to_array, unchecked_motion_states
+from .space_layout import RealVectorLayout
 
 if TYPE_CHECKING:
     from .certified import CertifiedMotionOptions
