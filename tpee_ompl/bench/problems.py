@@ -175,11 +175,12 @@ def _generic_queries(name: str) -> list[dict]:
 
 
 # ----------------------------------------------------------------- robot-checker problems (hook)
-def _robot_problem(name: str, dimension: int, description: str, robot: str, query_set: str, groups_name: str,
+def _robot_problem(name: str, dimension: int, description: str, robot: str, query_set: str,
                    groups: tuple[tuple[int, ...], ...], continuous: bool = False) -> Problem:
     """A problem on a :class:`~tpee_ompl.model.robot_checker.RobotChecker` made by a function of
     :mod:`tpee_ompl.model.robots`, its joint query set and ``make_simple_setup``: one entry per robot in
-    :data:`PROBLEMS`.  ``groups``: the value of ``robots.<groups_name>`` (the module needs the optional extra);
+    :data:`PROBLEMS`.  ``groups``: dimension-RRT's grouping, a copy of the robot's constant in
+    :mod:`~tpee_ompl.model.robots` (not imported here: listing the problems loads no Pinocchio; a test keeps them equal);
     ``continuous``: the robot has continuous joints (an SO2 compound: no certified validator, no informed sampler)."""
 
     def modules():
@@ -208,8 +209,7 @@ def _robot_problem(name: str, dimension: int, description: str, robot: str, quer
     def dimension_rrt(si, ctx):
         from ..planning.dimension_rrt import DimensionRRT
 
-        robots, _ = modules()
-        return DimensionRRT(si, groups=getattr(robots, groups_name), max_samples=ctx.max_samples, seed=ctx.seed,
+        return DimensionRRT(si, groups=groups, max_samples=ctx.max_samples, seed=ctx.seed,
                             stall_samples=ctx.stall_samples, **dict(ctx.dimension_rrt_overrides))
 
     extra = _SO2_COMPOUND if continuous else {}
@@ -224,10 +224,10 @@ PROBLEMS: dict[str, Problem] = {p.name: p for p in (
     _wearer("wearer-random", "paper_random", "the paper's random queries"),
     *(_generic(spec) for spec in GENERIC_PROBLEMS.values()),
     _robot_problem("panda-shelf", 7, "Franka Panda reaching into a shelf (Pinocchio + Coal checker)",
-                   robot="panda_shelf", query_set="panda_shelf", groups_name="PANDA_GROUPS",
+                   robot="panda_shelf", query_set="panda_shelf",
                    groups=((0, 1, 2), (3, 4, 5, 6))),
     _robot_problem("kinova-posts", 6, "Kinova Jaco2 arm, 3 continuous joints (SO2), between two posts (convex hulls)",
-                   robot="kinova_posts", query_set="kinova_posts", groups_name="KINOVA_GROUPS",
+                   robot="kinova_posts", query_set="kinova_posts",
                    groups=((0, 1, 2), (3, 4, 5)), continuous=True),
 )}
 """Every problem by name; the wearer first (the default)."""
