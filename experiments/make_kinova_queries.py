@@ -21,10 +21,10 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from make_panda_queries import report_rrtconnect  # noqa: E402
+from make_panda_queries import save_robot_queries  # noqa: E402
 from mesh_robots import user_srdf  # noqa: E402
 
-from tpee_ompl.model.joint_queries import JointQuery, save_joint_queries  # noqa: E402
+from tpee_ompl.model.joint_queries import JointQuery  # noqa: E402
 from tpee_ompl.model.robots import KINOVA_SRDF, kinova_files, kinova_posts  # noqa: E402
 from tpee_ompl.planning.space_layout import RealVectorLayout  # noqa: E402
 from tpee_ompl.planning.setup import make_simple_setup  # noqa: E402
@@ -62,12 +62,9 @@ def main() -> None:
     print(f"wrote {args.srdf}")
     checker = kinova_posts(n_threads=1, srdf=args.srdf)
     queries = make_queries(checker, np.random.default_rng(args.seed), args.n)
-    extra = {"robot": "kinova_posts", "security_margin": checker.security_margin,
-             "labels": {label: sum(q.label == label for q in queries) for label in ("across-pi", "within")}}
-    if args.check_time > 0:
-        extra["rrtconnect_solved"] = report_rrtconnect(checker, queries, args.check_time)
-    save_joint_queries(args.out, queries, name="kinova_posts", seed=args.seed, checker=checker, extra=extra)
-    print(f"wrote {len(queries)} queries to {args.out} ({extra['labels']})")
+    labels = {label: sum(q.label == label for q in queries) for label in ("across-pi", "within")}
+    save_robot_queries(args.out, queries, "kinova_posts", args.seed, checker, {"labels": labels}, args.check_time)
+    print(f"wrote {len(queries)} queries to {args.out} ({labels})")
 
 
 if __name__ == "__main__":

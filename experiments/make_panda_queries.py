@@ -103,6 +103,16 @@ def report_rrtconnect(checker, queries: list[JointQuery], seconds: float) -> dic
     return {"seconds": seconds, "solved": sum(solved), "of": len(solved)}
 
 
+def save_robot_queries(out: Path, queries: list[JointQuery], robot: str, seed: int, checker, details: dict,
+                       check_time: float) -> None:
+    """Write a robot's query set named ``robot``: its header names the robot, the margin, ``details`` and, when
+    ``check_time`` > 0, how many queries RRTConnect solves in that time (:func:`report_rrtconnect`)."""
+    extra = {"robot": robot, "security_margin": checker.security_margin, **details}
+    if check_time > 0:
+        extra["rrtconnect_solved"] = report_rrtconnect(checker, queries, check_time)
+    save_joint_queries(out, queries, name=robot, seed=seed, checker=checker, extra=extra)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", type=Path, default=query_set_path("panda_shelf"))
@@ -117,11 +127,8 @@ def main() -> None:
     pools = region_configs(checker, rng, args.per_region, args.attempts)
     print("configurations per region:", {k: len(v) for k, v in pools.items()})
     queries = make_queries(checker, rng, args.n, pools)
-    extra = {"robot": "panda_shelf", "security_margin": checker.security_margin,
-             "regions": {k: [list(lo), list(hi)] for k, (lo, hi) in PANDA_SHELF_REGIONS.items()}}
-    if args.check_time > 0:
-        extra["rrtconnect_solved"] = report_rrtconnect(checker, queries, args.check_time)
-    save_joint_queries(args.out, queries, name="panda_shelf", seed=args.seed, checker=checker, extra=extra)
+    regions = {k: [list(lo), list(hi)] for k, (lo, hi) in PANDA_SHELF_REGIONS.items()}
+    save_robot_queries(args.out, queries, "panda_shelf", args.seed, checker, {"regions": regions}, args.check_time)
     print(f"wrote {len(queries)} queries to {args.out}")
 
 
