@@ -21,3 +21,15 @@ def test_the_headline_names_are_exported():
 
 def test_version_has_one_source():
     assert importlib.metadata.version("tpee_ompl") == tpee_ompl.__version__
+
+
+def test_the_names_static_tools_see_are_the_names_exported_on_first_use():
+    """The ``TYPE_CHECKING`` imports (for IDEs and type checkers) name the same objects, from the same modules,
+    as the map the package imports them from on first use."""
+    import ast
+    from pathlib import Path
+
+    tree = ast.parse(Path(tpee_ompl.__file__).read_text())
+    block = next(n for n in tree.body if isinstance(n, ast.If) and getattr(n.test, "id", "") == "TYPE_CHECKING")
+    static = {a.name: "." + n.module for n in block.body if isinstance(n, ast.ImportFrom) for a in n.names}
+    assert static == tpee_ompl._EXPORTS

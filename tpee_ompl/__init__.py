@@ -55,65 +55,9 @@ if TYPE_CHECKING:  # what static tools see; at run time the names are imported o
     )
     from .planning.tpee import tpee_dimension_rrt
 
-__all__ = [
-    # the wearer model and the headline planner
-    "WearerArm",
-    "default_robot",
-    "DimensionRRT",
-    "DimensionRRTOptions",
-    "tpee_dimension_rrt",
-    "make_simple_setup",
-    "make_space",
-    "WearerValidityChecker",
-    "RobotValidityChecker",
-    "BatchedMotionValidator",
-    # any URDF robot among obstacles
-    "RobotChecker",
-    "Obstacle",
-    "kinova_posts",
-    "panda_shelf",
-    "JointQuery",
-    "load_joint_query_set",
-    # aiming, sectors, queries
-    "aim",
-    "aim_batch",
-    "aim_checked",
-    "AimingError",
-    "BlindAreaError",
-    "UnreachableTargetError",
-    "select_sector",
-    "posture_sector",
-    "in_pointing_sector",
-    "posture_preset",
-    "cross_sector_length_bound",
-    "cross_sector_trajectory",
-    "CROSS_SECTOR_TRAJECTORIES",
-    "POSTURE_PRESETS",
-    "SECTOR_PAIRS",
-    "Query",
-    "QuerySetError",
-    "load_queries",
-    # paths
-    "array_to_path",
-    "path_to_array",
-    "path_length",
-    "motion_states",
-    # the real-time layer
-    "LibraryDimensionRRT",
-    "PathLibrary",
-    "QueryResult",
-    "LibraryFileError",
-    "Tracker",
-    "TrackerOptions",
-    "make_default_planner",
-    "DMP",
-    "DMPOptions",
-    "learn_dmp",
-    "generate",
-    "generate_blended",
-]
 
 _EXPORTS = {
+    # the wearer model and the headline planner
     "WearerArm": ".model.wearer_arm",
     "default_robot": ".model.wearer_arm",
     "DimensionRRT": ".planning.dimension_rrt",
@@ -124,12 +68,14 @@ _EXPORTS = {
     "WearerValidityChecker": ".planning.setup",
     "RobotValidityChecker": ".planning.setup",
     "BatchedMotionValidator": ".planning.setup",
+    # any URDF robot among obstacles
     "RobotChecker": ".model.robot_checker",
     "Obstacle": ".model.obstacles",
     "kinova_posts": ".model.robots",
     "panda_shelf": ".model.robots",
     "JointQuery": ".model.joint_queries",
     "load_joint_query_set": ".model.joint_queries",
+    # aiming, sectors, queries
     "aim": ".model.pointing",
     "aim_batch": ".model.pointing",
     "aim_checked": ".model.pointing",
@@ -148,10 +94,12 @@ _EXPORTS = {
     "Query": ".model.queries",
     "QuerySetError": ".model.queries",
     "load_queries": ".model.queries",
+    # paths
     "array_to_path": ".planning.paths",
     "path_to_array": ".planning.paths",
     "path_length": ".planning.paths",
     "motion_states": ".planning.paths",
+    # the real-time layer
     "LibraryDimensionRRT": ".library",
     "PathLibrary": ".library",
     "QueryResult": ".library",
@@ -167,6 +115,8 @@ _EXPORTS = {
 }
 """Public name -> the module it lives in (imported on first use, so that ``import tpee_ompl``, and the command
 line's start, do not load OMPL, Pinocchio and Coal before they are needed)."""
+
+__all__ = list(_EXPORTS)
 
 _SUBPACKAGES = frozenset({"model", "planning", "library", "bench", "cli", "viz", "examples"})
 

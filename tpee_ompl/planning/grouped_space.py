@@ -14,8 +14,8 @@ bounds, metric and motion-check resolution.
 Metric
 ------
 Path length is measured with the state space's own ``distance``, which
-:meth:`~tpee_ompl.planning.space_layout.RealVectorLayout.distance` reproduces in numpy: the Euclidean norm of the joint differences for a ``RealVectorStateSpace``
-(radians for the wearer arm), and the weighted sum of the subspaces' Euclidean norms for a compound
+:meth:`~tpee_ompl.planning.space_layout.RealVectorLayout.distance` reproduces in numpy: the Euclidean norm
+of the joint differences for a ``RealVectorStateSpace`` (radians for the wearer arm), and the weighted sum of the subspaces' Euclidean norms for a compound
 space.  It is the metric of ``ob.PathLengthOptimizationObjective`` and of ``PathGeometric.length``,
 so every planner is scored with it.
 """

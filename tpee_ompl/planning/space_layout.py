@@ -67,14 +67,13 @@ class RealVectorLayout:
         self.is_plain = (len(self._leaves) == 1 and self._leaves[0][0] == () and self._weights[0] == 1.0
                          and not self.has_circular)
         """A single RealVector space: the metric is the plain Euclidean norm."""
-        self._bound_lists = (lows, highs)
 
     def bounds_changed(self, space: ob.StateSpace) -> bool:
         """Whether ``space``'s bounds differ from those this layout was built with (OMPL's planners read them at
         each solve).  For a single RealVector space a read of its bounds; otherwise a new layout compared."""
         if self.is_plain and isinstance(space, ob.RealVectorStateSpace):
             b = space.getBounds()
-            return list(b.low) != self._bound_lists[0] or list(b.high) != self._bound_lists[1]
+            return list(b.low) != self.lower.tolist() or list(b.high) != self.upper.tolist()
         layout = RealVectorLayout(space)
         return not (np.array_equal(layout.lower, self.lower) and np.array_equal(layout.upper, self.upper))
 
