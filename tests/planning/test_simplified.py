@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 from ompl import base as ob
@@ -46,3 +48,23 @@ def test_inner_must_be_an_ompl_planner(robot):
     si = make_simple_setup(robot).getSpaceInformation()
     with pytest.raises(ValueError, match="inner"):
         SimplifiedPlanner(si, "RRTConnect")
+
+
+def test_a_setup_without_an_objective_gets_the_simplified_path_by_length():
+    """A plain og.SimpleSetup (no optimization objective) on a 2-D box with a wall: the path is found,
+    simplified and compared by length, not a crash."""
+    space = ob.RealVectorStateSpace(2)
+    space.setBounds(0.0, 1.0)
+    ss = og.SimpleSetup(space)
+    ss.setStateValidityChecker(lambda s: not (0.45 < s[0] < 0.55 and s[1] < 0.8))
+    si = ss.getSpaceInformation()
+    start, goal = si.allocState(), si.allocState()
+    start[0], start[1], goal[0], goal[1] = 0.1, 0.1, 0.9, 0.1
+    ss.setStartAndGoalStates(start, goal)
+    planner = SimplifiedPlanner(si, og.RRTConnect(si))
+    ss.setPlanner(planner)
+    assert ss.solve(5.0) == ob.PlannerStatus.EXACT_SOLUTION
+    stats = planner.last_run_stats()
+    assert path_passes_motion_checks(si, ss.getSolutionPath())
+    assert stats["best_cost"] <= stats["raw_cost"] < math.inf
+    assert ss.getSolutionPath().length() == pytest.approx(stats["best_cost"])

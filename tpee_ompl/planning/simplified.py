@@ -18,7 +18,7 @@ from ompl import base as ob
 from ompl import geometric as og
 
 from .paths import path_passes_motion_checks
-from .planner_base import PythonPlanner, planner_status
+from .planner_base import PythonPlanner, planner_status, problem_objective
 
 __all__ = ["SimplifiedPlanner"]
 
@@ -74,7 +74,8 @@ class SimplifiedPlanner(PythonPlanner):
         status = self.inner.solve(ptc)
         if not pdef.hasExactSolution():
             return status
-        stats, opt = self._stats, pdef.getOptimizationObjective()
+        # a plain og.SimpleSetup has no objective: the raw and simplified paths are compared by length
+        stats, opt = self._stats, problem_objective(pdef) or ob.PathLengthOptimizationObjective(si)
         raw = og.PathGeometric(pdef.getSolutionPath())
         now = time.perf_counter() - t0
         stats.update(first_solution_time=now, raw_cost=float(raw.cost(opt).value()))
