@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..model.pointing import AimingError, PointingGeometry, aim_batch, check_target
+from ..model.pointing import AimingError, BlindAreaError, PointingGeometry, aim_batch, check_target
 from ..model.sectors import SECTORS, check_sector, in_pointing_sector, infer_sector, posture_preset, posture_sector
 from ..model.wearer_arm import WearerArm
 from ..planning.paths import MIN_JOINT_STEP, motion_is_valid, motion_states, motion_step, planned_waypoints
@@ -240,12 +240,11 @@ class Tracker:
         if in_pointing_sector(target, self.sector, self.geometry.pivot):
             try:
                 aim_batch(target[None], self.sector, geometry=self.geometry, pan_reference=self.q[2])
-            except AimingError as exc:
-                if type(exc).__name__ == "BlindAreaError":
-                    self.events.append(TrackEvent(t, "blind-area", self.sector, str(exc)))
-                    why = "blind-area"
-                else:  # an "unreachable" event only if no other posture can aim at it either (below)
-                    why = f"not reachable from posture {self.sector} ({exc})"
+            except BlindAreaError as exc:
+                self.events.append(TrackEvent(t, "blind-area", self.sector, str(exc)))
+                why = "blind-area"
+            except AimingError as exc:  # an "unreachable" event only if no other posture can aim at it either (below)
+                why = f"not reachable from posture {self.sector} ({exc})"
             else:
                 q = self._aim_from(target, self.sector)
                 if q is not None and self._motion_free(self.q, q):

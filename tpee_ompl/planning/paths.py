@@ -22,6 +22,8 @@ if TYPE_CHECKING:
 __all__ = [
     "MIN_JOINT_STEP",
     "array_to_path",
+    "batched_motion_states",
+    "counted_motion_states",
     "motion_interior_states",
     "motion_is_valid",
     "motion_states",
@@ -227,9 +229,16 @@ def batched_motion_states(A: np.ndarray, B: np.ndarray, step: float, factor: int
     D = B - A
     # the segment counts as motion_states computes them (one dot product per motion: the same rounding)
     n = np.array([factor * max(1, math.ceil(math.sqrt(float(d @ d)) / step)) for d in D], dtype=np.int64)
-    idx = np.repeat(np.arange(len(A)), n)
-    j = np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n) + 1
-    return A[idx] + (j / n[idx])[:, None] * D[idx], n
+    return counted_motion_states(A, D, n), n
+
+
+def counted_motion_states(A: np.ndarray, D: np.ndarray, counts: np.ndarray) -> np.ndarray:
+    """The states ``A[k] + (j / counts[k]) D[k]``, j = 1 .. counts[k], of every motion k in motion order (its
+    start excluded, its end ``A[k] + D[k]`` included): :func:`batched_motion_states` once the counts are known.
+    Not validated (inner loops)."""
+    idx = np.repeat(np.arange(len(A)), counts)
+    j = np.arange(int(counts.sum())) - np.repeat(np.cumsum(counts) - counts, counts) + 1
+    return A[idx] + (j / counts[idx])[:, None] * D[idx]
 
 
 def motion_interior_states(
@@ -254,26 +263,19 @@ def motion_interior_states(
 
 
 def polyline_motion_states(path: np.ndarray, step: float) -> np.ndarray:
-    """All states ``si.checkMotion`` checks along the polyline ``path`` (K, n), plus its first state.
-
-    For each segment a -> b: ``n = max(1, ceil(|b - a| / step))`` states ``a + (k / n)(b - a)``,
-    k = 1..n, exactly those of :func:`motion_states` (OMPL's discrete motion validator), built
-    for all segments at once; shape (1 + sum n, n).
+    """All states ``si.checkMotion`` checks along the polyline ``path`` (K, n), plus its first state:
+    its first row, then :func:`batched_motion_states` of its segments (the states of :func:`motion_states`,
+    OMPL's discrete motion validator, for every segment at once); shape (1 + sum n, n).
     """
     path = np.asarray(path, dtype=float)
     if path.ndim != 2 or len(path) < 1:
         raise ValueError(f"path must have shape (K >= 1, n); got {path.shape}")
-    if not np.isfinite(path).all():
-        raise ValueError("path contains NaN or inf")
-    if not step > 0:
-        raise ValueError(f"step must be > 0, got {step!r}")
-    delta = np.diff(path, axis=0)
-    if len(delta) == 0:
-        return path[:1].copy()
-    counts = np.maximum(1, np.ceil(np.linalg.norm(delta, axis=1) / step)).astype(np.int64)
-    seg = np.repeat(np.arange(len(delta)), counts)
-    k = np.arange(1, counts.sum() + 1) - np.repeat(np.cumsum(counts) - counts, counts)
-    states = path[seg] + (k / counts[seg])[:, None] * delta[seg]
+    if len(path) == 1:
+        if not np.isfinite(path).all():
+            raise ValueError("motion ends must be finite")
+        _check_step(step)
+        return path.copy()
+    states, _ = batched_motion_states(path[:-1], path[1:], step)
     return np.vstack([path[:1], states])
 
 
@@ -310,7 +312,7 @@ def motion_step(robot: WearerArm, step: float | None = None) -> float:
 
 
 def motion_is_valid(robot: WearerArm, path: np.ndarray, step: float | None = None) -> bool:
-    """True if the first state and every straight segment of ``path`` (K, 4) pass the motion check.
+    """True if the first state and every straight segment of ``path`` (K, nq) pass the motion check.
 
     Checks the states of :func:`~tpee_ompl.planning.paths.polyline_motion_states` (those ``si.checkMotion`` checks in a
     :func:`~tpee_ompl.planning.setup.make_simple_setup` setup at resolution :func:`motion_step` ``(robot, step)``)

@@ -31,7 +31,7 @@ from ompl import geometric as og
 from ..model.clearance_balls import SCREEN_COST_LIMIT, SCREEN_LEVELS, screened_all_valid, screened_lines_valid
 from ..model.robot_checker import RobotChecker
 from ..validation import check_bool, check_number
-from .paths import MIN_JOINT_STEP, batched_motion_states, state_to_array, unchecked_motion_states
+from .paths import MIN_JOINT_STEP, batched_motion_states, counted_motion_states, state_to_array, unchecked_motion_states
 from .space_layout import RealVectorLayout
 
 if TYPE_CHECKING:
@@ -187,9 +187,7 @@ class BatchedMotionValidator(ob.MotionValidator):
         lay = self._layout
         D = lay.delta(A, B)
         counts = self.segment_counts(A, B)
-        idx = np.repeat(np.arange(len(A)), counts)
-        j = np.arange(int(counts.sum())) - np.repeat(np.cumsum(counts) - counts, counts) + 1
-        S = lay.wrap(A[idx] + (j / counts[idx])[:, None] * D[idx])
+        S = lay.wrap(counted_motion_states(A, D, counts))
         self.motions_checked += len(counts)
         if self.screen_levels:  # the states are evenly spaced along each motion's joint-space line (unwrapped)
             spacing = np.linalg.norm(D, axis=1) / counts
