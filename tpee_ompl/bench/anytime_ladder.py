@@ -36,7 +36,7 @@ from ompl import tools as ot
 from .database import log_text
 from .ladder import CheckpointPlanner, DeriveContext, derive_planner_runs, run_seconds
 from .planners import PlannerContext, RecordingPlanner
-from .results import format_value
+from .results import format_value, planner_name
 
 __all__ = ["ANYTIME_READ", "AnytimeLadder", "TimeCheckpointPlanner", "copy_planner", "group_anytime_ladders"]
 
@@ -172,19 +172,17 @@ class AnytimeLadder:
     def derive(self, bench, name: str, records: dict, ctx: DeriveContext) -> list[tuple[str, dict, str | None]]:
         """One ``(log text, extras, error)`` per shorter budget, ascending (edits the recorded data in place:
         call after the longest budget's log is saved)."""
-        from .database import _planner_name
-
         ed = bench.getRecordedExperimentData()
         ctx.ss.getProblemDefinition().clearSolutionPaths()
         base = [copy_planner(pl) for pl in ed.planners]
-        order = [_planner_name(pl.name) for pl in base]
+        order = [planner_name(pl.name) for pl in base]
         separate = {}
         for spec in self.specs[:-1]:
             need = self._needs_separate(spec["budget"])
             if need:
                 log.info("%s at %gs: run separately: %s", name, spec["budget"], ", ".join(sorted(need)))
                 planners, extras, error = self.run_separate(spec, [self.names[n] for n in order if n in need])
-                separate[spec["budget"]] = ({_planner_name(p.name): p for p in planners}, extras, error)
+                separate[spec["budget"]] = ({planner_name(p.name): p for p in planners}, extras, error)
         out = []
         tag = f"_T{self.budget:g}s_"
         for spec in self.specs[:-1]:
@@ -197,7 +195,7 @@ class AnytimeLadder:
             ed.maxTime = float(b)
             extras, total, planners = {}, 0.0, []
             for pl0 in base:
-                pname = _planner_name(pl0.name)
+                pname = planner_name(pl0.name)
                 if pname in sep:
                     pl = sep[pname]
                     extras[pname] = sep_extras.get(pname, [])

@@ -31,10 +31,10 @@ from ompl import tools as ot
 
 from .config import PROGRESS_PROPERTIES
 from .planners import planner_settings
-from .results import format_value
+from .results import format_value, planner_name
 
 __all__ = ["build_database", "check_log", "failed_run_properties", "log_text", "pad_aborted_runs",
-           "patch_recorded_data", "set_aside_broken_logs"]
+           "patch_recorded_data", "progress_rows", "set_aside_broken_logs"]
 
 log = logging.getLogger(__name__)
 
@@ -45,16 +45,11 @@ def failed_run_properties(error: str) -> dict:
             "error_message TEXT": error[:200].replace("\n", " ").replace(";", ",")}
 
 
-def _planner_name(recorded_name: str) -> str:
-    """``geometric_RRTstar`` -> ``RRTstar`` (OMPL prefixes the planner's name in the recorded data)."""
-    return recorded_name.split("_", 1)[1] if "_" in recorded_name else recorded_name
-
-
 def pad_aborted_runs(bench, records: dict, run_count: int, error: str) -> None:
     """After an aborted ``benchmark()``: add a failed run (status *crash*) for every run that never finished."""
     crash = str(ob.PlannerStatus.CRASH.value)
     for pl in bench.getRecordedExperimentData().planners:
-        recs = records.setdefault(_planner_name(pl.name), [])
+        recs = records.setdefault(planner_name(pl.name), [])
         runs = list(pl.runs)
         del recs[len(runs):]  # a record whose run was not stored (the abort came after the post-run event)
         while len(runs) < run_count:
@@ -85,7 +80,7 @@ def patch_recorded_data(bench, wrappers: dict, records: dict, cap: int | None) -
     ``records``: planner name -> one ``{"props": {column: value}, "progress": [(t, cost, n)]}`` per run.
     """
     for pl in bench.getRecordedExperimentData().planners:
-        name = _planner_name(pl.name)
+        name = planner_name(pl.name)
         recs = records.get(name, [])
         for run, rec in zip(pl.runs, recs):
             for k, v in rec["props"].items():
@@ -103,13 +98,14 @@ def patch_recorded_data(bench, wrappers: dict, records: dict, cap: int | None) -
         pl.common["iteration_cap"] = str(cap) if cap is not None else "none"
         pl.common["wrapper"] = "RecordingPlanner"
         pl.progressPropertyNames = list(PROGRESS_PROPERTIES)
-        pl.runsProgressData = [
-            [
-                {"best cost REAL": format_value(c), "iterations INTEGER": format_value(n), "time REAL": format_value(t)}
-                for t, c, n in _dedupe_times(rec["progress"])
-            ]
-            for rec in recs
-        ]
+        pl.runsProgressData = [progress_rows(rec["progress"]) for rec in recs]
+
+
+def progress_rows(progress: Sequence[tuple[float, float, int | None]]) -> list[dict[str, str]]:
+    """A run's progress [(time, best cost, iterations), ...] as the rows of OMPL's recorded progress data
+    (:data:`~tpee_ompl.bench.config.PROGRESS_PROPERTIES`), one per printed time (the last entry at each)."""
+    return [{"best cost REAL": format_value(c), "iterations INTEGER": format_value(n), "time REAL": format_value(t)}
+            for t, c, n in _dedupe_times(progress)]
 
 
 def log_text(bench) -> str:

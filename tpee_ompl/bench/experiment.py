@@ -42,7 +42,7 @@ from .database import failed_run_properties, log_text, pad_aborted_runs, patch_r
 from .ladder import DeriveContext
 from .planners import SINGLE_USE_PLANNERS, PlannerContext, RecordingPlanner, planner_factory
 from .problems import Problem, get_problem
-from .results import format_value
+from .results import format_value, planner_name
 
 __all__ = ["experiment_name", "experiment_specs", "group_lengths", "log_name", "run_query_task"]
 
@@ -339,7 +339,7 @@ def _wrap_planner(pname: str, ctx: PlannerContext, spec: dict, setup: _Setup, la
     inner = factory(setup.si, ctx)
     if not isinstance(inner, ob.Planner):
         raise ValueError(f"planner factory {pname!r} returned {type(inner).__name__}, not an ompl.base.Planner")
-    if inner.getName() in {n.removeprefix("geometric_") for n in earlier} | set(earlier):
+    if inner.getName() in {planner_name(n) for n in earlier} | set(earlier):
         raise ValueError(f"planner factory {pname!r} makes a planner named {inner.getName()!r} like an earlier one "
                          "of the experiment: the log keys runs by name (give it another name, setName)")
     read = None if setup.layout.is_plain else setup.layout.read

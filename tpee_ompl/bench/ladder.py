@@ -40,9 +40,9 @@ from ompl import tools as ot
 
 from ..planning.setup import motion_counts, valid_motion_fraction
 from ..planning.space_layout import RealVectorLayout
-from .database import log_text
+from .database import log_text, progress_rows
 from .planners import PlannerContext, RecordingPlanner, planner_factory
-from .results import format_value
+from .results import format_value, planner_name
 
 __all__ = ["LADDER_PLANNERS", "CheckpointPlanner", "DeriveContext", "Ladder", "group_ladders"]
 
@@ -273,8 +273,6 @@ class Ladder:
     def derive(self, bench, name: str, records: dict, ctx: DeriveContext) -> list[tuple[str, dict, None]]:
         """One ``(log text, extras, None)`` per smaller cap, ascending (edits the recorded data in place:
         call after the largest cap's log is saved)."""
-        from .database import _planner_name
-
         ed = bench.getRecordedExperimentData()
         self._run_pending(ctx.ss, ctx.max_time)
         out = []
@@ -285,7 +283,7 @@ class Ladder:
             ed.parameters = params
             extras, total = {}, 0.0
             for pl in ed.planners:
-                pname = _planner_name(pl.name)
+                pname = planner_name(pl.name)
                 extras[pname], seconds = derive_planner_runs(pl, pl, self.wrappers[pname], records.get(pname, []), n, ctx)
                 total += seconds
                 pl.common["iteration_cap"] = str(n)
@@ -429,8 +427,6 @@ def run_seconds(row: dict) -> float:
 
 def set_runs(pl, rows: list[dict], progress: list[list]) -> None:
     """Replace a recorded planner's runs and progress (``pl``: an ``ot.PlannerExperiment``)."""
-    from .database import _dedupe_times
-
     runs = []
     for row in rows:
         new = ot.RunProperties()
@@ -438,6 +434,4 @@ def set_runs(pl, rows: list[dict], progress: list[list]) -> None:
             new[k] = v
         runs.append(new)
     pl.runs = runs
-    pl.runsProgressData = [
-        [{"best cost REAL": format_value(c), "iterations INTEGER": format_value(k),
-          "time REAL": format_value(t)} for t, c, k in _dedupe_times(p)] for p in progress]
+    pl.runsProgressData = [progress_rows(p) for p in progress]

@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from ..files import atomic_path, atomic_write_text
+from .results import planner_name
 
 __all__ = [
     "PAPER_TABLE4",
@@ -98,7 +99,7 @@ def load_runs(db_path: str | Path) -> list[dict]:
     finally:
         con.close()
     for r in rows:
-        r["planner"] = r["planner"].split("_", 1)[1] if r["planner"].startswith("geometric_") else r["planner"]
+        r["planner"] = planner_name(r["planner"])
         r["success"] = _success(r)
     return rows
 

@@ -24,9 +24,15 @@ __all__ = [
     "make_results_dir",
     "new_output_stem",
     "package_versions",
+    "planner_name",
     "utc_now",
     "write_json",
 ]
+
+
+def planner_name(recorded_name: str) -> str:
+    """``geometric_RRTstar`` -> ``RRTstar``: a planner's name without the prefix OMPL's benchmark records it with."""
+    return recorded_name.removeprefix("geometric_")
 
 
 def utc_now() -> str:
