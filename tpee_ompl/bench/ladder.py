@@ -38,6 +38,7 @@ from ompl import base as ob
 from ompl import geometric as og
 from ompl import tools as ot
 
+from ..planning.paths import states_to_array
 from ..planning.setup import motion_counts, valid_motion_fraction
 from ..planning.space_layout import RealVectorLayout
 from .database import log_text, progress_rows
@@ -87,13 +88,6 @@ def _ompl_text(v) -> str:
     return f"{float(v):.6g}"
 
 
-def _waypoints(states, dim: int, read=None) -> np.ndarray:
-    """(K, dim) array of OMPL states; ``read(state)`` for spaces other than RealVector (SO2 compounds)."""
-    if read is not None:
-        return np.array([read(s) for s in states], dtype=float).reshape(-1, dim)
-    return np.array([[s[i] for i in range(dim)] for s in states], dtype=float)
-
-
 def _tree_path(pd, si, goal_state, dim: int, read=None) -> tuple[np.ndarray | None, bool, float]:
     """RRT*'s solution from its planner data: (waypoints, exact, solution difference)."""
     if pd.numVertices() == 0:
@@ -116,7 +110,7 @@ def _tree_path(pd, si, goal_state, dim: int, read=None) -> tuple[np.ndarray | No
         if len(parents) != 1:
             raise RuntimeError(f"vertex {chain[-1]} has {len(parents)} parents: not a tree")
         chain.append(parents[0])
-    return _waypoints([pd.getVertex(i).getState() for i in reversed(chain)], dim, read), exact, diff
+    return states_to_array([pd.getVertex(i).getState() for i in reversed(chain)], dim, read=read), exact, diff
 
 
 @dataclasses.dataclass(frozen=True)
@@ -170,7 +164,7 @@ class CheckpointPlanner(RecordingPlanner):
 
     def _on_solution(self, planner, states, cost) -> None:
         # copied at once: the states belong to the posted path (holding them past its life corrupts the heap)
-        self._run["posted"] = (_waypoints(states, self.getSpaceInformation().getStateDimension(), self._read),
+        self._run["posted"] = (states_to_array(states, self.getSpaceInformation().getStateDimension(), read=self._read),
                                float(cost.value()))
 
     def _count(self) -> int | None:
@@ -313,7 +307,7 @@ class Ladder:
                     stats = p.last_run_stats()
                     W = None
                     if pdef.hasExactSolution():
-                        W = _waypoints(pdef.getSolutionPath().getStates(), si.getStateDimension(), w._read)
+                        W = states_to_array(pdef.getSolutionPath().getStates(), si.getStateDimension(), read=w._read)
                     snap.update(time=elapsed, waypoints=W, exact=W is not None, best_cost=stats["best_cost"],
                                 own_checks=w._checks() - c0, pending=False, iterations=stats["samples"],
                                 first_solution_time=stats["first_solution_time"],

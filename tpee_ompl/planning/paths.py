@@ -36,6 +36,7 @@ __all__ = [
     "resample_waypoints",
     "set_state",
     "state_to_array",
+    "states_to_array",
     "unchecked_motion_states",
 ]
 
@@ -59,12 +60,17 @@ def path_to_array(
     ``read(state) -> (n,)`` reads other state types (e.g. :meth:`RealVectorLayout.read` for a compound
     space); the default reads the first n values of a RealVector state.
     """
-    states = path.getStates()
+    return states_to_array(path.getStates(), n, read=read)
+
+
+def states_to_array(states: Sequence[ob.State], n: int, *,
+                    read: Callable[[ob.State], np.ndarray] | None = None) -> np.ndarray:
+    """OMPL states as an array (K, n): :func:`path_to_array` for states not in a path (a planner's data)."""
     if read is None:
         if len(states) and isinstance(states[0], ob.CompoundState):  # s[i] would read past its subspaces
             raise ValueError("path_to_array reads RealVector states; a CompoundStateSpace's need "
                              "read=RealVectorLayout(space).read")
-        return np.array([[s[i] for i in range(n)] for s in states], dtype=float)
+        return np.array([[s[i] for i in range(n)] for s in states], dtype=float).reshape(-1, n)
     return np.array([read(s) for s in states], dtype=float).reshape(-1, n)
 
 
