@@ -14,8 +14,8 @@ from typing import Any, TypeVar
 
 import numpy as np
 
-__all__ = ["MAX_COUNT", "MAX_JOINT_VALUE", "MAX_SECONDS", "MAX_SEED", "as_float_array", "check_bool", "check_int",
-           "check_name", "check_number", "check_seed", "resolve_options", "sub_seed"]
+__all__ = ["MAX_COUNT", "MAX_JOINT_VALUE", "MAX_SECONDS", "MAX_SEED", "MOTION_VALIDATORS", "as_float_array",
+           "check_bool", "check_int", "check_name", "check_number", "check_seed", "resolve_options", "sub_seed"]
 
 
 _Options = TypeVar("_Options")
@@ -102,6 +102,13 @@ a far larger one (1e10 s) overflows it into the past: every run stopped at once 
 
 MAX_SEED = 2**32 - 1
 """Largest accepted seed (OMPL's ``RNG.setSeed`` takes an unsigned integer; numpy's generators accept it too)."""
+
+MOTION_VALIDATORS = ("batched", "discrete", "certified", "dense")
+"""The motion validators a setup can have (``make_simple_setup(motion_validator=...)``, a campaign's checkers):
+batched Pinocchio calls screened by clearance balls, OMPL's ``DiscreteMotionValidator``, clearance certificates
+(a few Coal distances per motion), or the batched one checking every state (``dense``: the same verdicts as
+``batched``, to measure the screening).  Here, below both, so that the campaign's configuration reads them
+without importing OMPL."""
 
 
 def sub_seed(*parts: int) -> int:

@@ -11,6 +11,8 @@ import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from ..validation import MOTION_VALIDATORS
+
 __all__ = [
     "ANYTIME_PLANNERS",
     "CHECKERS",
@@ -57,11 +59,9 @@ never join the iteration-matched comparison; refused there before a campaign sta
 MAX_NAME_BYTES = 234
 """Longest campaign name: ``<UTC time>_<name>`` (and a ``_999`` that tells two campaigns of one second apart) must
 fit a file name, 255 bytes on most file systems."""
-CHECKERS = ("batched", "discrete", "certified", "dense")
-"""Motion validators: batched Pinocchio calls screened by clearance balls, OMPL's DiscreteMotionValidator,
-clearance certificates (a few Coal distances per motion), or the batched one checking every state
-(``dense``: the same verdicts as ``batched``, to measure the screening); the last two on robot-checker
-problems only."""
+CHECKERS = MOTION_VALIDATORS
+"""A campaign's motion validators (:data:`~tpee_ompl.validation.MOTION_VALIDATORS`); ``certified`` and ``dense``
+on robot-checker problems only."""
 DEFAULT_CHECKERS = ("batched", "discrete")
 """The validators a campaign runs unless told (``certified`` is chosen explicitly: ``--checkers``)."""
 PROGRESS_PROPERTIES = ["best cost REAL", "iterations INTEGER", "time REAL"]  # sorted, as OMPL's map

@@ -25,7 +25,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-from .config import ANYTIME_PLANNERS
+from .config import ANYTIME_PLANNERS, CHECKERS
 from .generic_problems import GENERIC_PROBLEMS, GenericProblem, generic_queries, make_generic_setup
 
 __all__ = ["DEFAULT_PROBLEM", "PROBLEM_NAMES", "Problem", "get_problem", "problem_table"]
@@ -128,7 +128,7 @@ def _wearer(name: str, queries: str, what: str) -> Problem:
     return Problem(name=name, description=f"TPEE wearer's 4-DOF arm, query set {queries} ({what})", dimension=4,
                    load_queries=_wearer_queries(queries), build=_wearer_setup,
                    build_dimension_rrt=_wearer_dimension_rrt, groups=((0, 1), (2, 3)), planners=ANYTIME_PLANNERS,
-                   checkers=("batched", "discrete", "certified", "dense"), library=True, query_sets=True, default_queries=queries)
+                   checkers=CHECKERS, library=True, query_sets=True, default_queries=queries)
 
 
 # ----------------------------------------------------------------- generic problems
@@ -213,7 +213,7 @@ def _robot_problem(name: str, dimension: int, description: str, robot: str, quer
                             stall_samples=ctx.stall_samples, **dict(ctx.dimension_rrt_overrides))
 
     extra = _SO2_COMPOUND if continuous else {}
-    checkers = ("batched", "discrete", "dense") if continuous else ("batched", "discrete", "certified", "dense")
+    checkers = tuple(c for c in CHECKERS if c != "certified") if continuous else CHECKERS
     return Problem(name=name, description=description, dimension=dimension, load_queries=load, build=build,
                    build_dimension_rrt=dimension_rrt, groups=groups, checkers=checkers, query_sets=True,
                    default_queries=query_set, **extra)

@@ -30,7 +30,7 @@ from ompl import geometric as og
 
 from ..model.clearance_balls import SCREEN_COST_LIMIT, SCREEN_LEVELS, screened_all_valid, screened_lines_valid
 from ..model.robot_checker import RobotChecker
-from ..validation import check_bool, check_number
+from ..validation import MOTION_VALIDATORS, check_bool, check_number
 from .paths import MIN_JOINT_STEP, batched_motion_states, counted_motion_states, state_to_array, unchecked_motion_states
 from .space_layout import RealVectorLayout
 
@@ -51,8 +51,6 @@ __all__ = [
 
 log = logging.getLogger(__name__)
 
-MOTION_VALIDATORS = ("batched", "certified", "dense", "discrete")
-"""Names accepted by ``make_simple_setup(motion_validator=...)``."""
 
 
 class RobotValidityChecker(ob.StateValidityChecker):
