@@ -36,9 +36,13 @@ from .demos import N_FAKE_TIME_STEPS, PairDemos, Plan, SampleQuery, collect_pair
 from .dmp import DMPOptions, generate_blended
 from .storage import read_library, write_library
 
-__all__ = ["PathLibrary", "QueryResult"]
+__all__ = ["CHECK_STEP", "PathLibrary", "QueryResult"]
 
 log = logging.getLogger(__name__)
+
+CHECK_STEP = 0.01
+"""Radians: the joint step the tracker checks its motions at by default (``TrackerOptions.check_step``), and so
+the library's as a tracker planner (a robot whose ``max_joint_step()`` is smaller is checked at that)."""
 
 
 @dataclass(frozen=True)
@@ -306,12 +310,12 @@ class PathLibrary:
 
         Cross-sector calls go to :meth:`query` at resolution ``step`` (pass the tracker's
         ``options.check_step`` so its own check sees exactly the states checked here; default
-        ``min(robot.max_joint_step(), 0.01)``, 0.01 being the tracker's default).  Raises
+        ``min(robot.max_joint_step(), CHECK_STEP)``, the tracker's default).  Raises
         RuntimeError when the outcome is "failed".  Same-sector calls (the tracker's re-aim
         around an obstacle) have no demonstrations: they go to ``same_sector``, by default
         :func:`tpee_ompl.library.tracker.make_default_planner`.
         """
-        step = motion_step(self.robot, 0.01 if step is None else step)
+        step = motion_step(self.robot, CHECK_STEP if step is None else step)
         fallback = same_sector
 
         def plan(start: np.ndarray, goal: np.ndarray, i: int, j: int) -> np.ndarray:

@@ -27,7 +27,7 @@ from ..model.sectors import SECTORS, check_sector, in_pointing_sector, infer_sec
 from ..model.wearer_arm import WearerArm
 from ..planning.paths import MIN_JOINT_STEP, motion_is_valid, motion_states, motion_step, planned_waypoints
 from ..validation import MAX_SECONDS, as_float_array, check_number, check_seed
-from .path_library import PathLibrary
+from .path_library import CHECK_STEP, PathLibrary
 
 __all__ = [
     "Planner",
@@ -64,7 +64,7 @@ class TrackerOptions:
     """
 
     joint_speed: float = 1.0
-    check_step: float = 0.01
+    check_step: float = CHECK_STEP
 
     def __post_init__(self) -> None:
         set_ = lambda field_, value: object.__setattr__(self, field_, value)  # noqa: E731 (frozen dataclass)
@@ -307,7 +307,7 @@ def make_default_planner(
     (:func:`tpee_ompl.model.queries.straight_motion`; within a sector a straight joint motion) when
     collision-free, else OMPL RRTConnect on :func:`tpee_ompl.planning.setup.make_simple_setup` for
     at most ``timeout`` seconds, simplified.  Every path is checked at the tracker's default step
-    (0.01 rad, or the robot's motion step if smaller); raises RuntimeError if none is found.
+    (:data:`~tpee_ompl.library.path_library.CHECK_STEP`, or the robot's motion step if smaller); raises RuntimeError if none is found.
     """
     from ompl import geometric as og
     from ompl import util as ou
@@ -322,7 +322,7 @@ def make_default_planner(
     ou.setLogLevel(ou.LOG_WARN)
     if seed is not None:
         ou.RNG.setSeed(check_seed("seed", seed))  # once per process: later calls only warn
-    step = motion_step(robot, 0.01)
+    step = motion_step(robot, CHECK_STEP)
     lib: PathLibrary | None = None
     if isinstance(library, PathLibrary):
         lib = library
