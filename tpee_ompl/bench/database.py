@@ -33,10 +33,15 @@ from .config import PROGRESS_PROPERTIES
 from .planners import planner_settings
 from .results import format_value, planner_name
 
-__all__ = ["build_database", "check_log", "failed_run_properties", "log_text", "pad_aborted_runs",
+__all__ = ["NO_PATH_COLUMNS", "build_database", "check_log", "failed_run_properties", "log_text", "pad_aborted_runs",
            "patch_recorded_data", "progress_rows", "set_aside_broken_logs"]
 
 log = logging.getLogger(__name__)
+
+
+NO_PATH_COLUMNS = {"best_cost REAL": None, "length_dof12 REAL": None, "length_dof34 REAL": None, "raw_length REAL": None,
+                   "path_valid_dense INTEGER": None, "reaches_goal INTEGER": 0}
+"""The path columns of a run before its path is read (NULL; ``path_valid_dense`` 0 would be a path that failed)."""
 
 
 def failed_run_properties(error: str) -> dict:

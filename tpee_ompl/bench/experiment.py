@@ -38,7 +38,7 @@ from ..files import write_new_file
 from ..planning.paths import path_length, path_passes_motion_checks
 from ..planning.space_layout import RealVectorLayout
 from ..validation import sub_seed
-from .database import failed_run_properties, log_text, pad_aborted_runs, patch_recorded_data
+from .database import NO_PATH_COLUMNS, failed_run_properties, log_text, pad_aborted_runs, patch_recorded_data
 from .ladder import DeriveContext
 from .planners import SINGLE_USE_PLANNERS, PlannerContext, RecordingPlanner, planner_factory
 from .problems import Problem, get_problem
@@ -386,12 +386,7 @@ def _run_properties(setup: _Setup, rec: dict, checks_before: int) -> dict:
         "iterations INTEGER": rec["iterations"],
         "samples INTEGER": rec["samples"],
         "first_solution_time REAL": rec["first_solution_time"],
-        "best_cost REAL": None,
-        "length_dof12 REAL": None,
-        "length_dof34 REAL": None,
-        "raw_length REAL": None,
-        "path_valid_dense INTEGER": None,  # no path: NULL (0 is a path that failed the check)
-        "reaches_goal INTEGER": 0,
+        **NO_PATH_COLUMNS,
         "planner_error INTEGER": int(rec["error"] is not None),
     }
     # OMPL's own columns, which it cannot fill through the wrapper: NULL where unknown (a Python planner's graph),

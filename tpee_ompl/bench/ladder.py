@@ -41,7 +41,7 @@ from ompl import tools as ot
 from ..planning.paths import states_to_array
 from ..planning.setup import motion_counts, valid_motion_fraction
 from ..planning.space_layout import RealVectorLayout
-from .database import log_text, progress_rows
+from .database import NO_PATH_COLUMNS, log_text, progress_rows
 from .planners import PlannerContext, RecordingPlanner, planner_factory
 from .results import format_value, planner_name
 
@@ -366,9 +366,7 @@ class Ladder:
             first = None
         out = dict(props)
         out.update({"collision_checks INTEGER": checks, "iterations INTEGER": snap["iterations"],
-                    "samples INTEGER": snap["iterations"], "first_solution_time REAL": first,
-                    "best_cost REAL": None, "length_dof12 REAL": None, "length_dof34 REAL": None,
-                    "raw_length REAL": None, "path_valid_dense INTEGER": None, "reaches_goal INTEGER": 0})
+                    "samples INTEGER": snap["iterations"], "first_solution_time REAL": first, **NO_PATH_COLUMNS})
         if snap.get("graph_states") is not None:
             out["graph states INTEGER"] = snap["graph_states"]
             out["graph motions INTEGER"] = snap["graph_motions"]
