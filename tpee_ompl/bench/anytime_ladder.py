@@ -95,6 +95,7 @@ class TimeCheckpointPlanner(CheckpointPlanner):
 
     def __init__(self, si, inner, checkpoints: list[float], context: tuple[str, PlannerContext], mode: str,
                  checker=None, read=None, renew=None, deadline: float | None = None):
+        self._check_inner(inner, mode == "posted")
         RecordingPlanner.__init__(self, si, inner, max_iterations=None, read=read, renew=renew, deadline=deadline)
         self._init_checkpoints(si, context, checker, python=mode == "posted")
         self.checkpoints = sorted({float(c) for c in checkpoints})

@@ -140,19 +140,25 @@ class CheckpointPlanner(RecordingPlanner):
     def __init__(self, si, inner, max_iterations: int, checkpoints: list[int], context: tuple[str, PlannerContext],
                  checker=None, read=None, renew=None):
         python = hasattr(inner, "last_run_stats")
+        if not python and type(inner) is not og.RRTstar:
+            raise ValueError(f"{inner.getName()}: checkpoint rows are verified for og.RRTstar only")
+        self._check_inner(inner, python)
         super().__init__(si, inner, max_iterations=None if python else max_iterations, read=read, renew=renew)
         self._init_checkpoints(si, context, checker, python)
         self.checkpoints = sorted({int(c) for c in checkpoints if int(c) < max_iterations})
-        if not self.python and type(inner) is not og.RRTstar:
-            raise ValueError(f"{inner.getName()}: checkpoint rows are verified for og.RRTstar only")
+
+    @staticmethod
+    def _check_inner(inner: ob.Planner, python: bool) -> None:
+        """Raise ValueError when checkpoints cannot be read from ``inner`` (before ``ob.Planner.__init__``: an
+        exception after it leaves a half-built trampoline)."""
+        if python and not hasattr(inner, "set_intermediate_solution_callback"):
+            raise ValueError(f"{inner.getName()}: no intermediate-solution callback, no checkpoints")
 
     def _init_checkpoints(self, si, context: tuple[str, PlannerContext], checker, python: bool) -> None:
         """What every checkpoint planner holds besides its checkpoints (they are caps here, times in the anytime
         ladder); ``python``: the inner planner is one of this package's, read through its posted paths."""
         self.context = context
         self.python = python
-        if python and not hasattr(self.inner, "set_intermediate_solution_callback"):
-            raise ValueError(f"{self.inner.getName()}: no intermediate-solution callback, no checkpoints")
         self.checker = checker if checker is not None else getattr(si.getStateValidityChecker(), "robot", None)
         """The problem's checker: its ``collision_checks`` counter gives each checkpoint's checks."""
         self.snapshots: list[dict] = []

@@ -188,8 +188,6 @@ class RecordingPlanner(ob.Planner):
     max_iterations : int or None
         Stop after this many ``inner.numIterations()`` (native planners only; Python planners
         get their cap through their factory).
-    progress_period : float, seconds
-        Progress sampling period for native planners exposing ``bestCost``/``numIterations``.
     read : callable, optional
         ``state -> array (n,)`` for spaces other than RealVector (e.g. ``RealVectorLayout.read`` of an
         SO2 compound); n is the space's dimension.
@@ -219,9 +217,15 @@ class RecordingPlanner(ob.Planner):
     returns status *crash*.
     """
 
-    def __init__(self, si, inner, max_iterations: int | None = None, progress_period: float = 0.05,
+    progress_period = 0.05
+    """Seconds between the progress rows of a native planner exposing ``bestCost``/``numIterations``."""
+
+    def __init__(self, si, inner, max_iterations: int | None = None,
                  read: Callable[[ob.State], object] | None = None, checker=None,
                  renew: Callable[[], ob.Planner] | None = None, deadline: float | None = None) -> None:
+        # checked before ob.Planner.__init__: an exception after it leaves a half-built trampoline
+        if max_iterations is not None and not hasattr(inner, "last_run_stats") and not hasattr(inner, "numIterations"):
+            raise ValueError(f"{inner.getName()} has no numIterations(): it cannot be iteration-capped")
         super().__init__(si, inner.getName())
         self.checker = checker
         self.renew = renew
@@ -231,11 +235,8 @@ class RecordingPlanner(ob.Planner):
         self._read = read
         self.inner = inner
         self.max_iterations = max_iterations
-        self.progress_period = float(progress_period)
         self._native = not hasattr(inner, "last_run_stats")
         """A native OMPL planner: watched at every termination check (cap, first solution, progress)."""
-        if max_iterations is not None and not hasattr(inner, "last_run_stats") and not hasattr(inner, "numIterations"):
-            raise ValueError(f"{inner.getName()} has no numIterations(): it cannot be iteration-capped")
         self._setup_error: str | None = None
         self.last: dict = {}
 
