@@ -1,6 +1,6 @@
 """Headless PNG plots of a campaign database (matplotlib Agg).
 
-* ``fig15_ratios.png``: per-query ratios dimension-RRT / RRT* vs sample count (mean with the
+* ``fig15_ratios_<validator>.png``: per-query ratios dimension-RRT / RRT* vs sample count (mean with the
   quartile band, median dashed) with the paper's Table-4 values overlaid, like the paper's Fig. 15.
 * ``box_time.png`` / ``box_length.png``: time and raw path length per planner and sample cap.
 * ``anytime_cost.png``: median cost of successful runs vs time budget per planner, and the median

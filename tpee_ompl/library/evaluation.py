@@ -23,7 +23,8 @@ def benchmark_queries(
 
     Columns: ``pair``, ``id``, ``outcome``, ``query_s`` (whole :meth:`PathLibrary.query`, with
     validation, repair and fallback), ``generation_s`` (nearest demo + its DMP path, no check),
-    ``raw_valid`` (that path passed the motion check), ``length`` (rad, joint-space), and with a
+    ``raw_valid`` (that path passed the motion check), ``candidates_tried`` (demonstrations' paths the query
+    generated and checked), ``length`` (rad, joint-space), and with a
     ``reference`` planner ``ref_length`` and ``length_ratio`` (NaN when either has no path).
     """
     rows = []

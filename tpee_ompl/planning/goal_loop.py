@@ -3,8 +3,8 @@ stopping on a stall, and each pass of samples with its improvements posted to OM
 
 :class:`~tpee_ompl.planning.dimension_rrt.DimensionRRT` builds the runs (one per goal state), the
 :class:`~tpee_ompl.planning.solution_posting.SolutionPoster` and the way a new search is made, then hands them to
-:class:`GoalLoop`; what each rule does and why is in the planner's module docstring ("Several goal states",
-"Raising h", "Stopping", the release of the prescribed rows).
+:class:`GoalLoop`; what each rule does and why is in the planner's module docstring ("Goal regions",
+"Raising h", "Stopping like an OMPL planner", the release of the prescribed rows).
 """
 
 from __future__ import annotations
