@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 from ompl import base as ob
+from ompl import geometric as og
 
 from ..model.queries import straight_motion
 from ..model.sectors import check_sector, infer_sector, posture_preset
@@ -168,6 +169,16 @@ class LibraryDimensionRRT(PythonPlanner):
         lib = self.library
         have_exact = False
         seed = None
+
+        def post(path: og.PathGeometric, outcome: str) -> None:
+            """Add a proven path to the problem definition; the first one posted names the outcome."""
+            pdef.addSolutionPath(path, False, 0.0, self.getName())
+            now, cost = time.perf_counter() - t0, path.length()
+            if stats["first_solution_time"] is None:
+                stats.update(library_outcome=outcome, first_solution_time=now)
+            stats["best_cost"] = cost
+            progress.append((now, cost, 0))
+
         if cross and (i, j) in lib.pairs and len(lib.pairs[(i, j)].starts):
             order = lib.demo_order(start, goal, i, j)
             for rank, k in enumerate(order[: lib.n_candidates]):
@@ -175,13 +186,8 @@ class LibraryDimensionRRT(PythonPlanner):
                 W = lib.generate(start, goal, i, j, int(k), stride=lib.query_stride)
                 path = array_to_path(si, W)
                 if path_passes_motion_checks(si, path, in_bounds=True):
-                    pdef.addSolutionPath(path, False, 0.0, self.getName())
-                    now = time.perf_counter() - t0
-                    cost, best_path = path.length(), path
-                    stats.update(library_outcome="dmp" if rank == 0 else "repaired", first_solution_time=now,
-                                 best_cost=cost)
-                    progress.append((now, cost, 0))
-                    have_exact = True
+                    post(path, "dmp" if rank == 0 else "repaired")
+                    best_path, have_exact = path, True
                     break
             seed = lib.generate(start, goal, i, j, int(order[0]), stride=lib.per_step)
             # near the space's bounds (the joint limits) a DMP seed can leave them; it is only a head start: clip it
@@ -190,26 +196,16 @@ class LibraryDimensionRRT(PythonPlanner):
         if cross and not have_exact:  # Table 3's straight motion: often free when the library's paths are not
             path = array_to_path(si, straight_motion(start, goal, i, j))
             if path_passes_motion_checks(si, path, in_bounds=True):
-                pdef.addSolutionPath(path, False, 0.0, self.getName())
-                now = time.perf_counter() - t0
-                cost, best_path = path.length(), path
-                stats.update(library_outcome="straight", first_solution_time=now, best_cost=cost)
-                progress.append((now, cost, 0))
-                have_exact = True
+                post(path, "straight")
+                best_path, have_exact = path, True
         stats["library_seconds"] = time.perf_counter() - t0
         if have_exact and (ptc() or (opt is not None and opt.isSatisfied(best_path.cost(opt)))):
             return planner_status(ob.PlannerStatus.EXACT_SOLUTION)
         # the direct joint-space motion, when free, is the shortest path there is: nothing to refine
         direct = array_to_path(si, np.stack([start, goal]))
         if path_passes_motion_checks(si, direct, in_bounds=True):
-            now = time.perf_counter() - t0
-            cost = direct.length()
-            if not have_exact or cost < stats["best_cost"]:
-                pdef.addSolutionPath(direct, False, 0.0, self.getName())
-                if not have_exact:
-                    stats.update(library_outcome="direct", first_solution_time=now)
-                stats["best_cost"] = cost
-                progress.append((now, cost, 0))
+            if not have_exact or direct.length() < stats["best_cost"]:
+                post(direct, "direct")
             stats["direct_motion"] = True
             return planner_status(ob.PlannerStatus.EXACT_SOLUTION)
         if stats["library_outcome"] is None:
