@@ -275,3 +275,8 @@ def test_generate_refuses_a_stride_that_is_not_a_positive_integer(library, strid
     (i, j), pd = next(iter(library.pairs.items()))
     with pytest.raises(ValueError, match="stride"):
         library.generate(pd.starts[0], pd.goals[0], i, j, 0, stride=stride)
+
+
+def test_a_library_tries_at_least_one_candidate(robot: WearerArm) -> None:
+    with pytest.raises(ValueError, match="n_candidates"):
+        PathLibrary(robot, {}, n_candidates=0)

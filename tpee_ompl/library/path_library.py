@@ -20,7 +20,7 @@ import inspect
 import logging
 import time
 from collections import Counter
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
@@ -107,7 +107,7 @@ class PathLibrary:
         self.per_step = int(per_step)
         self.options = options or LIBRARY_DMP_OPTIONS
         self.plan = plan
-        self.n_candidates = int(n_candidates)
+        self.n_candidates = check_int("n_candidates", n_candidates, minimum=1)  # a library file's bound too
         self.build_stats = dict(build_stats or {})
         self.build_params = dict(build_params or {})
         if query_stride < 1:
@@ -208,6 +208,13 @@ class PathLibrary:
             raise ValueError(f"the library has no demonstrations for {pair[0]}->{pair[1]} (pairs: {sorted(self.pairs)})")
         return pd.closest_first(start, goal)
 
+    def candidate_paths(self, start: np.ndarray, goal: np.ndarray, from_sector: int,
+                        to_sector: int) -> Iterator[tuple[int, int, np.ndarray]]:
+        """The DMP paths a query tries, unchecked: ``(rank, demonstration index, path)`` for the ``n_candidates``
+        demonstrations closest to (start, goal), closest first, each generated at ``query_stride``."""
+        for rank, k in enumerate(self.demo_order(start, goal, from_sector, to_sector)[: self.n_candidates]):
+            yield rank, int(k), self.generate(start, goal, from_sector, to_sector, int(k), stride=self.query_stride)
+
     def generate(
         self, start: np.ndarray, goal: np.ndarray, from_sector: int, to_sector: int, demo_index: int, stride: int = 1
     ) -> np.ndarray:
@@ -258,15 +265,14 @@ class PathLibrary:
         tried = 0
         seed_path = None
         if pd is not None and len(pd.starts):
-            order = pd.closest_first(start, goal)  # start, goal and pair already checked above
-            for rank, k in enumerate(order[: self.n_candidates]):
+            closest = None
+            for rank, k, path in self.candidate_paths(start, goal, i, j):
                 tried += 1
-                path = self.generate(start, goal, i, j, int(k), stride=self.query_stride)
+                closest = k if closest is None else closest
                 if motion_is_valid(self.robot, path, step):
-                    outcome = "dmp" if rank == 0 else "repaired"
-                    return self._result(path, outcome, int(k), tried, t0)
-            if self.plan is not None:
-                seed_path = self.generate(start, goal, i, j, int(order[0]), stride=self.per_step)
+                    return self._result(path, "dmp" if rank == 0 else "repaired", k, tried, t0)
+            if self.plan is not None and closest is not None:
+                seed_path = self.generate(start, goal, i, j, closest, stride=self.per_step)
         if self.plan is not None:
             kw = {}
             if seed_path is not None and seed_path.shape == (N_FAKE_TIME_STEPS, 4) and _takes_initial_waypoints(self.plan):

@@ -180,16 +180,16 @@ class LibraryDimensionRRT(PythonPlanner):
             progress.append((now, cost, 0))
 
         if cross and (i, j) in lib.pairs and len(lib.pairs[(i, j)].starts):
-            order = lib.demo_order(start, goal, i, j)
-            for rank, k in enumerate(order[: lib.n_candidates]):
+            closest = None
+            for rank, k, W in lib.candidate_paths(start, goal, i, j):
                 stats["candidates_tried"] += 1
-                W = lib.generate(start, goal, i, j, int(k), stride=lib.query_stride)
+                closest = k if closest is None else closest
                 path = array_to_path(si, W)
                 if path_passes_motion_checks(si, path, in_bounds=True):
                     post(path, "dmp" if rank == 0 else "repaired")
                     best_path, have_exact = path, True
                     break
-            seed = lib.generate(start, goal, i, j, int(order[0]), stride=lib.per_step)
+            seed = lib.generate(start, goal, i, j, closest, stride=lib.per_step)
             # near the space's bounds (the joint limits) a DMP seed can leave them; it is only a head start: clip it
             bounds = si.getStateSpace().getBounds()
             seed = np.clip(seed, np.array(bounds.low, dtype=float), np.array(bounds.high, dtype=float))
