@@ -75,25 +75,23 @@ def query_sampler(
     its straight motion collides (about 2 % of draws: slow, ~1 s per pair); after ``max_draws``
     the last valid draw is returned.  Deterministic given the generator passed in.
     """
-    from ..model.pointing import PointingGeometry, aim_checked
-    from ..planning.query_generation import NECESSITY_REGIONS, _sample_aimable, straight_motion_valid
+    from ..model.pointing import PointingGeometry
+    from ..planning.query_generation import NECESSITY_REGIONS, aimable_samples, draw_cross_sector, straight_motion_valid
 
     geometry = PointingGeometry.from_robot(robot)
     origin = geometry.pivot
     regions = NECESSITY_REGIONS if regions is None else regions
 
     def sample(rng: np.random.Generator, i: int, j: int) -> tuple[np.ndarray, np.ndarray]:
-        from_stream = _sample_aimable(robot, geometry, i, tuple(regions[i]), rng, origin)
-        to_stream = _sample_aimable(robot, geometry, j, tuple(regions[j]), rng, origin)
+        from_stream = aimable_samples(robot, geometry, i, tuple(regions[i]), rng, origin)
+        to_stream = aimable_samples(robot, geometry, j, tuple(regions[j]), rng, origin)
         last = None
         for _ in range(max_draws):
-            _, qa = next(from_stream)
-            tb, _ = next(to_stream)
-            qb, ok = aim_checked(robot, tb[None], j, pan_reference=qa[2], geometry=geometry)
-            if not ok[0]:
+            draw = draw_cross_sector(robot, geometry, from_stream, to_stream, j)
+            if draw is None:
                 continue
-            last = (np.asarray(qa, dtype=float), np.asarray(qb[0], dtype=float))
-            if not require_planning or not straight_motion_valid(robot, qa, qb[0], i, j):
+            last = (np.asarray(draw[2], dtype=float), np.asarray(draw[3], dtype=float))
+            if not require_planning or not straight_motion_valid(robot, *last, i, j):
                 return last
         if last is None:
             raise RuntimeError(f"no valid cross-sector motion {i}->{j} in {max_draws} draws")

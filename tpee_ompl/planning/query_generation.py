@@ -11,7 +11,7 @@ Loading and saving query files is :mod:`tpee_ompl.model.queries`.
 from __future__ import annotations
 
 import logging
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -27,6 +27,8 @@ __all__ = [
     "STRAIGHT_MOTION_STEP",
     "BarrelRegion",
     "TargetRegion",
+    "aimable_samples",
+    "draw_cross_sector",
     "generate_queries",
     "planning_necessity",
     "straight_motion_valid",
@@ -124,7 +126,7 @@ def straight_motion_valid(
     return motion_is_valid(robot, straight_motion(start, goal, i, j), step)
 
 
-def _sample_aimable(
+def aimable_samples(
     robot: WearerArm,
     geometry: PointingGeometry,
     k: int,
@@ -133,8 +135,9 @@ def _sample_aimable(
     origin: np.ndarray,
     batch: int = 64,
     max_rounds: int = 200,
-):
-    """Yield (target (3,), configuration (4,)) in sector k's regions, above the floor, aimable from posture k."""
+) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+    """Yield (target (3,), configuration (4,)) in sector k's regions, above the floor, aimable from posture k
+    (RuntimeError after ``max_rounds`` batches in a row with none)."""
     empty_rounds = 0
     while empty_rounds < max_rounds:  # an endless stream; give up only when nothing is aimable
         empty_rounds += 1
@@ -153,6 +156,19 @@ def _sample_aimable(
             empty_rounds = 0
         yield from zip(pts[ok], q[ok])
     raise RuntimeError(f"could not find aimable targets for sector {k} in {regions}")
+
+
+def draw_cross_sector(
+    robot: WearerArm, geometry: PointingGeometry, from_stream: Iterator[tuple[np.ndarray, np.ndarray]],
+    to_stream: Iterator[tuple[np.ndarray, np.ndarray]], j: int,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None:
+    """One cross-sector draw: the start aims from its posture at the next target of ``from_stream``, the goal from
+    posture j at the next of ``to_stream``, its pan the solution closest to the start's (the smaller rotation).
+    (start target, goal target, start, goal), or None when posture j cannot aim there from that pan."""
+    ta, qa = next(from_stream)
+    tb, _ = next(to_stream)
+    qb, ok = aim_checked(robot, tb[None], j, pan_reference=qa[2], geometry=geometry)
+    return (ta, tb, qa, qb[0]) if ok[0] else None
 
 
 def generate_queries(
@@ -194,7 +210,7 @@ def generate_queries(
     origin = geometry.pivot
     if regions is None:
         regions = NECESSITY_REGIONS if require_planning else {k: _random_region(k) for k in SECTORS}
-    streams = {k: _sample_aimable(robot, geometry, k, tuple(regions[k]), rng, origin) for k in SECTORS}
+    streams = {k: aimable_samples(robot, geometry, k, tuple(regions[k]), rng, origin) for k in SECTORS}
     queries: list[Query] = []
     drawn = colliding = 0
     per_pair: dict[str, dict[str, int]] = {}
@@ -207,19 +223,16 @@ def generate_queries(
             tries = 0
             while len(needed) < n_per_pair and tries < max_draws_per_pair:
                 tries += 1
-                ta, qa = next(streams[i])
-                tb, _ = next(streams[j])
-                # goal pan: the solution closest to the start pan (smaller rotation)
-                qb, ok = aim_checked(robot, tb[None], j, pan_reference=qa[2], geometry=geometry)
-                if not ok[0]:
+                draw = draw_cross_sector(robot, geometry, streams[i], streams[j], j)
+                if draw is None:
                     continue
-                needs = not straight_motion_valid(robot, qa, qb[0], i, j)
+                needs = not straight_motion_valid(robot, draw[2], draw[3], i, j)
                 drawn += 1
                 colliding += needs
                 if needs or not require_planning:
-                    needed.append((ta, tb, qa, qb[0]))
+                    needed.append(draw)
                 elif len(spare) < n_per_pair:
-                    spare.append((ta, tb, qa, qb[0]))
+                    spare.append(draw)
             n_needed = len(needed) if require_planning else -1
             if len(needed) < n_per_pair:
                 log.warning("pair %d->%d: %d planning-necessary queries in %d draws; filling with others",
