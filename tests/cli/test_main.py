@@ -26,6 +26,31 @@ def test_bad_arguments_exit_non_zero_with_one_line(capsys, argv, message):
     assert message in err and "Traceback" not in err
 
 
+@pytest.mark.parametrize(
+    ("argv", "said_by"),
+    [
+        (["--bogus"], "tpee-ompl: "),
+        (["-v", "--bogus"], "tpee-ompl: "),
+        (["plan", "--from", "1", "--to", "4", "--bogus"], "tpee-ompl plan: "),
+        (["library", "stats", "--bogus", "x"], "tpee-ompl library stats: "),
+    ],
+)
+def test_an_unknown_option_is_named_by_the_command_it_was_given_to(capsys, argv, said_by):
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert err.startswith(said_by + "error: unrecognized arguments: --bogus") and err.count("\n") == 1
+
+
+def test_version_is_printed(capsys):
+    from tpee_ompl import __version__
+
+    with pytest.raises(SystemExit) as exc:
+        main(["--version"])
+    assert exc.value.code == 0 and capsys.readouterr().out.strip() == f"tpee-ompl {__version__}"
+
+
 def test_missing_urdf_is_one_line_on_stderr(capsys, tmp_path):
     argv = ["plan", "--from", "1", "--to", "4", *start_goal_args(), "--urdf", str(tmp_path / "missing.urdf")]
     assert main(argv) == 2

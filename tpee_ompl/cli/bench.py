@@ -17,7 +17,7 @@ import traceback
 from collections.abc import Sequence
 from pathlib import Path
 
-from ..bench.config import CHECKERS, CampaignConfig, check_planner_name
+from ..bench.config import CHECKERS, KNOWN_PLANNERS, CampaignConfig, check_planner_name
 from ..bench.problems import DEFAULT_PROBLEM, get_problem
 from ._common import Parser, nonempty, positive_int, seconds, seed
 
@@ -96,7 +96,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--anytime", type=seconds, nargs="*", default=_default("anytime_budgets"),
                    help="time budgets (s) of the anytime comparison (default: %(default)s); none to skip")
     p.add_argument("--planners", type=_planner, nargs="+", default=_default("iteration_planners"),
-                   help="iteration-matched planners; the first is compared with the second (default: %(default)s)")
+                   help="iteration-matched planners; the first is compared with the second (default: %(default)s); "
+                        f"built in: {' '.join(KNOWN_PLANNERS)}, or module:function naming a factory")
     p.add_argument("--anytime-planners", type=_planner, nargs="+", default=None,
                    help=f"(default: the problem's planners; the wearer's: {' '.join(_default('anytime_planners'))})")
     p.add_argument("--checkers", nargs="+", default=None, choices=CHECKERS,
@@ -258,7 +259,7 @@ def _print_result(result) -> None:
     print(f"database: {result.database}  (open in Planner Arena: plannerarena.org)" if result.database is not None
           else "database: none (no experiment finished)")
     if result.report:
-        print(f"report: {result.report.get('markdown')}  {result.report.get('csv')}")
+        print("report:", *(result.report[k] for k in ("markdown", "csv") if k in result.report))
     if result.plots:
         print(f"plots: {result.directory / 'plots'} ({len(result.plots)} PNG)")
     if result.broken_logs:

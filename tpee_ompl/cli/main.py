@@ -21,6 +21,7 @@ import sys
 import traceback
 from collections.abc import Sequence
 
+from .._version import __version__
 from ..signals import sigterm_as_keyboard_interrupt
 from ._common import CliError, Parser
 from .bench import register as register_bench
@@ -35,6 +36,7 @@ def get_argument_parser() -> argparse.ArgumentParser:
     """The full ``tpee-ompl`` argument parser."""
     parser = Parser(prog="tpee-ompl", description=__doc__.split("\n")[0].replace("``", ""))
     parser.add_argument("-v", "--verbose", action="store_true", help="log at INFO level")
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     fmt = argparse.RawDescriptionHelpFormatter
     for register in (register_plan, register_pictures, register_bench, register_library):
@@ -45,7 +47,14 @@ def get_argument_parser() -> argparse.ArgumentParser:
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``tpee-ompl``; returns the exit code."""
     parser = get_argument_parser()
-    args = parser.parse_args(argv)
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if not any(a in parser._subparsers._group_actions[0].choices for a in argv):  # noqa: SLF001
+        unknown = [a for a in argv if a.startswith("-") and a not in ("-v", "--verbose")]
+        if unknown and not {"-h", "--help", "--version"} & set(argv):  # not "COMMAND is required"
+            parser.error(f"unrecognized arguments: {' '.join(unknown)}")
+    args, extra = parser.parse_known_args(argv)
+    if extra:  # said by the (sub)command that was given them, as its other usage errors
+        _command_parser(parser, args).error(f"unrecognized arguments: {' '.join(extra)}")
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
                         format="%(levelname)s %(name)s: %(message)s")
     try:
@@ -64,6 +73,17 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 130
     finally:
         gc.collect()  # break si <-> Python checker cycles before exit (nanobind leak warnings otherwise)
+
+
+def _command_parser(parser: argparse.ArgumentParser, args: argparse.Namespace) -> argparse.ArgumentParser:
+    """The parser of the innermost (sub)command ``args`` came through (``tpee-ompl library build``'s for it)."""
+    while parser._subparsers is not None:  # noqa: SLF001 (argparse keeps its subparsers there)
+        action = parser._subparsers._group_actions[0]  # noqa: SLF001
+        name = getattr(args, action.dest, None)
+        if name not in action.choices:
+            break
+        parser = action.choices[name]
+    return parser
 
 
 def _report(args: argparse.Namespace, exc: Exception) -> int:
