@@ -152,6 +152,14 @@ def test_report_has_the_anytime_quality_section_and_csv(tmp_path, monkeypatch):
     assert float(rows["A"]["within_share"]) == pytest.approx(0.4) and rows["A"]["queries"] == "5"
 
 
+def test_an_anytime_only_campaign_has_no_table4_heading_or_csv(tmp_path, monkeypatch):
+    runs = [r for r in anytime_campaign() if r["comparison"] == "anytime"]
+    monkeypatch.setattr(report, "load_runs", lambda db: runs)
+    out = report.write_report(tmp_path / "unused.db", tmp_path, planner="A", reference="B")
+    assert "Table 4" not in out["markdown_text"] and out["markdown_text"].startswith("## Success counts")
+    assert "csv" not in out and not (tmp_path / "table4.csv").exists()
+
+
 def test_a_capped_run_stopped_by_max_time_before_its_cap_is_a_failure():
     """Its path came from fewer samples than the cap: compared as a run at the cap it made Table 4 wrong."""
     base = {"comparison": "iterations", "sample_cap": 5000, "timelimit": 0.05, "solved": 1, "status": 6,

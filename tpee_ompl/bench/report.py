@@ -323,8 +323,8 @@ def _f(x: float, nd: int = 3) -> str:
     return "–" if x is None or (isinstance(x, float) and math.isnan(x)) else f"{x:.{nd}f}"
 
 
-def _markdown(ratios: list[dict], succ: list[dict], quality: list[dict], anytime: list[dict],
-              planner: str, reference: str, headline: str | None) -> str:
+def _ratio_markdown(ratios: list[dict], planner: str, reference: str, headline: str | None) -> list[str]:
+    """The Table-4 section of the report: per validator and sample cap, the per-query ratios' summaries."""
     lines = [f"## Table 4: {planner} / {reference} at equal sample counts", ""]
     has_paper = any(not math.isnan(r["paper"]) for r in ratios)
     lines.append(f"Mean of per-query ratios{' (paper in brackets)' if has_paper else ''}, then median [Q1, Q3]; "
@@ -344,7 +344,13 @@ def _markdown(ratios: list[dict], succ: list[dict], quality: list[dict], anytime
                 paper = f" ({_f(r['paper'])})" if has_paper else ""
                 cells.append(f"{_f(r['mean'])}{paper} med {_f(r['median'])} [{_f(r['q1'])}, {_f(r['q3'])}]")
             lines.append(f"| {cap} | {n}/{r['queries']} | " + " | ".join(cells) + " |")
-    lines += ["", "## Success counts", "",
+    return lines + [""]
+
+
+def _markdown(ratios: list[dict], succ: list[dict], quality: list[dict], anytime: list[dict],
+              planner: str, reference: str, headline: str | None) -> str:
+    lines = _ratio_markdown(ratios, planner, reference, headline) if ratios else []  # no sample caps: no Table 4
+    lines += ["## Success counts", "",
               "| comparison | validator | setting | planner | success / runs | solved but invalid | unsolved | missing queries |",
               "|---|---|---|---|---|---|---|---|"]
     for r in succ:
@@ -422,8 +428,8 @@ def _lost_queries(expected: dict | None) -> str:
 
 def write_report(db_path: str | Path, directory: str | Path, expected: dict | None = None,
                  planner: str | None = None, reference: str | None = None) -> dict:
-    """Write ``report.md``, ``table4.csv``, ``success.csv``, ``length_quality.csv``, ``anytime.csv``,
-    ``anytime_quality.csv``.
+    """Write ``report.md``, ``table4.csv`` (when the campaign had sample caps), ``success.csv``,
+    ``length_quality.csv``, ``anytime.csv``, ``anytime_quality.csv``.
 
     ``planner``/``reference`` default to the campaign's first two iteration planners (or
     DimensionRRT / RRTstar).  Returns the paths and the Markdown text.
@@ -443,9 +449,11 @@ def write_report(db_path: str | Path, directory: str | Path, expected: dict | No
     anytime_quality = anytime_quality_table(runs)
     text = (_markdown(ratios, succ, quality, anytime, planner, reference, headline)
             + _anytime_quality_markdown(anytime_quality) + _lost_queries(expected))
-    paths = {"markdown": directory / "report.md", "csv": directory / "table4.csv"}
+    paths = {"markdown": directory / "report.md"}
     atomic_write_text(paths["markdown"], text)
-    _write_csv(paths["csv"], ratios)
+    if ratios:  # a campaign without sample caps has no Table 4
+        paths["csv"] = directory / "table4.csv"
+        _write_csv(paths["csv"], ratios)
     for name, rows in (("success", succ), ("length_quality", quality), ("anytime", anytime),
                        ("anytime_quality", anytime_quality)):
         paths[name] = directory / f"{name}.csv"
