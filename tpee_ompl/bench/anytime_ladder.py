@@ -30,7 +30,9 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable
+from typing import Any
 
+from ompl import base as ob
 from ompl import tools as ot
 
 from .database import log_text
@@ -65,7 +67,7 @@ def group_anytime_ladders(groups: list[list[dict]], enabled: bool) -> list[list[
     return [sorted(g, key=lambda s: s["budget"]) if g[0]["comparison"] == "anytime" else g for g in out]
 
 
-def copy_planner(pl) -> ot.PlannerExperiment:
+def copy_planner(pl: ot.PlannerExperiment) -> ot.PlannerExperiment:
     """A detached copy of a recorded planner (``ot.PlannerExperiment``), to outlive its benchmark."""
     new = ot.PlannerExperiment()
     new.name = pl.name
@@ -93,8 +95,10 @@ class TimeCheckpointPlanner(CheckpointPlanner):
     path not posted yet).
     """
 
-    def __init__(self, si, inner, checkpoints: list[float], context: tuple[str, PlannerContext], mode: str,
-                 checker=None, read=None, renew=None, deadline: float | None = None):
+    def __init__(self, si: ob.SpaceInformation, inner: ob.Planner, checkpoints: list[float],
+                 context: tuple[str, PlannerContext], mode: str, checker: Any = None,
+                 read: Callable[[ob.State], object] | None = None, renew: Callable[[], ob.Planner] | None = None,
+                 deadline: float | None = None) -> None:
         self._check_inner(inner, mode == "posted")
         RecordingPlanner.__init__(self, si, inner, max_iterations=None, read=read, renew=renew, deadline=deadline)
         self._init_checkpoints(si, context, checker, python=mode == "posted")
@@ -144,11 +148,14 @@ class AnytimeLadder:
         """The spec of the run itself (the longest budget)."""
         return self.specs[-1]
 
-    def wrap(self, si, inner, cap, pname: str, ctx: PlannerContext, checker=None, read=None,
-             renew=None) -> RecordingPlanner:
+    def wrap(self, si: ob.SpaceInformation, inner: ob.Planner, cap: int | None, pname: str, ctx: PlannerContext,
+             checker: Any = None, read: Callable[[ob.State], object] | None = None,
+             renew: Callable[[], ob.Planner] | None = None) -> RecordingPlanner:
         """The recording wrapper of one planner: a :class:`TimeCheckpointPlanner` when its answer at a
         time can be read (:data:`ANYTIME_READ`), else a plain :class:`RecordingPlanner` run separately
-        (``renew``: :class:`RecordingPlanner`'s)."""
+        (``renew``: :class:`RecordingPlanner`'s).  ``cap`` is ignored (the anytime ladder has time budgets, not
+        caps): it is there so a caller wraps with either ladder the same way
+        (:meth:`~tpee_ompl.bench.ladder.Ladder.wrap`)."""
         mode = ANYTIME_READ.get(pname)
         if mode == "posted" and not hasattr(inner, "set_intermediate_solution_callback"):
             mode = None
@@ -170,7 +177,8 @@ class AnytimeLadder:
                 out.add(name)
         return out
 
-    def derive(self, bench, name: str, records: dict, ctx: DeriveContext) -> list[tuple[str, dict, str | None]]:
+    def derive(self, bench: ot.Benchmark, name: str, records: dict,
+               ctx: DeriveContext) -> list[tuple[str, dict, str | None]]:
         """One ``(log text, extras, error)`` per shorter budget, ascending (edits the recorded data in place:
         call after the longest budget's log is saved)."""
         ed = bench.getRecordedExperimentData()

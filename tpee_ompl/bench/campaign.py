@@ -31,6 +31,7 @@ import sys
 import time
 from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from .config import CampaignConfig, CampaignResult
 from .database import build_database, set_aside_broken_logs
@@ -39,6 +40,10 @@ from ..files import check_writable_folder, write_new_file
 from ..signals import sigterm_as_keyboard_interrupt
 from .results import append_json_line, make_results_dir, package_versions, utc_now, write_json
 
+if TYPE_CHECKING:  # hints only: the model imports pinocchio, the executors are imported when a campaign runs
+    from ..model.wearer_arm import WearerArm
+    from .executors import CampaignExecutor
+
 __all__ = ["CampaignPlan", "load_campaign", "prepare_campaign", "query_rows", "resume_campaign", "run_campaign",
            "stratified_subset"]
 
@@ -46,7 +51,7 @@ log = logging.getLogger(__name__)
 
 
 # --------------------------------------------------------------------------- queries
-def query_rows(name_or_path: str, robot=None) -> tuple[str, list[dict]]:
+def query_rows(name_or_path: str, robot: WearerArm | None = None) -> tuple[str, list[dict]]:
     """The query set's name and its queries as plain (picklable, JSON-able) dicts.
 
     Each row: ``id``, ``from_sector``, ``to_sector``, ``start``, ``goal`` (lists of floats).  The set
@@ -170,7 +175,7 @@ def run_campaign(
     on_task_done: Callable[[list[str]], None] | None = None,
     report: bool = True,
     progress_bar: bool = True,
-    executor=None,
+    executor: CampaignExecutor | None = None,
     plan: CampaignPlan | None = None,
 ) -> CampaignResult:
     """Run a campaign into a new timestamped folder, build the DB, the report and the plots.
@@ -267,7 +272,7 @@ def _bad_query_data(rows: object, n: int) -> str | None:
 def resume_campaign(
     directory: str | os.PathLike,
     *,
-    executor=None,
+    executor: CampaignExecutor | None = None,
     workers: int | None = None,
     on_task_done: Callable[[list[str]], None] | None = None,
     report: bool = True,

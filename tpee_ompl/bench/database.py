@@ -50,7 +50,7 @@ def failed_run_properties(error: str) -> dict:
             "error_message TEXT": error[:200].replace("\n", " ").replace(";", ",")}
 
 
-def pad_aborted_runs(bench, records: dict, run_count: int, error: str) -> None:
+def pad_aborted_runs(bench: ot.Benchmark, records: dict, run_count: int, error: str) -> None:
     """After an aborted ``benchmark()``: add a failed run (status *crash*) for every run that never finished."""
     crash = str(ob.PlannerStatus.CRASH.value)
     for pl in bench.getRecordedExperimentData().planners:
@@ -78,7 +78,7 @@ SAMPLED_SPACE_SETTINGS = ("projection.cellsize",)
 cell sizes): they differ from experiment to experiment and would split one planner's configuration."""
 
 
-def patch_recorded_data(bench, wrappers: dict, records: dict, cap: int | None) -> None:
+def patch_recorded_data(bench: ot.Benchmark, wrappers: dict, records: dict, cap: int | None) -> None:
     """Write the post-run records into the recorded experiment data (in place, before saving).
 
     ``wrappers``: planner name -> its :class:`~tpee_ompl.bench.planners.RecordingPlanner`;
@@ -113,7 +113,7 @@ def progress_rows(progress: Sequence[tuple[float, float, int | None]]) -> list[d
             for t, c, n in _dedupe_times(progress)]
 
 
-def log_text(bench) -> str:
+def log_text(bench: ot.Benchmark) -> str:
     """The OMPL log of the benchmark's recorded data, as text (``saveResultsToFile`` into a temporary folder)."""
     with tempfile.TemporaryDirectory(prefix="tpee_log_") as tmp:
         path = Path(tmp) / "experiment.log"

@@ -80,15 +80,16 @@ class InProcessExecutor:
     fresh_process_per_task = False
     shares_filesystem = True
 
-    def run(self, fn: TaskFn, tasks: Sequence[dict]) -> Iterator[dict]:  # noqa: D102
+    def run(self, fn: TaskFn, tasks: Sequence[dict]) -> Iterator[dict]:
+        """Run ``fn`` on each task here, in order; yield each result (a task that raises: :func:`task_failure`)."""
         for t in tasks:
             try:
                 yield fn(t)
             except Exception as exc:  # noqa: BLE001 (recorded as the pools record it; the other queries go on)
                 yield task_failure(t, f"{type(exc).__name__}: {exc}", 1)
 
-    def shutdown(self, cancel: bool = False) -> None:  # noqa: D102
-        pass
+    def shutdown(self, cancel: bool = False) -> None:
+        """Nothing to release: the tasks ran in this process."""
 
 
 def _child_main(fn: TaskFn, task: dict, conn) -> None:
@@ -171,7 +172,8 @@ class ProcessPoolExecutor:
             self._running.append(_Running(proc, recv, task, attempt,
                                           None if limit is None else time.monotonic() + float(limit)))
 
-    def run(self, fn: TaskFn, tasks: Sequence[dict]) -> Iterator[dict]:  # noqa: D102
+    def run(self, fn: TaskFn, tasks: Sequence[dict]) -> Iterator[dict]:
+        """Run ``fn`` on each task in a fresh spawned process; yield each result as it finishes."""
         ctx = mp.get_context("spawn")
         queue = deque((t, 1) for t in tasks)
         try:
@@ -228,7 +230,8 @@ class ProcessPoolExecutor:
                   else _death_reason(r.proc.exitcode))
         return {"lost": reason}
 
-    def shutdown(self, cancel: bool = False) -> None:  # noqa: D102
+    def shutdown(self, cancel: bool = False) -> None:
+        """Kill the task processes still running and close their pipes (whatever ``cancel`` is)."""
         for r in self._running:
             if r.proc.is_alive():
                 r.proc.kill()
@@ -372,7 +375,8 @@ class DaskExecutor:
             self.description = f"Dask scheduler {scheduler}"
         self._futures: list = []
 
-    def run(self, fn: TaskFn, tasks: Sequence[dict]) -> Iterator[dict]:  # noqa: D102
+    def run(self, fn: TaskFn, tasks: Sequence[dict]) -> Iterator[dict]:
+        """Submit one Dask task per task; yield each result as it completes."""
         import uuid
 
         from distributed import as_completed
@@ -392,7 +396,8 @@ class DaskExecutor:
             yield res
             fut.release()
 
-    def shutdown(self, cancel: bool = False) -> None:  # noqa: D102
+    def shutdown(self, cancel: bool = False) -> None:
+        """Cancel unfinished tasks when ``cancel``; close the client and the local cluster this executor started."""
         with contextlib.suppress(Exception):
             if cancel and self._futures:
                 self.client.cancel(self._futures)

@@ -248,7 +248,7 @@ class _Setup:
     start: np.ndarray
     goal: np.ndarray
 
-    def path_properties(self, si, rec: dict, start: np.ndarray, goal: np.ndarray) -> dict:
+    def path_properties(self, si: ob.SpaceInformation, rec: dict, start: np.ndarray, goal: np.ndarray) -> dict:
         """:func:`_path_properties` with this problem's first group and state layout."""
         return _path_properties(si, rec, start, goal, self.problem.groups[0], self.layout)
 

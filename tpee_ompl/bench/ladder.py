@@ -32,6 +32,7 @@ import logging
 import math
 import time
 from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 from ompl import base as ob
@@ -137,8 +138,10 @@ class CheckpointPlanner(RecordingPlanner):
     motion validator's), ``pending`` (dimension-RRT's best path was not posted yet: no waypoints).
     """
 
-    def __init__(self, si, inner, max_iterations: int, checkpoints: list[int], context: tuple[str, PlannerContext],
-                 checker=None, read=None, renew=None):
+    def __init__(self, si: ob.SpaceInformation, inner: ob.Planner, max_iterations: int, checkpoints: list[int],
+                 context: tuple[str, PlannerContext], checker: Any = None,
+                 read: Callable[[ob.State], object] | None = None,
+                 renew: Callable[[], ob.Planner] | None = None) -> None:
         python = hasattr(inner, "last_run_stats")
         if not python and type(inner) is not og.RRTstar:
             raise ValueError(f"{inner.getName()}: checkpoint rows are verified for og.RRTstar only")
@@ -262,15 +265,16 @@ class Ladder:
         """The spec of the run itself (the largest cap)."""
         return self.specs[-1]
 
-    def wrap(self, si, inner, cap: int, pname: str, ctx: PlannerContext, checker=None, read=None,
-             renew=None) -> CheckpointPlanner:
+    def wrap(self, si: ob.SpaceInformation, inner: ob.Planner, cap: int, pname: str, ctx: PlannerContext,
+             checker: Any = None, read: Callable[[ob.State], object] | None = None,
+             renew: Callable[[], ob.Planner] | None = None) -> CheckpointPlanner:
         """The recording wrapper of one planner of the run (``checker``: the problem's, whose checks are
         counted; ``read``: the state reader of a non-RealVector space; ``renew``: :class:`RecordingPlanner`'s)."""
         w = CheckpointPlanner(si, inner, cap, self.checkpoints, (pname, ctx), checker=checker, read=read, renew=renew)
         self.wrappers[w.getName()] = w
         return w
 
-    def derive(self, bench, name: str, records: dict, ctx: DeriveContext) -> list[tuple[str, dict, None]]:
+    def derive(self, bench: ot.Benchmark, name: str, records: dict, ctx: DeriveContext) -> list[tuple[str, dict, None]]:
         """One ``(log text, extras, None)`` per smaller cap, ascending (edits the recorded data in place:
         call after the largest cap's log is saved)."""
         ed = bench.getRecordedExperimentData()
@@ -340,7 +344,7 @@ class Ladder:
         path = RealVectorLayout(space).to_path(si, W)  # SO2 compounds too
         factor = space.getValidSegmentCountFactor()
 
-        def describe(p, prefix: str) -> dict:
+        def describe(p: og.PathGeometric, prefix: str) -> dict:
             out = {f"{prefix}solution length REAL": p.length(), f"{prefix}solution smoothness REAL": p.smoothness(),
                    f"{prefix}solution clearance REAL": p.clearance(),
                    f"{prefix}solution segments INTEGER": p.getStateCount() - 1}
@@ -402,8 +406,8 @@ def derived_run(ctx: DeriveContext, w: CheckpointPlanner, i: int, row: dict, rec
     return row, prog, props
 
 
-def derive_planner_runs(source, target, w: CheckpointPlanner, recs: list[dict], key,
-                        ctx: DeriveContext) -> tuple[list[dict], float]:
+def derive_planner_runs(source: ot.PlannerExperiment, target: ot.PlannerExperiment, w: CheckpointPlanner,
+                        recs: list[dict], key: float, ctx: DeriveContext) -> tuple[list[dict], float]:
     """Write into ``target`` (an ``ot.PlannerExperiment``) the runs of ``source`` as they stood at checkpoint
     ``key`` (a cap or a budget; :func:`derived_run` per run); return the runs' extra columns and their seconds."""
     rows, progress, extras = [], [], []
@@ -423,7 +427,7 @@ def run_seconds(row: dict) -> float:
     return float(row.get("time REAL") or 0) + float(row.get("simplification time REAL") or 0)
 
 
-def set_runs(pl, rows: list[dict], progress: list[list]) -> None:
+def set_runs(pl: ot.PlannerExperiment, rows: list[dict], progress: list[list]) -> None:
     """Replace a recorded planner's runs and progress (``pl``: an ``ot.PlannerExperiment``)."""
     runs = []
     for row in rows:

@@ -163,7 +163,7 @@ def _parse_settings(text: str) -> dict[str, str]:
     return out
 
 
-def planner_settings(p) -> dict[str, str]:
+def planner_settings(p: ob.Planner) -> dict[str, str]:
     """A planner's settings as text: its ``settings()`` (Python planners) or parsed ``printSettings()``."""
     if hasattr(p, "settings"):  # one line each: a log holds one setting per line (a newline made a log unreadable)
         return {" ".join(str(k).split()): " ".join(str(v).split()) for k, v in p.settings().items()}
@@ -220,8 +220,8 @@ class RecordingPlanner(ob.Planner):
     progress_period = 0.05
     """Seconds between the progress rows of a native planner exposing ``bestCost``/``numIterations``."""
 
-    def __init__(self, si, inner, max_iterations: int | None = None,
-                 read: Callable[[ob.State], object] | None = None, checker=None,
+    def __init__(self, si: ob.SpaceInformation, inner: ob.Planner, max_iterations: int | None = None,
+                 read: Callable[[ob.State], object] | None = None, checker: Any = None,
                  renew: Callable[[], ob.Planner] | None = None, deadline: float | None = None) -> None:
         # checked before ob.Planner.__init__: an exception after it leaves a half-built trampoline
         if max_iterations is not None and not hasattr(inner, "last_run_stats") and not hasattr(inner, "numIterations"):
@@ -267,7 +267,7 @@ class RecordingPlanner(ob.Planner):
             if self._ran:  # never solve a used single-use planner again: the run is recorded as a crash
                 self._setup_error = repr(exc)
 
-    def solve(self, ptc):  # noqa: D102 (OMPL override)
+    def solve(self, ptc: ob.PlannerTerminationCondition) -> ob.PlannerStatus:  # noqa: D102 (OMPL override)
         inner, cap = self.inner, self.max_iterations
         pdef = self.getProblemDefinition()
         t0 = time.perf_counter()

@@ -105,7 +105,7 @@ def package_versions() -> dict[str, str]:
     return out
 
 
-def format_value(v) -> str:
+def format_value(v: object) -> str:
     """A value as OMPL log text: '' for None, 0/1 for booleans, ``repr`` for floats, 'nan'/'inf'."""
     if v is None:
         return ""
