@@ -6,7 +6,7 @@ import pytest
 
 from dataclasses import dataclass
 
-from tpee_ompl.validation import MAX_SEED, check_seed, resolve_options
+from tpee_ompl.validation import MAX_SEED, as_float_array, check_seed, resolve_options
 
 
 @pytest.mark.parametrize("seed", [0, -5, MAX_SEED + 1, 10**20, 1.5, True, "3", None])
@@ -34,3 +34,9 @@ def test_options_resolve_to_defaults_or_the_given_ones_with_overrides_and_refuse
         resolve_options(_Options, {"a": 2}, {})
     with pytest.raises(TypeError):
         resolve_options(_Options, None, {"c": 3})
+
+
+@pytest.mark.parametrize("x", [10**400, [1, 10**400], "1", 1j, ["a"]])
+def test_as_float_array_refuses_what_is_not_a_real_float_with_a_value_error(x):
+    with pytest.raises(ValueError, match="things must be real numbers"):
+        as_float_array(x, "things")

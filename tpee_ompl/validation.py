@@ -79,14 +79,15 @@ def as_float_array(x: object, what: str) -> np.ndarray:
     """``x`` as a float array, raising ValueError (naming ``what``) for non-numeric input.
 
     Complex numbers (numpy would drop the imaginary part with a warning), strings (numpy would parse
-    ``"1"`` as 1.0) and dates are refused, not coerced; booleans and integers become floats.
+    ``"1"`` as 1.0) and dates are refused, not coerced; booleans and integers become floats (an integer too
+    large for a float is refused too).
     """
     try:
         a = np.asarray(x)
         if a.dtype.kind in "cUSMmV":
             raise TypeError(f"{a.dtype} values are not real numbers")
         return a.astype(float, copy=False)
-    except (TypeError, ValueError) as exc:
+    except (TypeError, ValueError, OverflowError) as exc:
         raise ValueError(f"{what} must be real numbers, got {x!r} ({exc})"[:400]) from exc
 
 

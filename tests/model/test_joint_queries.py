@@ -35,6 +35,8 @@ def test_a_saved_set_loads_back_equal_and_refuses_another_model(tmp_path):
     ('{"queries": []}', "not a joint query set"),
     ('{"format": "joint_queries/1", "queries": [{"id": 1, "label": "", "start": [1], "goal": ["x"]}]}', "list of numbers"),
     ('{"format": "joint_queries/1", "queries": [{"id": 1, "label": "", "start": [1], "goal": [1, 2]}]}', "start has 1"),
+    ('{"format": "joint_queries/1", "queries": [{"id": 1, "label": "", "start": [1' + "0" * 400 + '], "goal": [1]}]}',
+     "start must be finite numbers"),  # an integer too large for a float
 ])
 def test_malformed_sets_are_refused_naming_the_problem(tmp_path, text, match):
     p = tmp_path / "bad.json"

@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from ..files import atomic_write_text
+from ..validation import as_float_array
 from .queries import QuerySetError, check_set_model, query_entries, read_query_document
 from .robot_checker import RobotChecker
 
@@ -42,9 +43,9 @@ class JointQuery:
             raise ValueError(f"query {self.id}: label must be a string, got {self.label!r}")
         for name in ("start", "goal"):
             try:
-                a = np.array(getattr(self, name), dtype=float)
-            except (TypeError, ValueError) as exc:
-                raise ValueError(f"query {self.id}: {name} must be finite numbers, got {getattr(self, name)!r}") from exc
+                a = as_float_array(getattr(self, name), name).copy()
+            except ValueError as exc:
+                raise ValueError(f"query {self.id}: {name} must be finite numbers, got {getattr(self, name)!r}"[:300]) from exc
             if a.ndim != 1 or a.size == 0 or not np.all(np.isfinite(a)):
                 raise ValueError(f"query {self.id}: {name} must be a non-empty list of finite numbers, got {a!r}")
             a.setflags(write=False)

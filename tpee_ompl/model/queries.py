@@ -28,6 +28,7 @@ import numpy as np
 
 from ..files import atomic_write_text
 from ..resources import query_set_path
+from ..validation import as_float_array
 from .sectors import POSTURE_PRESETS, check_sector, cross_sector_trajectory, infer_sector
 from .wearer_arm import WearerArm
 
@@ -80,8 +81,8 @@ class Query:
             raise ValueError(f"query {self.id}: from_sector == to_sector == {self.from_sector}")
         for name, n in (("target_a", 3), ("target_b", 3), ("start", 4), ("goal", 4)):
             try:
-                a = np.array(getattr(self, name), dtype=float)
-            except (TypeError, ValueError, OverflowError) as exc:  # (an integer too large for a float)
+                a = as_float_array(getattr(self, name), name).copy()
+            except ValueError as exc:
                 raise ValueError(f"query {self.id}: {name} must be {n} finite numbers, got {getattr(self, name)!r}"[:300]) from exc
             if a.shape != (n,) or not np.all(np.isfinite(a)):
                 raise ValueError(f"query {self.id}: {name} must be {n} finite numbers, got {a!r}")
