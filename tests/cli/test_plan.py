@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import json
 
 import numpy as np
@@ -70,6 +71,28 @@ def test_track_jitter_on_a_boundary_causes_no_cross_sector_motion(capsys):
     assert main(["track", "--script", "jitter", "--duration", "5", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["events"]["cross-sector"] <= 1 and out["events"]["aim"] > 0
+
+
+def test_track_with_the_library_seeds_both_of_its_fallback_planners_with_seed(capsys, monkeypatch):
+    from tpee_ompl.cli import plan as plan_cli
+    from tpee_ompl.library import tracker
+
+    seeds = {}
+    real_drrt, real_default = plan_cli.dimension_rrt_planner, tracker.make_default_planner
+
+    @functools.wraps(real_drrt)  # the parser reads its flags' defaults from the signature
+    def drrt(robot, **kw):
+        seeds["dimension_rrt"] = kw.get("seed")
+        return real_drrt(robot, **kw)
+
+    def default(robot, **kw):
+        seeds["same_sector"] = kw.get("seed")
+        return real_default(robot, **kw)
+
+    monkeypatch.setattr(plan_cli, "dimension_rrt_planner", drrt)
+    monkeypatch.setattr(tracker, "make_default_planner", default)
+    assert main(["track", "--planner", "library", "--script", "jump", "--duration", "2", "--seed", "7", "--json"]) == 0
+    assert seeds == {"dimension_rrt": 7, "same_sector": 7}
 
 
 def test_plan_reports_its_samples_and_says_when_the_time_limit_came_before_the_sample_cap(capsys):

@@ -268,8 +268,10 @@ def cmd_track(args: argparse.Namespace) -> int:
     elif args.planner == "library":
         from ..library import PathLibrary
 
-        lib = PathLibrary.load(args.library, robot, plan=dimension_rrt_planner(robot, max_samples=args.samples))
-        planner = lib.as_planner()
+        lib = PathLibrary.load(args.library, robot,
+                               plan=dimension_rrt_planner(robot, max_samples=args.samples, seed=args.seed))
+        # same-sector re-aims have no demonstrations: the default planner's straight motion or RRTConnect, seeded
+        planner = lib.as_planner(same_sector=make_default_planner(robot, seed=args.seed, library=None))
     else:
         planner = make_default_planner(robot, seed=args.seed, library=args.library)
     stream = _scripted_targets(args.script, args.duration, args.rate)
