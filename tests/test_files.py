@@ -126,3 +126,10 @@ def test_a_folder_that_exists_or_can_be_made_passes_and_a_file_in_the_way_is_nam
         check_writable_folder(tmp_path / "f", "out")
     with pytest.raises(ValueError, match=r"^out .*: .*f is a file, not a folder"):
         check_writable_folder(tmp_path / "f" / "below", "out")
+
+
+def test_a_failed_write_of_a_new_file_leaves_no_part_file(tmp_path):
+    with pytest.raises(UnicodeEncodeError):
+        write_new_file(tmp_path / "x.txt", "a\ud800")  # a lone surrogate cannot be written as UTF-8
+    assert list(tmp_path.iterdir()) == []
+    assert write_new_file(tmp_path / "y.txt", "é") and (tmp_path / "y.txt").read_text(encoding="utf-8") == "é"

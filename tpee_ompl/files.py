@@ -135,7 +135,7 @@ def atomic_write_text(path: str | os.PathLike, text: str, *, force: bool = True)
 
 
 def write_new_file(target: str | os.PathLike, text: str) -> bool:
-    """Write ``text`` to ``target`` atomically and never over an existing file.
+    """Write ``text`` (UTF-8) to ``target`` atomically and never over an existing file.
 
     The text goes to a unique ``.part`` file first, then is hard-linked to ``target`` (which fails
     if ``target`` exists, even when two processes race, unlike a check before :func:`atomic_path`).
@@ -143,14 +143,15 @@ def write_new_file(target: str | os.PathLike, text: str) -> bool:
     """
     target = Path(target)
     tmp = target.with_name(f"{target.name}.{os.getpid()}.{time.monotonic_ns()}.part")
-    with open(tmp, "w") as f:
-        f.write(text)
-        f.flush()
-        os.fsync(f.fileno())
     try:
+        with open(tmp, "w", encoding="utf-8") as f:
+            f.write(text)
+            f.flush()
+            os.fsync(f.fileno())
         os.link(tmp, target)
         return True
     except FileExistsError:
         return False
     finally:
-        tmp.unlink()
+        with contextlib.suppress(FileNotFoundError):  # (open failed: nothing to remove)
+            tmp.unlink()
