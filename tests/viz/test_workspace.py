@@ -54,3 +54,9 @@ def test_workspace_sampling_settings_are_value_errors_naming_them(robot, kw, mat
 def test_sector_pointing_range_refuses_no_directions(robot):
     with pytest.raises(ValueError, match="n_dirs"):
         sector_pointing_range(robot, 1, n_dirs=0)  # warned "mean of empty slice" and drew nan %
+
+
+def test_a_refused_argument_leaves_no_folder_for_the_figure_behind(robot, tmp_path):
+    with pytest.raises(ValueError, match="n_samples"):
+        pointing_workspace(robot, 0, np.random.default_rng(0), tmp_path / "new" / "sub" / "ws.png")
+    assert list(tmp_path.iterdir()) == []

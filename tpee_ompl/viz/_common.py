@@ -94,15 +94,22 @@ def check_waypoints(robot: WearerArm, waypoints: Any) -> np.ndarray:
 
 # ---------------------------------------------------------------------------- files
 def output_path(out_path: str | os.PathLike, suffixes: tuple[str, ...] | None = None) -> Path:
-    """``out_path`` as a Path, its parent folders created; ValueError first (nothing made) when it is no path or,
-    with ``suffixes``, its name ends in none of them."""
+    """``out_path`` as a Path that can be written (:func:`~tpee_ompl.files.check_output_path`; its missing folders
+    are made when the file is written); ValueError when it is no path, cannot be written or, with ``suffixes``, its
+    name ends in none of them.  Nothing is created here: a later argument error leaves no empty folder behind."""
+    from ..files import check_output_path
+
     if not isinstance(out_path, (str, os.PathLike)) or not str(out_path):
         raise ValueError(f"out_path must be a file name, got {out_path!r}")
     out = Path(out_path)
-    if suffixes is not None and out.suffix.lower() not in suffixes:
+    if suffixes is not None:
+        _check_image_suffix(out, suffixes)
+    return check_output_path(out, force=True, what="figure file")
+
+
+def _check_image_suffix(out: Path, suffixes: tuple[str, ...]) -> None:
+    if out.suffix.lower() not in suffixes:
         raise ValueError(f"figure file {out}: give a name ending in an image suffix ({', '.join(suffixes[:4])}, ...)")
-    out.parent.mkdir(parents=True, exist_ok=True)
-    return out
 
 
 def image_suffixes() -> tuple[str, ...]:
@@ -122,8 +129,7 @@ def write_figure(fig: Figure, out: Path, dpi: int, **savefig_kwargs: Any) -> Pat
     """
     from ..files import atomic_path
 
-    if out.suffix.lower() not in image_suffixes():
-        raise ValueError(f"figure file {out}: give a name ending in an image suffix ({', '.join(image_suffixes()[:4])}, ...)")
+    _check_image_suffix(out, image_suffixes())
     with atomic_path(out) as tmp:
         fig.savefig(tmp, dpi=dpi, format=out.suffix[1:].lower(), **savefig_kwargs)
     log.info("wrote %s", out)
