@@ -61,6 +61,8 @@ def test_bad_scene_inputs_raise_with_a_message(robot, aimed):
         render_scene(robot, q, target=[1.0, 2.0])
     with pytest.raises(ValueError, match="shape"):
         render_scene(robot, q[:3])
+    with pytest.raises(ValueError, match="azim"):
+        render_scene(robot, q, azim=float("inf"))  # as save_scene: a non-finite angle drew an empty picture
 
 
 def test_a_figure_name_without_an_image_suffix_is_refused_before_any_folder_is_made(robot, tmp_path):

@@ -30,14 +30,15 @@ def new_axes(figsize: tuple[float, float] = (7.0, 7.0), dpi: int = 110) -> Axes:
     return fig.add_subplot(projection="3d")
 
 
-def check_view(elev: float, azim: float, dpi: int) -> None:
-    """The camera angles (degrees, finite) and the resolution (dots per inch, 1..2000); ValueError naming the bad one
-    (a NaN angle drew an empty picture)."""
+def check_view(elev: float, azim: float, dpi: int | None = None) -> None:
+    """The camera angles (degrees, finite) and the resolution (dots per inch, 1..2000; None: no file written);
+    ValueError naming the bad one (a NaN angle drew an empty picture)."""
     from ..validation import check_int, check_number
 
     check_number("elev (degrees)", elev)
     check_number("azim (degrees)", azim)
-    check_int("dpi", dpi, minimum=1, maximum=2000)
+    if dpi is not None:
+        check_int("dpi", dpi, minimum=1, maximum=2000)
 
 
 def set_view(ax: Axes, lo: np.ndarray, hi: np.ndarray, elev: float, azim: float) -> None:

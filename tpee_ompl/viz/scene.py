@@ -99,6 +99,7 @@ def render_scene(
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
     t0 = time.perf_counter()
+    check_view(elev, azim)
     q = robot.check_config(q)
     tgt = check_target(target)
     W = check_waypoints(robot, path) if path is not None else None
