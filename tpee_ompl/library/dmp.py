@@ -325,21 +325,16 @@ def learn_dmp(demo: np.ndarray, options: DMPOptions | None = None) -> DMP:
     acc = np.diff(v, axis=0) / dt
     f_target = acc - ay * (by * (g - demo[:-1]) - v[:-1])  # (P-1, D)
 
-    # (ii) LWR, eq. 17
-    x = canonical_phase(P, options.alpha_x)
+    # (ii) LWR, eq. 17 (the grid's phase, normalised basis, free and impulse responses: shared, cached)
+    x, phi, free, response = _grid(P, options)
     psi = basis_functions(x, N, options.alpha_x, options.width)
-    phi = psi / np.maximum(psi.sum(axis=1, keepdims=True), np.finfo(float).tiny)
     zeta = x[:-1, None] * S  # (P-1, D)
     num = psi[:-1].T @ (zeta * f_target)
     den = psi[:-1].T @ (zeta**2)
     weights = (num / np.maximum(den, np.finfo(float).tiny)).T  # (D, N)
 
-    # (iii) exact end: response at T of each unit basis forcing x phi_i (S = 1) is linear in w
-    free = _free_response(P, options)
-    # by time invariance, y(T) after a unit impulse at step k is the impulse response at step P-1-k
-    impulse = np.zeros((P, 1))
-    impulse[0] = 1.0
-    response = integrate(np.zeros(1), np.zeros(1), impulse, options)[:, 0]
+    # (iii) exact end: response at T of each unit basis forcing x phi_i (S = 1) is linear in w; by time
+    # invariance, y(T) after a unit impulse at step k is the impulse response at step P-1-k
     c = (response[:0:-1] * x[:-1]) @ phi[:-1]  # (N,)
     target = free[-1] * amplitude / S  # scaled: a(T); absolute: a(T) (g - y0)
     weights = weights + np.outer(target - weights @ c, c) / (c @ c)
