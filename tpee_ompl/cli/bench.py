@@ -19,7 +19,7 @@ from pathlib import Path
 
 from ..bench.config import CHECKERS, KNOWN_PLANNERS, CampaignConfig, check_planner_name
 from ..bench.problems import DEFAULT_PROBLEM, get_problem
-from ._common import Parser, nonempty, positive_int, seconds, seed
+from ._common import Parser, count, nonempty, positive_int, seconds, seed
 
 __all__ = ["DESCRIPTION", "EXAMPLE", "add_arguments", "build_parser", "config_from_args", "list_problems", "main",
            "register", "run"]
@@ -50,16 +50,6 @@ def _problem(text: str) -> str:
         return get_problem(text).name
     except ValueError as exc:
         raise argparse.ArgumentTypeError(str(exc)) from None
-
-
-def _count(text: str) -> int:
-    """argparse type: an int >= 0 (a count where 0 means none)."""
-    from ..validation import check_int
-
-    try:
-        return check_int("value", int(text), minimum=0)
-    except ValueError as exc:
-        raise argparse.ArgumentTypeError(f"must be an integer >= 0: {text}") from exc
 
 
 _OPTION_OF = {"sample_caps": "--samples", "anytime_budgets": "--anytime", "iteration_planners": "--planners",
@@ -103,11 +93,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--checkers", nargs="+", default=None, choices=CHECKERS,
                    help="motion validators; the first is the headline (default: the problem's: for the wearer "
                         f"{' '.join(_default('checkers'))}, for the generic problems discrete only)")
-    p.add_argument("--alt-checker-queries", type=_count, default=_default("alt_checker_queries"),
+    p.add_argument("--alt-checker-queries", type=count, default=_default("alt_checker_queries"),
                    help="run the non-headline validators on the first k queries only (default: all)")
     p.add_argument("--alt-checker-samples", type=positive_int, nargs="+", default=_default("alt_checker_caps"),
                    help="caps for the non-headline validators (default: all --samples)")
-    p.add_argument("--anytime-queries", type=_count, default=_default("anytime_queries"),
+    p.add_argument("--anytime-queries", type=count, default=_default("anytime_queries"),
                    help="anytime comparison on the first k queries only")
     p.add_argument("--max-queries", type=positive_int, default=_default("max_queries"),
                    help="use N queries, round-robin over the ordered sector pairs")
@@ -125,7 +115,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                         "scheduler (needs the dask extra: pip install 'tpee_ompl[dask]')")
     g.add_argument("--scheduler", metavar="tcp://HOST:PORT", type=nonempty, default=None, help="same as --dask tcp://HOST:PORT")
     g.add_argument("--dask-workers", type=positive_int, default=2, help="workers of --dask local (default: %(default)s)")
-    g.add_argument("--retries", type=_count, default=2, help="Dask retries of a task that raises (default: %(default)s)")
+    g.add_argument("--retries", type=count, default=2, help="Dask retries of a task that raises (default: %(default)s)")
     p.set_defaults(bench_prog=p.prog)
     p.add_argument("--resume", metavar="DIR", type=nonempty, default=None,
                    help="finish an interrupted campaign in DIR: run only its missing experiments (configuration "

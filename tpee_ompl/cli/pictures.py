@@ -137,18 +137,17 @@ def cmd_view(args: argparse.Namespace) -> int:
     """Interactive 3-D view in meshcat (optional extra `viewer`)."""
     import time
 
-    from ..signals import sigterm_as_keyboard_interrupt
     from ..viz.meshcat import view_meshcat
 
     robot = load_robot(args)
     q = np.array(args.q) if args.q is not None else np.radians(DEFAULT_SCENE_Q)
     with argument("--q"):
         q = robot.check_config(q)
-    with sigterm_as_keyboard_interrupt():  # a kill ends it as Ctrl-C does: meshcat's server process goes too
-        view_meshcat(robot, q, open_browser=not args.no_browser)
-        print("meshcat viewer running; press Ctrl-C to stop")
-        while True:
-            time.sleep(1.0)
+    # (main() runs every command with SIGTERM as Ctrl-C: a kill ends it and meshcat's server process goes too)
+    view_meshcat(robot, q, open_browser=not args.no_browser)
+    print("meshcat viewer running; press Ctrl-C to stop")
+    while True:
+        time.sleep(1.0)
 
 
 def register(sub: argparse._SubParsersAction, fmt: type) -> None:

@@ -143,11 +143,11 @@ class RobotChecker:
         loaded = self._load_model()
         self.model, self.gmodel = loaded.model, loaded.gmodel
         self.model_hash = loaded.model_hash
+        """Short SHA-256 of the URDF (+ SRDF, locked joints, obstacles): stored with query sets and path libraries."""
         self.circular = np.array([n in loaded.continuous for n in self.model.names[1:]], dtype=bool)
         """Per planned joint, True for a URDF continuous joint: its coordinate is an angle in [-pi, pi] that wraps
         around (an SO2 subspace in :func:`~tpee_ompl.planning.setup.make_space`)."""
         self.circular.setflags(write=False)
-        """Short SHA-256 of the URDF (+ SRDF, locked joints, obstacles): stored with query sets and path libraries."""
         self.data = self.model.createData()
         if isinstance(extra_points, str) or not all(isinstance(f, str) for f in extra_points):
             raise ValueError(f"extra_points must be a sequence of frame names, got {extra_points!r}")
