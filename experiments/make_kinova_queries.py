@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from make_panda_queries import save_robot_queries  # noqa: E402
+from make_panda_queries import check_outputs, save_robot_queries  # noqa: E402
 from mesh_robots import user_srdf  # noqa: E402
 
 from tpee_ompl.model.joint_queries import JointQuery  # noqa: E402
@@ -56,14 +56,18 @@ def main() -> None:
     ap.add_argument("-n", type=int, default=30, help="number of queries")
     ap.add_argument("--seed", type=int, default=2022)
     ap.add_argument("--check-time", type=float, default=1.0, help="RRTConnect seconds per query (0: skip)")
+    ap.add_argument("--force", action="store_true", help="replace --out and --srdf if they exist (the packaged files "
+                    "by default)")
     args = ap.parse_args()
+    check_outputs(ap, [args.out, args.srdf], args.force)
     urdf, dirs = kinova_files()
     user_srdf(urdf, None, dirs, args.srdf)
     print(f"wrote {args.srdf}")
     checker = kinova_posts(n_threads=1, srdf=args.srdf)
     queries = make_queries(checker, np.random.default_rng(args.seed), args.n)
     labels = {label: sum(q.label == label for q in queries) for label in ("across-pi", "within")}
-    save_robot_queries(args.out, queries, "kinova_posts", args.seed, checker, {"labels": labels}, args.check_time)
+    save_robot_queries(args.out, queries, "kinova_posts", args.seed, checker, {"labels": labels}, args.check_time,
+                       force=args.force)
     print(f"wrote {len(queries)} queries to {args.out} ({labels})")
 
 

@@ -22,6 +22,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
+from tpee_ompl.files import OutputExistsError, check_output_path
 from tpee_ompl.model.joint_queries import JointQuery, save_joint_queries
 from tpee_ompl.model.robots import PANDA_SHELF_REGIONS, PANDA_TOOL_FRAME, panda_region, panda_shelf
 from tpee_ompl.planning.paths import motion_states
@@ -103,14 +104,24 @@ def report_rrtconnect(checker, queries: list[JointQuery], seconds: float) -> dic
     return {"seconds": seconds, "solved": sum(solved), "of": len(solved)}
 
 
+def check_outputs(ap: argparse.ArgumentParser, paths: list[Path], force: bool) -> None:
+    """Refuse (a usage error, before any work) an output that exists unless ``force``: the defaults are the packaged
+    files."""
+    for path in paths:
+        try:
+            check_output_path(path, force=force)
+        except (OutputExistsError, ValueError) as exc:
+            ap.error(str(exc))
+
+
 def save_robot_queries(out: Path, queries: list[JointQuery], robot: str, seed: int, checker, details: dict,
-                       check_time: float) -> None:
+                       check_time: float, force: bool = True) -> None:
     """Write a robot's query set named ``robot``: its header names the robot, the margin, ``details`` and, when
     ``check_time`` > 0, how many queries RRTConnect solves in that time (:func:`report_rrtconnect`)."""
     extra = {"robot": robot, "security_margin": checker.security_margin, **details}
     if check_time > 0:
         extra["rrtconnect_solved"] = report_rrtconnect(checker, queries, check_time)
-    save_joint_queries(out, queries, name=robot, seed=seed, checker=checker, extra=extra)
+    save_joint_queries(out, queries, name=robot, seed=seed, checker=checker, extra=extra, force=force)
 
 
 def main() -> None:
@@ -121,14 +132,17 @@ def main() -> None:
     ap.add_argument("--per-region", type=int, default=12)
     ap.add_argument("--attempts", type=int, default=400, help="IK attempts per region at most")
     ap.add_argument("--check-time", type=float, default=1.0, help="RRTConnect seconds per query (0: skip)")
+    ap.add_argument("--force", action="store_true", help="replace --out if it exists (the packaged set by default)")
     args = ap.parse_args()
+    check_outputs(ap, [args.out], args.force)
     rng = np.random.default_rng(args.seed)
     checker = panda_shelf(n_threads=1)
     pools = region_configs(checker, rng, args.per_region, args.attempts)
     print("configurations per region:", {k: len(v) for k, v in pools.items()})
     queries = make_queries(checker, rng, args.n, pools)
     regions = {k: [list(lo), list(hi)] for k, (lo, hi) in PANDA_SHELF_REGIONS.items()}
-    save_robot_queries(args.out, queries, "panda_shelf", args.seed, checker, {"regions": regions}, args.check_time)
+    save_robot_queries(args.out, queries, "panda_shelf", args.seed, checker, {"regions": regions}, args.check_time,
+                       force=args.force)
     print(f"wrote {len(queries)} queries to {args.out}")
 
 

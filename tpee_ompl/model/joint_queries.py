@@ -76,10 +76,11 @@ class JointQuery:
 
 
 def save_joint_queries(path: str | os.PathLike, queries: Sequence[JointQuery], *, name: str, seed: int,
-                       checker: RobotChecker, extra: dict | None = None) -> Path:
+                       checker: RobotChecker, extra: dict | None = None, force: bool = True) -> Path:
     """Write a joint query set (atomically): format, name, seed, model_hash, joint_names, queries (+ extra).
 
-    Every query must have the checker's ``nq`` values."""
+    Every query must have the checker's ``nq`` values; an existing file is replaced, or with ``force=False``
+    refused (:class:`~tpee_ompl.files.OutputExistsError`)."""
     for q in queries:
         if q.start.size != checker.nq:
             raise ValueError(f"query {q.id} has {q.start.size} values, the checker {checker.nq}")
@@ -87,7 +88,7 @@ def save_joint_queries(path: str | os.PathLike, queries: Sequence[JointQuery], *
            "joint_names": list(checker.joint_names)}
     doc.update(extra or {})
     doc["queries"] = [q.to_dict() for q in queries]
-    return atomic_write_text(path, json.dumps(doc, indent=1) + "\n")
+    return atomic_write_text(path, json.dumps(doc, indent=1) + "\n", force=force)
 
 
 def load_joint_query_set(name_or_path: str | os.PathLike,

@@ -157,14 +157,16 @@ def save_queries(
     seed: int,
     model_hash: str,
     extra: dict | None = None,
+    force: bool = True,
 ) -> Path:
     """Write a versioned JSON query set: format_version, name, seed, model_hash, queries (+ extra keys).
 
-    Written atomically (:func:`tpee_ompl.files.atomic_write_text`); an existing file is replaced."""
+    Written atomically (:func:`tpee_ompl.files.atomic_write_text`); an existing file is replaced, or with
+    ``force=False`` refused (:class:`~tpee_ompl.files.OutputExistsError`)."""
     doc = {"format_version": FORMAT_VERSION, "name": name, "seed": seed, "model_hash": model_hash}
     doc.update(extra or {})
     doc["queries"] = [q.to_dict() for q in queries]
-    return atomic_write_text(path, json.dumps(doc, indent=1) + "\n")
+    return atomic_write_text(path, json.dumps(doc, indent=1) + "\n", force=force)
 
 
 def read_query_document(name_or_path: str | os.PathLike) -> tuple[Path, object]:
