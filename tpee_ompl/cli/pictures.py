@@ -45,7 +45,7 @@ DEFAULT_SCENE_TARGET = (4.0, 1.5, 1.9)
 
 def cmd_show(args: argparse.Namespace) -> int:
     """Draw the wearer, the arm at q and the line of sight to the target into a PNG."""
-    from ..viz._common import check_target, image_suffixes
+    from ..viz._common import image_suffixes, optional_target
     from ..viz.scene import save_scene
 
     check_output(args.output, "--output", args.force, image_suffixes())
@@ -55,7 +55,7 @@ def cmd_show(args: argparse.Namespace) -> int:
         q = robot.check_config(q)
     if args.target is not None:
         with argument("--target"):
-            target = check_target(args.target)
+            target = optional_target(args.target)
     else:
         target = np.array(DEFAULT_SCENE_TARGET) if args.q is None else None
     out = save_scene(robot, q, args.output, target=target, sectors=args.sectors)

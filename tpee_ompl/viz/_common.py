@@ -76,7 +76,7 @@ def clip_segment(a: np.ndarray, b: np.ndarray, lo: np.ndarray, hi: np.ndarray) -
 
 
 # ---------------------------------------------------------------------------- argument checks
-def check_target(target: Any) -> np.ndarray | None:
+def optional_target(target: Any) -> np.ndarray | None:
     """None, or the target as 3 finite floats (metres) within the model's MAX_TARGET_DISTANCE; ValueError otherwise."""
     from ..model.wearer_arm import check_target_point
 

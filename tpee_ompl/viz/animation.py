@@ -17,7 +17,7 @@ import numpy as np
 
 from ..files import atomic_path
 from ..validation import MAX_COUNT, check_int
-from ._common import check_target, check_view, check_waypoints, clip_segment, draw_floor, new_axes, output_path, set_view
+from ._common import check_view, check_waypoints, clip_segment, draw_floor, new_axes, optional_target, output_path, set_view
 from .meshes import arm_polygons, scene_mesh
 from .style import DEFAULT_AZIM, DEFAULT_ELEV, LOS_BLOCKED, LOS_CLEAR
 
@@ -120,7 +120,7 @@ def animate_path(
         writer = animation.FFMpegWriter(fps=fps)
     else:
         raise ValueError(f"unsupported animation format {out.suffix!r}: use .gif or .mp4")
-    ta, tb = check_target(target_a), check_target(target_b)
+    ta, tb = optional_target(target_a), optional_target(target_b)
     Q = resample_path(W, frames)
     valid = robot.are_valid(Q)
     trace = muzzle_trace(robot, Q)

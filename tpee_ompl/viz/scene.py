@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..model.sectors import SECTORS, posture_preset
-from ._common import (check_target, check_view, check_waypoints, clip_segment, draw_floor, image_suffixes, new_axes,
+from ._common import (check_view, check_waypoints, clip_segment, draw_floor, image_suffixes, new_axes, optional_target,
                       output_path, set_view, write_figure)
 from .animation import muzzle_trace, resample_path
 from .meshes import arm_polygons, scene_mesh
@@ -101,7 +101,7 @@ def render_scene(
     t0 = time.perf_counter()
     check_view(elev, azim)
     q = robot.check_config(q)
-    tgt = check_target(target)
+    tgt = optional_target(target)
     W = check_waypoints(robot, path) if path is not None else None
     if ax is None:
         ax = new_axes()
