@@ -2,7 +2,8 @@
 
 Exit codes (:func:`tpee_ompl.cli.main.main`): **2** for a usage error -- argparse's own, or a
 :class:`CliError` raised while the arguments are checked, before any work starts (a bad value, a
-missing input file, an output that exists without ``--force``); **1** for a runtime error -- anything
+missing input file, an output that exists without ``--force``), and for an optional extra that is not
+installed (an ImportError saying what to install); **1** for a runtime error -- anything
 raised once the work has started (a damaged library or query file, a model mismatch, a planner
 failure, an unexpected exception).  Either way: one line on stderr, no traceback (``-v`` adds it).
 

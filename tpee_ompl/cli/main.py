@@ -3,8 +3,9 @@
 One module per command group, each with ``register(sub, fmt)``: :mod:`.plan` (plan, aim, track),
 :mod:`.pictures` (show, animate, workspace, view), :mod:`.library` (library build|query|stats) and
 the bench group.  Every subcommand is one function.  Errors are one line on stderr, never a
-traceback (``-v`` adds it): exit code 2 for a usage error (argparse's, or a
-:class:`~tpee_ompl.cli._common.CliError` from the argument checks that run before any work), 1 for
+traceback (``-v`` adds it): exit code 2 for a usage error (argparse's, a
+:class:`~tpee_ompl.cli._common.CliError` from the argument checks that run before any work, or a missing
+optional extra: an ImportError saying what to install), 1 for
 an error at run time (a damaged input file, a model mismatch, a failure, anything unexpected),
 130 when interrupted (Ctrl-C, or SIGTERM, which every command handles as Ctrl-C), 141 without a word when
 the reader of its output went away (``tpee-ompl plan ... | head -1``), as a command killed by SIGPIPE.
