@@ -67,7 +67,13 @@ def test_bench_help_shows_an_example(capsys):
 def test_library_query_without_a_library_file_is_one_line(capsys, tmp_path):
     assert main(["library", "stats", "--library", str(tmp_path / "none.npz")]) == 2
     err = capsys.readouterr().err
-    assert "not found" in err and err.count("\n") == 1
+    assert "not found" in err and err.count("\n") == 1 and err.startswith("tpee-ompl library stats: error:")
+
+
+def test_library_query_index_without_a_query_set_is_a_usage_error(capsys):
+    assert main(["library", "query", "--index", "3", "--from", "1", "--to", "2", "--start", "0", "0", "0", "0",
+                 "--goal", "0", "0", "0", "0"]) == 2
+    assert "--index picks a query of --query-set" in capsys.readouterr().err
 
 
 def _raising(exc: BaseException):

@@ -136,11 +136,14 @@ def run_query(args: argparse.Namespace) -> int:
             queries = load_queries(args.query_set, default_robot())
         except FileNotFoundError as exc:
             raise CliError(f"--query-set: {exc}") from None
-        if args.index >= len(queries):
-            raise CliError(f"--index must be in 0..{len(queries) - 1} for query set {args.query_set!r}, got {args.index}")
-        q = queries[args.index]
+        k = 0 if args.index is None else args.index
+        if k >= len(queries):
+            raise CliError(f"--index must be in 0..{len(queries) - 1} for query set {args.query_set!r}, got {k}")
+        q = queries[k]
         start, goal, i, j = q.start, q.goal, q.from_sector, q.to_sector
     else:
+        if args.index is not None:
+            raise CliError("--index picks a query of --query-set: give --query-set NAME too")
         missing = [n for n in ("--from", "--to", "--start", "--goal") if n not in given]
         if missing:
             raise CliError(f"give --query-set NAME --index K, or all of --from --to --start --goal (missing {' '.join(missing)})")
@@ -227,7 +230,7 @@ def register(subparsers: argparse._SubParsersAction, formatter_class: type = arg
     q = sub.add_parser("query", help="answer one query", epilog=_QUERY_EXAMPLE, formatter_class=formatter_class)
     common(q)
     q.add_argument("--query-set", metavar="NAME", type=nonempty, help="take the query from a named set (e.g. planning_necessary)")
-    q.add_argument("--index", type=index, default=0, help="index in --query-set, from 0 (default 0)")
+    q.add_argument("--index", type=index, default=None, help="index in --query-set, from 0 (default 0)")
     q.add_argument("--from", dest="from_sector", type=sector, help="start sector (1-4)")
     q.add_argument("--to", dest="to_sector", type=sector, help="goal sector (1-4)")
     q.add_argument("--start", type=finite, nargs=4, metavar="Q", help="start configuration, 4 angles in rad")

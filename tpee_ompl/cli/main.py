@@ -54,8 +54,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         if unknown and not {"-h", "--help", "--version"} & set(argv):  # not "COMMAND is required"
             parser.error(f"unrecognized arguments: {' '.join(unknown)}")
     args, extra = parser.parse_known_args(argv)
+    command = _command_parser(parser, args)
     if extra:  # said by the (sub)command that was given them, as its other usage errors
-        _command_parser(parser, args).error(f"unrecognized arguments: {' '.join(extra)}")
+        command.error(f"unrecognized arguments: {' '.join(extra)}")
+    args.prog = command.prog  # "tpee-ompl library query": who says an error or an interruption
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
                         format="%(levelname)s %(name)s: %(message)s")
     try:
@@ -70,7 +72,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     except Exception as exc:  # noqa: BLE001 (the last resort: one line, never a traceback without -v)
         return _report(args, exc)
     except KeyboardInterrupt:
-        print(f"tpee-ompl {args.command}: interrupted", file=sys.stderr)
+        print(f"{args.prog}: interrupted", file=sys.stderr)
         return 130
     finally:
         gc.collect()  # break si <-> Python checker cycles before exit (nanobind leak warnings otherwise)
@@ -92,7 +94,7 @@ def _report(args: argparse.Namespace, exc: Exception) -> int:
     if args.verbose:
         traceback.print_exception(exc)
     code, message = _describe(exc)
-    print(f"tpee-ompl {args.command}: error: {message}", file=sys.stderr)
+    print(f"{args.prog}: error: {message}", file=sys.stderr)
     return code
 
 
