@@ -68,3 +68,38 @@ def test_a_setup_without_an_objective_gets_the_simplified_path_by_length():
     assert path_passes_motion_checks(si, ss.getSolutionPath())
     assert stats["best_cost"] <= stats["raw_cost"] < math.inf
     assert ss.getSolutionPath().length() == pytest.approx(stats["best_cost"])
+
+
+def test_an_inner_planner_on_another_space_information_is_refused(robot):
+    si = make_simple_setup(robot).getSpaceInformation()
+    other = make_simple_setup(robot).getSpaceInformation()
+    with pytest.raises(ValueError, match="another SpaceInformation"):
+        SimplifiedPlanner(si, og.RRTConnect(other))
+    with pytest.raises(ValueError, match="si must be"):
+        SimplifiedPlanner(make_simple_setup(robot), og.RRTConnect(si))
+
+
+def test_a_problem_without_a_start_state_is_invalid_start_not_a_crash(robot):
+    ss = make_simple_setup(robot)  # no start, no goal
+    si = ss.getSpaceInformation()
+    planner = SimplifiedPlanner(si, og.RRTConnect(si))
+    planner.setProblemDefinition(ss.getProblemDefinition())
+    assert planner.solve(0.1) == ob.PlannerStatus.INVALID_START
+
+
+def test_the_simplifier_starts_no_pass_after_the_termination_condition(robot, monkeypatch):
+    """OMPL's simplify(path, ptc) finishes one whole pass past ptc unless told atLeastOnce=False."""
+    calls = []
+    real = og.PathSimplifier.simplify
+
+    class Recording(og.PathSimplifier):
+        def simplify(self, path, ptc, at_least_once=True):
+            calls.append(at_least_once)
+            return real(self, path, ptc, at_least_once)
+
+    monkeypatch.setattr(og, "PathSimplifier", Recording)
+    q = load_queries("planning_necessary")[0]
+    ss = make_simple_setup(robot, q.start, q.goal)
+    si = ss.getSpaceInformation()
+    ss.setPlanner(SimplifiedPlanner(si, og.RRTConnect(si)))
+    assert ss.solve(5.0) == ob.PlannerStatus.EXACT_SOLUTION and calls == [False]

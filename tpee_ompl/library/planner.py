@@ -27,7 +27,7 @@ from ..model.queries import straight_motion
 from ..model.sectors import check_sector, infer_sector, posture_preset
 from ..planning.dimension_rrt import RELEASE_AFTER, DimensionRRT, DimensionRRTOptions, shortcuts_on
 from ..planning.paths import array_to_path, path_passes_motion_checks, state_to_array
-from ..planning.planner_base import PythonPlanner, planner_status, problem_objective
+from ..planning.planner_base import PythonPlanner, check_space_information, planner_status, problem_objective
 from ..planning.tpee import tpee_dimension_rrt
 from ..validation import sub_seed
 from .path_library import PathLibrary
@@ -80,8 +80,7 @@ class LibraryDimensionRRT(PythonPlanner):
         # everything is checked before ob.Planner.__init__ (an exception after it crashes at GC)
         if not isinstance(library, PathLibrary):
             raise ValueError(f"library must be a PathLibrary, got {type(library).__name__}")
-        if not isinstance(si, ob.SpaceInformation):
-            raise ValueError(f"si must be an ompl.base.SpaceInformation, got {type(si).__name__}")
+        check_space_information(si)
         space, nq = si.getStateSpace(), library.robot.nq
         if not isinstance(space, ob.RealVectorStateSpace) or space.getDimension() != nq:
             raise ValueError(f"LibraryDimensionRRT plans in the library robot's joint space, a RealVectorStateSpace({nq}) "

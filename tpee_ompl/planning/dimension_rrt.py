@@ -120,7 +120,7 @@ from .dimension_search import Search, SearchSettings
 from .goal_loop import GoalLoop, LoopLimits
 from .goal_runs import GoalRun, goal_states
 from .grouped_space import GroupedSpace
-from .planner_base import PythonPlanner, planner_status
+from .planner_base import PythonPlanner, check_space_information, planner_status
 from .search_checker import Checker
 from .solution_posting import SolutionPoster
 
@@ -179,8 +179,7 @@ class DimensionRRT(PythonPlanner):
         # Validate everything BEFORE super().__init__: an exception raised after it leaves a
         # half-constructed nanobind trampoline whose collection crashed the interpreter.
         opts = resolve_options(options, overrides)
-        if not isinstance(si, ob.SpaceInformation):
-            raise ValueError(f"si must be an ompl.base.SpaceInformation, got {type(si).__name__}")
+        check_space_information(si)
         grouped = GroupedSpace(si, opts.groups, opts.h, prescribed)
         rng_full = self._full_range(opts, grouped)
         initial = grouped.check_initial(initial_waypoints)

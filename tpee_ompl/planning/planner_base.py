@@ -15,7 +15,7 @@ from typing import Any
 
 from ompl import base as ob
 
-__all__ = ["PythonPlanner", "finite_state", "planner_status"]
+__all__ = ["PythonPlanner", "check_space_information", "finite_state", "planner_status"]
 
 log = logging.getLogger(__name__)
 
@@ -29,6 +29,14 @@ def finite_state(si: ob.SpaceInformation, state: ob.State) -> bool:
     """Whether every value of ``state`` is finite: its distance to itself is 0, not NaN, in any space
     (``si.satisfiesBounds`` lets NaN through, and a NaN state would reach the checker)."""
     return math.isfinite(si.distance(state, state))
+
+
+def check_space_information(si: object) -> ob.SpaceInformation:
+    """``si`` if it is an ``ob.SpaceInformation`` (a planner's first argument); ValueError naming what it is otherwise
+    (the bindings' own TypeError says nothing a user can act on)."""
+    if not isinstance(si, ob.SpaceInformation):
+        raise ValueError(f"si must be an ompl.base.SpaceInformation, got {type(si).__name__}")
+    return si
 
 
 def planner_status(code: Any) -> ob.PlannerStatus:

@@ -18,7 +18,7 @@ from ompl import base as ob
 from ompl import geometric as og
 
 from .paths import path_passes_motion_checks
-from .planner_base import PythonPlanner, planner_status, problem_objective
+from .planner_base import PythonPlanner, check_space_information, planner_status, problem_objective
 
 __all__ = ["SimplifiedPlanner"]
 
@@ -38,8 +38,11 @@ class SimplifiedPlanner(PythonPlanner):
     """
 
     def __init__(self, si: ob.SpaceInformation, inner: ob.Planner, name: str | None = None) -> None:
+        check_space_information(si)
         if not isinstance(inner, ob.Planner):
             raise ValueError(f"inner must be an ompl.base.Planner, got {type(inner).__name__}")
+        if inner.getSpaceInformation() is not si:  # its paths would be checked against another space's validity
+            raise ValueError(f"inner planner {inner.getName()} is built on another SpaceInformation than si")
         if name is not None and (not isinstance(name, str) or not name):
             raise ValueError(f"name must be a non-empty string, got {name!r}")
         super().__init__(si, name or f"{inner.getName()}Simplify")
@@ -67,6 +70,10 @@ class SimplifiedPlanner(PythonPlanner):
     def _solve(self, ptc: ob.PlannerTerminationCondition) -> ob.PlannerStatus:
         t0 = time.perf_counter()
         si, pdef = self.getSpaceInformation(), self.getProblemDefinition()
+        missing = "start state" if pdef.getStartStateCount() == 0 else "goal" if pdef.getGoal() is None else None
+        if missing:  # the inner planner would throw (a CRASH with a traceback)
+            log.error("%s: the problem has no %s", self.getName(), missing)
+            return planner_status(ob.PlannerStatus.INVALID_START if missing == "start state" else ob.PlannerStatus.INVALID_GOAL)
         self.inner.setProblemDefinition(pdef)
         if not self._inner_setup:  # the bindings expose setup() but not isSetup()
             self.inner.setup()
@@ -85,7 +92,8 @@ class SimplifiedPlanner(PythonPlanner):
             return planner_status(ob.PlannerStatus.EXACT_SOLUTION)
         path = og.PathGeometric(raw)
         t1 = time.perf_counter()
-        og.PathSimplifier(si, pdef.getGoal(), opt).simplify(path, ptc)
+        # atLeastOnce=False: no pass started after ptc holds (the bindings' default finishes one whole pass past it)
+        og.PathSimplifier(si, pdef.getGoal(), opt).simplify(path, ptc, False)
         stats["simplify_time"] = time.perf_counter() - t1
         cost = float(path.cost(opt).value())
         if cost < stats["raw_cost"] and path_passes_motion_checks(si, path):
