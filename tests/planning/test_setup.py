@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 from ompl import base as ob
@@ -10,6 +12,7 @@ from ompl import util as ou
 
 from tpee_ompl.planning.setup import BatchedMotionValidator, make_simple_setup, motion_check_step
 from tpee_ompl.planning.paths import motion_states, path_passes_motion_checks, path_to_array, set_state
+from tpee_ompl.model.queries import load_queries
 from tpee_ompl.model.wearer_arm import WearerArm
 from tpee_ompl.model.sectors import posture_preset
 
@@ -268,3 +271,19 @@ def test_a_robot_whose_screen_costs_more_than_it_saves_is_checked_densely_with_t
     A = rng.uniform(robot.lower, robot.upper, (60, robot.nq))
     B = np.clip(A + rng.normal(scale=0.3, size=A.shape), robot.lower, robot.upper)
     np.testing.assert_array_equal(validators["costly"].check_motions(A, B), validators["cheap"].check_motions(A, B))
+
+
+@pytest.mark.parametrize("validator", ["batched", "dense", "certified"])
+@pytest.mark.parametrize("bad", [math.nan, math.inf, -math.inf])
+def test_a_motion_to_a_non_finite_state_is_invalid_as_ompls_validator_says(robot, validator, bad):
+    """OMPL's DiscreteMotionValidator answers False; ours raised on the segment count of a NaN or inf motion."""
+    si = make_simple_setup(robot, motion_validator=validator).getSpaceInformation()
+    mv = si.getMotionValidator()
+    a = load_queries("planning_necessary")[0].start
+    b = a + np.r_[0.0, 0.0, 0.01, 0.0]
+    c = b.copy()
+    c[2] = bad
+    assert not si.checkMotion(set_state(si.allocState(), a), set_state(si.allocState(), c))
+    before = mv.motions_checked
+    assert mv.check_motions(np.stack([a, a, a]), np.stack([b, c, b])).tolist() == [True, False, True]
+    assert mv.motions_checked - before == 3

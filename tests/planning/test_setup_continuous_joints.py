@@ -174,3 +174,15 @@ def test_the_certified_validator_refuses_continuous_joints_by_name(tmp_path):
     robot = RobotChecker(_chain(tmp_path, MIXED))
     with pytest.raises(ValueError, match=r"certified motion validator .*continuous: \['j0', 'j3'\]"):
         make_simple_setup(robot, motion_validator="certified")
+
+
+@pytest.mark.parametrize("bad", [math.nan, math.inf])
+def test_a_motion_to_a_non_finite_state_is_invalid_in_a_compound_space(tmp_path, bad):
+    robot = RobotChecker(_chain(tmp_path, MIXED))
+    si = make_simple_setup(robot, motion_validator="batched").getSpaceInformation()
+    layout, mv = RealVectorLayout(si.getStateSpace()), si.getMotionValidator()
+    a, b = np.zeros(4), np.array([0.3, 0.2, -0.2, 0.1])
+    c = b.copy()
+    c[1] = bad
+    assert not si.checkMotion(layout.write(si.allocState(), a), layout.write(si.allocState(), c))
+    assert mv.check_motions(np.stack([a, a]), np.stack([c, b])).tolist() == [False, True]

@@ -31,7 +31,7 @@ from ompl import base as ob
 from ..model.robot_checker import RobotChecker
 from ..validation import check_int, check_number
 from .paths import state_to_array, unchecked_motion_states
-from .setup import BatchedMotionValidator
+from .setup import BatchedMotionValidator, finite_motions_checked
 
 __all__ = ["CertifiedMotionOptions", "ClearanceGroups", "CertifiedMotionValidator"]
 
@@ -227,16 +227,24 @@ class CertifiedMotionValidator(BatchedMotionValidator):
         return a + t[:, None] * u
 
     def checkMotion(self, s1: ob.State, s2: ob.State) -> bool:  # noqa: N802 (OMPL override)
-        """True if the motion s1 -> s2 is certified, or its uncertified part passes the dense check."""
+        """True if the motion s1 -> s2 is certified, or its uncertified part passes the dense check (False for a
+        NaN or inf end)."""
         a, b = state_to_array(s1, self._n), state_to_array(s2, self._n)
-        self.motions_checked += 1
-        return self._tally(self._decide([self.certify(a, b)])[0])
+        return bool(self.check_motions(a[None], b[None])[0])
 
     def check_motions(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
-        """Validity of many motions A[k] -> B[k]; their uncertified parts go to one batched call."""
+        """Validity of many motions A[k] -> B[k]; their uncertified parts go to one batched call (a motion with a
+        NaN or inf end is invalid)."""
         A, B = np.atleast_2d(np.asarray(A, dtype=float)), np.atleast_2d(np.asarray(B, dtype=float))
+        try:
+            return self._check_finite_motions(A, B)
+        except (ValueError, OverflowError):
+            return finite_motions_checked(A, B, self._check_finite_motions, self)
+
+    def _check_finite_motions(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
+        verdicts = [self.certify(a, b) for a, b in zip(A, B)]
         self.motions_checked += len(A)
-        return self._tally(np.array(self._decide([self.certify(a, b) for a, b in zip(A, B)]), dtype=bool))
+        return self._tally(np.array(self._decide(verdicts), dtype=bool))
 
     def _decide(self, verdicts: list[bool | np.ndarray]) -> list[bool]:
         dense = [v for v in verdicts if isinstance(v, np.ndarray) and len(v)]

@@ -21,7 +21,7 @@ checked links.**
 from __future__ import annotations
 
 import logging
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -148,16 +148,30 @@ class BatchedMotionValidator(ob.MotionValidator):
         return state_to_array(state, self._n) if self._layout is None else self._layout.read(state)
 
     def checkMotion(self, s1: ob.State, s2: ob.State) -> bool:  # noqa: N802 (OMPL override)
-        """True if every state along s1 -> s2 (excluding s1) is valid."""
+        """True if every state along s1 -> s2 (excluding s1) is valid (False for a NaN or inf end, as OMPL's
+        ``DiscreteMotionValidator`` answers)."""
         a, b = self.read_state(s1), self.read_state(s2)
         if self._layout is not None:
             return bool(self.check_motions(a[None], b[None])[0])
         self.motions_checked += 1
-        return self._tally(bool(self.all_valid([unchecked_motion_states(a, b, self.step, factor=self.factor())])[0]))
+        try:
+            states = unchecked_motion_states(a, b, self.step, factor=self.factor())
+        except (ValueError, OverflowError):  # the segment count of a NaN or inf motion (no cost when finite)
+            if np.isfinite(a).all() and np.isfinite(b).all():
+                raise
+            return False
+        return self._tally(bool(self.all_valid([states])[0]))
 
     def check_motions(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
-        """Validity of many motions A[k] -> B[k] (each excluding its start), batched together."""
+        """Validity of many motions A[k] -> B[k] (each excluding its start), batched together; a motion with a NaN
+        or inf end is invalid."""
         A, B = np.atleast_2d(A), np.atleast_2d(B)
+        try:
+            return self._check_finite_motions(A, B)
+        except (ValueError, OverflowError):
+            return finite_motions_checked(A, B, self._check_finite_motions, self)
+
+    def _check_finite_motions(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
         if self._layout is not None:
             return self._check_geodesics(A, B)
         S, counts = batched_motion_states(A, B, self.step, factor=self.factor())
@@ -176,6 +190,8 @@ class BatchedMotionValidator(ob.MotionValidator):
         step; at most ``step`` apart in the Euclidean joint metric), times the space's ``validSegmentCountFactor``
         (which OMPL's own validator does not apply to a compound space's subspaces: this one is stricter there)."""
         need = np.ceil(self._layout.leaf_distances(A, B) / self._leaf_steps).max(axis=-1)
+        if not np.isfinite(need).all():
+            raise ValueError("motion ends must be finite")
         return self.factor() * np.maximum(1, need).astype(np.int64)
 
     def _check_geodesics(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
@@ -210,6 +226,21 @@ class BatchedMotionValidator(ob.MotionValidator):
         ok = self.robot.are_valid(np.concatenate(chunks))
         bounds = np.cumsum([0] + [len(c) for c in chunks])
         return np.array([ok[bounds[k] : bounds[k + 1]].all() for k in range(len(chunks))], dtype=bool)
+
+
+def finite_motions_checked(A: np.ndarray, B: np.ndarray, check: Callable[[np.ndarray, np.ndarray], np.ndarray],
+                           validator: BatchedMotionValidator) -> np.ndarray:
+    """After ``check(A, B)`` raised: ``check`` of the motions whose ends are finite, False for the others (counted
+    as checked, as OMPL's ``DiscreteMotionValidator`` answers a NaN or inf end); the error again when every end is
+    finite (it was another)."""
+    finite = np.isfinite(A).all(axis=1) & np.isfinite(B).all(axis=1)
+    if finite.all():
+        raise
+    out = np.zeros(len(A), dtype=bool)
+    if finite.any():
+        out[finite] = check(A[finite], B[finite])
+    validator.motions_checked += int((~finite).sum())
+    return out
 
 
 def motion_counts(mv: ob.MotionValidator) -> tuple[int, int]:
