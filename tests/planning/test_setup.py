@@ -287,3 +287,17 @@ def test_a_motion_to_a_non_finite_state_is_invalid_as_ompls_validator_says(robot
     before = mv.motions_checked
     assert mv.check_motions(np.stack([a, a, a]), np.stack([b, c, b])).tolist() == [True, False, True]
     assert mv.motions_checked - before == 3
+
+
+def test_quieter_ompl_raises_the_level_for_its_block_only_and_never_lowers_it():
+    from tpee_ompl.planning.setup import quieter_ompl
+
+    before = ou.getLogLevel()
+    try:
+        for level, inside in ((ou.LOG_INFO, ou.LOG_WARN), (ou.LOG_NONE, ou.LOG_NONE)):
+            ou.setLogLevel(level)
+            with quieter_ompl():
+                assert ou.getLogLevel() == inside
+            assert ou.getLogLevel() == level
+    finally:
+        ou.setLogLevel(before)

@@ -29,7 +29,7 @@ from ompl import geometric as og
 from ompl import util as ou
 
 from ..planning.paths import path_to_array
-from ..planning.setup import motion_counts, valid_motion_fraction
+from ..planning.setup import motion_counts, quieter_ompl, valid_motion_fraction
 from .config import KNOWN_PLANNERS
 
 __all__ = [
@@ -167,14 +167,11 @@ def planner_settings(p: ob.Planner) -> dict[str, str]:
     """A planner's settings as text: its ``settings()`` (Python planners) or parsed ``printSettings()``."""
     if hasattr(p, "settings"):  # one line each: a log holds one setting per line (a newline made a log unreadable)
         return {" ".join(str(k).split()): " ".join(str(v).split()) for k, v in p.settings().items()}
-    level = ou.getLogLevel()
-    ou.setLogLevel(ou.LOG_ERROR)  # printSettings reads BIT*'s deprecated options, each getter warns; errors still show
     try:
-        return _parse_settings(p.printSettings())
+        with quieter_ompl(ou.LOG_ERROR):  # printSettings reads BIT*'s deprecated options, each getter warns
+            return _parse_settings(p.printSettings())
     except Exception:  # noqa: BLE001 (bindings differ per planner)
         return {}
-    finally:
-        ou.setLogLevel(level)
 
 
 class RecordingPlanner(ob.Planner):

@@ -113,13 +113,9 @@ def dimension_rrt_planner(
     any other path).  Returns the exact solution's (7, 4) waypoints (every segment passed
     ``si.checkMotion``), else None.
     """
-    from ompl import util as ou
-
     from ..planning.paths import path_to_array
-    from ..planning.setup import make_simple_setup
+    from ..planning.setup import make_simple_setup, quieter_ompl
     from ..planning.tpee import tpee_dimension_rrt
-
-    ou.setLogLevel(ou.LOG_WARN)
 
     def plan(
         start: np.ndarray, goal: np.ndarray, i: int, j: int, initial_waypoints: np.ndarray | None = None
@@ -135,7 +131,8 @@ def dimension_rrt_planner(
         if initial_waypoints is not None:
             planner.set_initial_waypoints(np.clip(np.asarray(initial_waypoints, dtype=float), robot.lower, robot.upper))
         ss.setPlanner(planner)
-        ss.solve(timeout)
+        with quieter_ompl():
+            ss.solve(timeout)
         if not ss.haveExactSolutionPath():
             return None
         W = path_to_array(ss.getSolutionPath(), robot.nq)

@@ -290,6 +290,23 @@ class Tracker:
         )
 
 
+_OMPL_SEED: list[int] = []
+"""The seed OMPL's random generator was given here: it takes one per process (later ones change nothing but make OMPL
+print an error)."""
+
+
+def _seed_ompl(seed: int) -> None:
+    """Seed OMPL's global random generator, once per process (:data:`_OMPL_SEED`); a later, other seed is logged."""
+    from ompl import util as ou
+
+    if not _OMPL_SEED:
+        ou.RNG.setSeed(seed)
+        _OMPL_SEED.append(seed)
+    elif seed != _OMPL_SEED[0]:
+        log.warning("OMPL's random generator takes one seed per process (%d here): seed %d changes nothing",
+                    _OMPL_SEED[0], seed)
+
+
 def make_default_planner(
     robot: WearerArm,
     *,
@@ -310,18 +327,16 @@ def make_default_planner(
     (:data:`~tpee_ompl.library.path_library.CHECK_STEP`, or the robot's motion step if smaller); raises RuntimeError if none is found.
     """
     from ompl import geometric as og
-    from ompl import util as ou
 
     from ..model.queries import straight_motion
     from ..planning.paths import path_to_array
-    from ..planning.setup import make_simple_setup
+    from ..planning.setup import make_simple_setup, quieter_ompl
     from .planner import LibraryDimensionRRT
 
     timeout = check_number("timeout (seconds)", timeout, low=0.0, low_open=True, high=MAX_SECONDS)
     library_time = check_number("library_time (seconds)", library_time, low=0.0, low_open=True, high=MAX_SECONDS)
-    ou.setLogLevel(ou.LOG_WARN)
     if seed is not None:
-        ou.RNG.setSeed(check_seed("seed", seed))  # once per process: later calls only warn
+        _seed_ompl(check_seed("seed", seed))
     step = motion_step(robot, CHECK_STEP)
     lib: PathLibrary | None = None
     if isinstance(library, PathLibrary):
@@ -332,6 +347,10 @@ def make_default_planner(
         lib = PathLibrary.load(default_library_path() if library == "default" else library, robot)
 
     def plan(start: np.ndarray, goal: np.ndarray, i: int, j: int) -> np.ndarray:
+        with quieter_ompl():  # no "Info:" line per tracker motion
+            return _plan(start, goal, i, j)
+
+    def _plan(start: np.ndarray, goal: np.ndarray, i: int, j: int) -> np.ndarray:
         if i != j and lib is not None:
             ss = make_simple_setup(robot, start, goal, joint_step=step)
             ss.setPlanner(LibraryDimensionRRT(ss.getSpaceInformation(), lib, i, j, seed=seed))

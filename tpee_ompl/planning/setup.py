@@ -20,13 +20,15 @@ checked links.**
 
 from __future__ import annotations
 
+import contextlib
 import logging
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from typing import TYPE_CHECKING
 
 import numpy as np
 from ompl import base as ob
 from ompl import geometric as og
+from ompl import util as ou
 
 from ..model.clearance_balls import SCREEN_COST_LIMIT, SCREEN_LEVELS, screened_all_valid, screened_lines_valid
 from ..model.robot_checker import RobotChecker
@@ -45,11 +47,24 @@ __all__ = [
     "make_simple_setup",
     "motion_check_step",
     "motion_counts",
+    "quieter_ompl",
     "valid_motion_fraction",
     "MOTION_VALIDATORS",
 ]
 
 log = logging.getLogger(__name__)
+
+
+@contextlib.contextmanager
+def quieter_ompl(level: ou.LogLevel = ou.LOG_WARN) -> Iterator[None]:
+    """OMPL's messages below ``level`` off inside the block (its "Info:" lines by default), then its level as it was:
+    a library function must not change the process-wide level of its caller (who may have chosen LOG_NONE)."""
+    before = ou.getLogLevel()
+    ou.setLogLevel(max(before, level, key=lambda v: v.value))
+    try:
+        yield
+    finally:
+        ou.setLogLevel(before)
 
 
 
