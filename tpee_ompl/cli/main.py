@@ -38,7 +38,7 @@ def get_argument_parser() -> argparse.ArgumentParser:
     parser = Parser(prog="tpee-ompl", description=__doc__.split("\n")[0].replace("``", ""))
     parser.add_argument("-v", "--verbose", action="store_true", help="log at INFO level")
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
-    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")  # required: main() says so after other errors
     fmt = argparse.RawDescriptionHelpFormatter
     for register in (register_plan, register_pictures, register_bench, register_library):
         register(sub, fmt)
@@ -48,15 +48,12 @@ def get_argument_parser() -> argparse.ArgumentParser:
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``tpee-ompl``; returns the exit code."""
     parser = get_argument_parser()
-    argv = list(sys.argv[1:] if argv is None else argv)
-    if not any(a in parser._subparsers._group_actions[0].choices for a in argv):  # noqa: SLF001
-        unknown = [a for a in argv if a.startswith("-") and a not in ("-v", "--verbose")]
-        if unknown and not {"-h", "--help", "--version"} & set(argv):  # not "COMMAND is required"
-            parser.error(f"unrecognized arguments: {' '.join(unknown)}")
     args, extra = parser.parse_known_args(argv)
     command = _command_parser(parser, args)
     if extra:  # said by the (sub)command that was given them, as its other usage errors
         command.error(f"unrecognized arguments: {' '.join(extra)}")
+    if args.command is None:
+        parser.error("the following arguments are required: COMMAND")
     args.prog = command.prog  # "tpee-ompl library query": who says an error or an interruption
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
                         format="%(levelname)s %(name)s: %(message)s")
