@@ -324,7 +324,9 @@ def make_default_planner(
     (:func:`tpee_ompl.model.queries.straight_motion`; within a sector a straight joint motion) when
     collision-free, else OMPL RRTConnect on :func:`tpee_ompl.planning.setup.make_simple_setup` for
     at most ``timeout`` seconds, simplified.  Every path is checked at the tracker's default step
-    (:data:`~tpee_ompl.library.path_library.CHECK_STEP`, or the robot's motion step if smaller); raises RuntimeError if none is found.
+    (:data:`~tpee_ompl.library.path_library.CHECK_STEP`, or the robot's motion step if smaller); raises
+    RuntimeError if none is found.  OMPL's log level is left as the caller set it (its "Info:" lines are off
+    while a motion is planned), and OMPL's generator is seeded once per process.
     """
     from ompl import geometric as og
 
