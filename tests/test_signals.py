@@ -6,7 +6,9 @@ import multiprocessing as mp
 import os
 import signal
 
-from tpee_ompl.signals import child_sigint, sigint_blocked_for_children, sigterm_as_keyboard_interrupt
+import pytest
+
+from tpee_ompl.signals import child_sigint, interrupts, sigint_blocked_for_children, sigterm_as_keyboard_interrupt
 
 
 def _report_sigint(conn) -> None:
@@ -41,3 +43,46 @@ def test_sigterm_within_the_block_interrupts_like_ctrl_c_and_the_handler_is_rest
     except KeyboardInterrupt:
         pass
     assert signal.getsignal(signal.SIGTERM) == before
+
+
+def _interrupt_in_a_weakref_callback(signum: int) -> None:
+    """A signal whose handler runs inside a weakref callback: Python prints "Exception ignored" and drops the
+    KeyboardInterrupt (matplotlib's callbacks while plots are drawn)."""
+    import weakref
+
+    class Node:
+        pass
+
+    node = Node()
+
+    def callback(_ref: object) -> None:
+        os.kill(os.getpid(), signum)
+        for _ in range(10_000):  # the handler runs between bytecodes, here
+            pass
+
+    ref = weakref.ref(node, callback)
+    del node
+    assert ref() is None
+
+
+@pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")  # Python's "Exception ignored"
+def test_an_interrupt_python_drops_is_still_counted() -> None:
+    with sigterm_as_keyboard_interrupt():
+        seen = interrupts()
+        for signum in (signal.SIGTERM, signal.SIGINT):
+            _interrupt_in_a_weakref_callback(signum)  # no KeyboardInterrupt reaches here
+        assert interrupts() == seen + 2
+
+
+def test_a_sigterm_while_children_start_is_held_until_they_have() -> None:
+    reached = []
+    with sigterm_as_keyboard_interrupt():
+        try:
+            with sigint_blocked_for_children():
+                os.kill(os.getpid(), signal.SIGTERM)
+                for _ in range(10_000):
+                    pass
+                reached.append(True)  # the block ran to its end
+        except KeyboardInterrupt:
+            reached.append("raised at the end")
+    assert reached == [True, "raised at the end"]

@@ -5,10 +5,14 @@ spawned a moment earlier is still importing (unpickling its task imports OMPL), 
 raised inside the bindings' import aborts it with a C++ ``terminate`` and a page of traceback.  Children
 started within :func:`sigint_blocked_for_children` begin with SIGINT blocked (the signal mask survives fork
 and exec); once running, each one says what SIGINT does to it with :func:`child_sigint`.  The parent's own
-SIGINT is held, not lost, while the block lasts (starting a process: milliseconds).
+SIGINT is held, not lost, while the block lasts (starting a process: milliseconds), and so is a SIGTERM
+handled by :func:`sigterm_as_keyboard_interrupt` (it raises when the block ends: a Dask cluster interrupted
+while it started left a traceback at exit).
 
 :func:`sigterm_as_keyboard_interrupt`: within it SIGTERM (``kill``, a cluster's scheduler) ends the work the
-way Ctrl-C does, so the same cleanup runs (finished logs kept, child processes ended).
+way Ctrl-C does, so the same cleanup runs (finished logs kept, child processes ended).  Both signals are
+also counted (:func:`interrupts`): Python drops an exception raised in a weakref callback or ``__del__``
+(matplotlib's, while plots are drawn), so a caller asks after the work whether one came.
 """
 
 from __future__ import annotations
@@ -19,7 +23,19 @@ import threading
 from collections.abc import Callable, Iterator
 from typing import Any
 
-__all__ = ["child_sigint", "sigint_blocked_for_children", "sigterm_as_keyboard_interrupt"]
+__all__ = ["child_sigint", "interrupts", "sigint_blocked_for_children", "sigterm_as_keyboard_interrupt"]
+
+_RECEIVED: list[int] = []
+"""Every SIGINT or SIGTERM the handler of :func:`sigterm_as_keyboard_interrupt` was called for, in order."""
+_HELD: list[int] = []
+"""Non-empty while children start (:func:`sigint_blocked_for_children`): a SIGTERM then waits for the block's end."""
+
+
+def interrupts() -> int:
+    """How many interrupts (SIGINT, SIGTERM) :func:`sigterm_as_keyboard_interrupt` has seen in this process: compare
+    the count before and after a piece of work to know whether one came, even one whose KeyboardInterrupt Python
+    dropped."""
+    return len(_RECEIVED)
 
 
 @contextlib.contextmanager
@@ -32,10 +48,15 @@ def sigint_blocked_for_children() -> Iterator[None]:
 
     resource_tracker.ensure_running()  # started on a spawn's first use, it unblocks SIGINT afterwards: start it first
     previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    _HELD.append(0)  # (a marker: SIGTERM's handler holds its signal while this is non-empty)
+    held = len(_RECEIVED)
     try:
         yield
     finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+        _HELD.pop()
+        signal.pthread_sigmask(signal.SIG_SETMASK, previous)  # a held SIGINT is delivered here
+        if len(_RECEIVED) > held and not _HELD:  # a SIGTERM came while the children started
+            raise KeyboardInterrupt(f"signal {_RECEIVED[-1]}")
 
 
 def child_sigint(handler: Callable[[int, Any], Any] | int) -> None:
@@ -48,16 +69,23 @@ def child_sigint(handler: Callable[[int, Any], Any] | int) -> None:
 
 @contextlib.contextmanager
 def sigterm_as_keyboard_interrupt() -> Iterator[None]:
-    """Within the block, SIGTERM raises KeyboardInterrupt like Ctrl-C (main thread only; a no-op elsewhere)."""
+    """Within the block, SIGTERM raises KeyboardInterrupt like Ctrl-C, and both are counted (:func:`interrupts`);
+    main thread only, a no-op elsewhere."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
 
     def handler(signum: int, frame: object) -> None:
+        _RECEIVED.append(signum)
+        if signum == signal.SIGTERM and _HELD:  # children are starting: raised when they have (as SIGINT's mask does)
+            return
         raise KeyboardInterrupt(f"signal {signum}")
 
     previous = signal.signal(signal.SIGTERM, handler)
+    previous_int = signal.signal(signal.SIGINT, handler) if signal.getsignal(signal.SIGINT) is signal.default_int_handler else None
     try:
         yield
     finally:
         signal.signal(signal.SIGTERM, previous)
+        if previous_int is not None:
+            signal.signal(signal.SIGINT, previous_int)

@@ -204,3 +204,38 @@ def test_an_interrupt_while_the_database_is_built_names_the_campaign_to_resume(q
                  "--no-progress"])
     (folder,) = tmp_path.iterdir()
     assert code == 130 and f"--resume {folder}" in capsys.readouterr().err
+
+
+@pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")  # Python's "Exception ignored"
+def test_an_interrupt_python_drops_while_plots_are_drawn_still_ends_the_campaign_as_interrupted(
+        query_file, tmp_path, monkeypatch, capsys):
+    """A SIGTERM whose KeyboardInterrupt lands in a weakref callback (matplotlib's) was lost: exit 0, and
+    ``campaign.json`` said "interrupted": false with the plots missing."""
+    import os
+    import weakref
+
+    from tpee_ompl.bench import plots
+
+    class Node:
+        pass
+
+    def make_plots(*args, **kwargs):
+        node = Node()
+
+        def callback(_ref):
+            os.kill(os.getpid(), signal.SIGTERM)
+            for _ in range(10_000):
+                pass
+
+        ref = weakref.ref(node, callback)
+        del node
+        assert ref() is None
+        return []
+
+    monkeypatch.setattr(plots, "make_plots", make_plots)
+    code = main(["--queries", str(query_file), "--max-queries", "1", "--samples", "20", "--anytime", "--planners",
+                 STANDIN, "RRTstar", "--checkers", "batched", "--workers", "1", "--out", str(tmp_path),
+                 "--no-progress"])
+    (folder,) = tmp_path.iterdir()
+    assert code == 130 and f"--resume {folder}" in capsys.readouterr().err
+    assert json.loads((folder / "campaign.json").read_text())["interrupted"] is True

@@ -127,6 +127,40 @@ def test_sigterm_ends_any_command_as_ctrl_c_does(monkeypatch, capsys):
     assert signal.getsignal(signal.SIGTERM) == before
 
 
+@pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")  # Python's "Exception ignored"
+@pytest.mark.parametrize("then", ["returns", "raises ImportError"])
+def test_an_interrupt_python_dropped_or_turned_into_another_error_still_exits_130(monkeypatch, capsys, then):
+    """A signal whose KeyboardInterrupt lands in a weakref callback (matplotlib's, while plots are drawn) is dropped
+    by Python, and one that stops an import can come back as an ImportError: both used to end with 0 or 1."""
+    import os
+    import signal
+    import weakref
+
+    import tpee_ompl.cli.plan as plan
+
+    class Node:
+        pass
+
+    def command(args):
+        node = Node()
+
+        def callback(_ref):
+            os.kill(os.getpid(), signal.SIGTERM)
+            for _ in range(10_000):
+                pass
+
+        ref = weakref.ref(node, callback)
+        del node
+        assert ref() is None
+        if then == "raises ImportError":
+            raise ImportError("initialization failed")
+        return 0
+
+    monkeypatch.setattr(plan, "cmd_aim", command)
+    assert main(["aim", "--target", "5", "2", "1.5"]) == 130
+    assert capsys.readouterr().err.strip().endswith("tpee-ompl aim: interrupted")
+
+
 @pytest.mark.parametrize("value", ["-1e6", "-1.5E+2", "-.5e-1", "-3"])
 def test_negative_numbers_in_any_notation_are_values_not_options(value):
     from tpee_ompl.cli.main import get_argument_parser

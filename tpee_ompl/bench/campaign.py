@@ -37,7 +37,7 @@ from .config import CampaignConfig, CampaignResult
 from .database import build_database, set_aside_broken_logs
 from .experiment import experiment_specs, log_name, run_query_task
 from ..files import check_writable_folder, write_new_file
-from ..signals import sigterm_as_keyboard_interrupt
+from ..signals import interrupts, sigterm_as_keyboard_interrupt
 from .results import append_json_line, make_results_dir, package_versions, utc_now, write_json
 
 if TYPE_CHECKING:  # hints only: the model imports pinocchio, the executors are imported when a campaign runs
@@ -379,10 +379,24 @@ def _execute_locked(directory: Path, meta: dict, executor, on_task_done, report:
                     executor.shutdown(cancel=True)
                 except KeyboardInterrupt as exc:  # a second interrupt: say which campaign to resume
                     raise CampaignInterrupted(directory) from exc
+        seen = interrupts()
         try:
-            return _finish(directory, meta, executor, failed, broken, interrupted, report, time.perf_counter() - t0)
+            result = _finish(directory, meta, executor, failed, broken, interrupted, report, time.perf_counter() - t0)
         except KeyboardInterrupt as exc:  # a second interrupt: say which campaign to resume
+            _mark_interrupted(directory, meta)
             raise CampaignInterrupted(directory) from exc
+        if interrupts() > seen:  # one whose KeyboardInterrupt Python dropped (raised in matplotlib's weakref callbacks)
+            _mark_interrupted(directory, meta)
+            raise CampaignInterrupted(directory)
+        return result
+
+
+def _mark_interrupted(directory: Path, meta: dict) -> None:
+    """Say in ``campaign.json`` that the campaign was interrupted while its database, report or plots were made
+    (``--resume`` makes them again)."""
+    meta["interrupted"] = True
+    with contextlib.suppress(OSError):
+        write_json(directory / "campaign.json", meta)
 
 
 def _finish(directory: Path, meta: dict, executor, failed: list[dict], broken: list, interrupted: bool, report: bool,

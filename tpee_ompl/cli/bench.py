@@ -19,6 +19,7 @@ from pathlib import Path
 
 from ..bench.config import CHECKERS, KNOWN_PLANNERS, CampaignConfig, check_planner_name
 from ..bench.problems import DEFAULT_PROBLEM, get_problem
+from ..signals import interrupts
 from ._common import Parser, count, nonempty, positive_int, seconds, seed
 
 __all__ = ["DESCRIPTION", "EXAMPLE", "add_arguments", "build_parser", "config_from_args", "list_problems", "main",
@@ -210,6 +211,7 @@ def run(args: argparse.Namespace) -> int:
     except (ValueError, FileNotFoundError, ImportError) as exc:
         print(f"{prog}: error: {_user_message(exc)}", file=sys.stderr)
         return 1 if isinstance(exc, QuerySetError) else 2  # a damaged query file is a runtime error, as in ``plan``
+    seen = interrupts()
     try:
         if args.resume:
             result = resume_campaign(args.resume, executor=executor, workers=args.workers,
@@ -221,6 +223,10 @@ def run(args: argparse.Namespace) -> int:
         print(f"{prog}: interrupted; finished logs are kept: finish the campaign with --resume {where}", file=sys.stderr)
         return 130
     except Exception as exc:  # noqa: BLE001 (a runtime failure: one line, no traceback unless -v)
+        if interrupts() > seen:  # the interrupt came back as another error (an ImportError of an import it stopped)
+            print(f"{prog}: interrupted; finished logs are kept: finish the campaign with --resume "
+                  f"{args.resume or 'DIR'}", file=sys.stderr)
+            return 130
         if getattr(args, "verbose", False):
             traceback.print_exc()
         print(f"{prog}: error: {type(exc).__name__}: {_user_message(exc)}", file=sys.stderr)
@@ -231,8 +237,8 @@ def run(args: argparse.Namespace) -> int:
               f"finish it with --resume {result.directory}")
         return 130
     if result.failed_tasks or result.skipped_logs:
-        lost = "; ".join(f"query {f['query_id']} ({f['reason']}, {len(f['missing_logs'])} experiment(s))"
-                         for f in result.failed_tasks)
+        lost = "; ".join(f"query {f['query_id']} ({' '.join(str(f['reason']).split())}, "
+                         f"{len(f['missing_logs'])} experiment(s))" for f in result.failed_tasks)  # one line
         bad = ", ".join(p.name for p in result.skipped_logs)
         print(f"{prog}: error: campaign finished incomplete: {len(result.failed_tasks)} query(ies) lost"
               + (f": {lost}" if lost else "") + (f"; unreadable logs: {bad}" if bad else "")

@@ -23,7 +23,7 @@ import traceback
 from collections.abc import Sequence
 
 from .._version import __version__
-from ..signals import sigterm_as_keyboard_interrupt
+from ..signals import interrupts, sigterm_as_keyboard_interrupt
 from ._common import CliError, Parser
 from .bench import register as register_bench
 from .library import register as register_library
@@ -57,16 +57,22 @@ def main(argv: Sequence[str] | None = None) -> int:
     args.prog = command.prog  # "tpee-ompl library query": who says an error or an interruption
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
                         format="%(levelname)s %(name)s: %(message)s")
+    seen = interrupts()
     try:
         with sigterm_as_keyboard_interrupt():  # kill / a scheduler: the same cleanup as Ctrl-C (temporary files, workers)
             code = int(args.func(args) or 0)
             sys.stdout.flush()  # a closed pipe shows here, not in the interpreter's own flush at exit
+            if interrupts() > seen and code != 130:  # its KeyboardInterrupt was dropped (raised in a weakref callback)
+                raise KeyboardInterrupt
             return code
     except BrokenPipeError as exc:
         if _stdout_gone():
             return 141
         return _report(args, exc)  # another pipe (a worker's): an error like any other
     except Exception as exc:  # noqa: BLE001 (the last resort: one line, never a traceback without -v)
+        if interrupts() > seen:  # the interrupt came back as another error (an ImportError of an import it stopped)
+            print(f"{args.prog}: interrupted", file=sys.stderr)
+            return 130
         return _report(args, exc)
     except KeyboardInterrupt:
         print(f"{args.prog}: interrupted", file=sys.stderr)
