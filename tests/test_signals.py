@@ -7,6 +7,7 @@ import os
 import signal
 
 import pytest
+from helpers.interrupts import interrupt_in_a_weakref_callback
 
 from tpee_ompl.signals import child_sigint, interrupts, sigint_blocked_for_children, sigterm_as_keyboard_interrupt
 
@@ -45,32 +46,12 @@ def test_sigterm_within_the_block_interrupts_like_ctrl_c_and_the_handler_is_rest
     assert signal.getsignal(signal.SIGTERM) == before
 
 
-def _interrupt_in_a_weakref_callback(signum: int) -> None:
-    """A signal whose handler runs inside a weakref callback: Python prints "Exception ignored" and drops the
-    KeyboardInterrupt (matplotlib's callbacks while plots are drawn)."""
-    import weakref
-
-    class Node:
-        pass
-
-    node = Node()
-
-    def callback(_ref: object) -> None:
-        os.kill(os.getpid(), signum)
-        for _ in range(10_000):  # the handler runs between bytecodes, here
-            pass
-
-    ref = weakref.ref(node, callback)
-    del node
-    assert ref() is None
-
-
 @pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")  # Python's "Exception ignored"
 def test_an_interrupt_python_drops_is_still_counted() -> None:
     with sigterm_as_keyboard_interrupt():
         seen = interrupts()
         for signum in (signal.SIGTERM, signal.SIGINT):
-            _interrupt_in_a_weakref_callback(signum)  # no KeyboardInterrupt reaches here
+            interrupt_in_a_weakref_callback(signum)  # no KeyboardInterrupt reaches here
         assert interrupts() == seen + 2
 
 

@@ -192,6 +192,12 @@ def test_a_campaign_already_running_in_another_process_is_not_resumed_a_second_t
     assert resume_campaign(res.directory, report=False, progress_bar=False).database is not None  # once free
 
 
+def _one_query_campaign(query_file: Path, out: Path) -> list[str]:
+    """``tpee-ompl bench`` arguments of a campaign of one query, 20 samples, the stand-in planner and RRT*."""
+    return ["--queries", str(query_file), "--max-queries", "1", "--samples", "20", "--anytime", "--planners", STANDIN,
+            "RRTstar", "--checkers", "batched", "--workers", "1", "--out", str(out), "--no-progress"]
+
+
 def test_an_interrupt_while_the_database_is_built_names_the_campaign_to_resume(query_file, tmp_path, monkeypatch, capsys):
     from tpee_ompl.bench import campaign
 
@@ -199,9 +205,7 @@ def test_an_interrupt_while_the_database_is_built_names_the_campaign_to_resume(q
         raise KeyboardInterrupt
 
     monkeypatch.setattr(campaign, "build_database", interrupted)
-    code = main(["--queries", str(query_file), "--max-queries", "1", "--samples", "20", "--anytime", "--planners",
-                 STANDIN, "RRTstar", "--checkers", "batched", "--workers", "1", "--out", str(tmp_path),
-                 "--no-progress"])
+    code = main(_one_query_campaign(query_file, tmp_path))
     (folder,) = tmp_path.iterdir()
     assert code == 130 and f"--resume {folder}" in capsys.readouterr().err
 
@@ -211,31 +215,16 @@ def test_an_interrupt_python_drops_while_plots_are_drawn_still_ends_the_campaign
         query_file, tmp_path, monkeypatch, capsys):
     """A SIGTERM whose KeyboardInterrupt lands in a weakref callback (matplotlib's) was lost: exit 0, and
     ``campaign.json`` said "interrupted": false with the plots missing."""
-    import os
-    import weakref
+    from helpers.interrupts import interrupt_in_a_weakref_callback
 
     from tpee_ompl.bench import plots
 
-    class Node:
-        pass
-
     def make_plots(*args, **kwargs):
-        node = Node()
-
-        def callback(_ref):
-            os.kill(os.getpid(), signal.SIGTERM)
-            for _ in range(10_000):
-                pass
-
-        ref = weakref.ref(node, callback)
-        del node
-        assert ref() is None
+        interrupt_in_a_weakref_callback()
         return []
 
     monkeypatch.setattr(plots, "make_plots", make_plots)
-    code = main(["--queries", str(query_file), "--max-queries", "1", "--samples", "20", "--anytime", "--planners",
-                 STANDIN, "RRTstar", "--checkers", "batched", "--workers", "1", "--out", str(tmp_path),
-                 "--no-progress"])
+    code = main(_one_query_campaign(query_file, tmp_path))
     (folder,) = tmp_path.iterdir()
     assert code == 130 and f"--resume {folder}" in capsys.readouterr().err
     assert json.loads((folder / "campaign.json").read_text())["interrupted"] is True

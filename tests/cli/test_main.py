@@ -132,26 +132,12 @@ def test_sigterm_ends_any_command_as_ctrl_c_does(monkeypatch, capsys):
 def test_an_interrupt_python_dropped_or_turned_into_another_error_still_exits_130(monkeypatch, capsys, then):
     """A signal whose KeyboardInterrupt lands in a weakref callback (matplotlib's, while plots are drawn) is dropped
     by Python, and one that stops an import can come back as an ImportError: both used to end with 0 or 1."""
-    import os
-    import signal
-    import weakref
+    from helpers.interrupts import interrupt_in_a_weakref_callback
 
     import tpee_ompl.cli.plan as plan
 
-    class Node:
-        pass
-
     def command(args):
-        node = Node()
-
-        def callback(_ref):
-            os.kill(os.getpid(), signal.SIGTERM)
-            for _ in range(10_000):
-                pass
-
-        ref = weakref.ref(node, callback)
-        del node
-        assert ref() is None
+        interrupt_in_a_weakref_callback()
         if then == "raises ImportError":
             raise ImportError("initialization failed")
         return 0
