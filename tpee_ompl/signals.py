@@ -82,7 +82,8 @@ def sigterm_as_keyboard_interrupt() -> Iterator[None]:
         raise KeyboardInterrupt(f"signal {signum}")
 
     previous = signal.signal(signal.SIGTERM, handler)
-    previous_int = signal.signal(signal.SIGINT, handler) if signal.getsignal(signal.SIGINT) is signal.default_int_handler else None
+    default_int = signal.getsignal(signal.SIGINT) is signal.default_int_handler  # (not a handler of someone else's)
+    previous_int = signal.signal(signal.SIGINT, handler) if default_int else None
     try:
         yield
     finally:

@@ -73,7 +73,8 @@ class SimplifiedPlanner(PythonPlanner):
         missing = "start state" if pdef.getStartStateCount() == 0 else "goal" if pdef.getGoal() is None else None
         if missing:  # the inner planner would throw (a CRASH with a traceback)
             log.error("%s: the problem has no %s", self.getName(), missing)
-            return planner_status(ob.PlannerStatus.INVALID_START if missing == "start state" else ob.PlannerStatus.INVALID_GOAL)
+            return planner_status(ob.PlannerStatus.INVALID_START if missing == "start state"
+                                  else ob.PlannerStatus.INVALID_GOAL)
         self.inner.setProblemDefinition(pdef)
         if not self._inner_setup:  # the bindings expose setup() but not isSetup()
             self.inner.setup()
