@@ -46,12 +46,14 @@ def inputs(tmp_path_factory, robot) -> Path:
     (d / "bad_campaign" / "campaign.json").write_text('{"config": ')
     (d / "list_campaign").mkdir()
     (d / "list_campaign" / "campaign.json").write_text("[]")
-    meta = {"config": {"queries": None}, "query_set": "good", "expected_experiments": 1,
+    meta = {"config": {"queries": None, "seed": 1}, "query_set": "good", "expected_experiments": 1,
             "query_data": [{"start": [0.0] * 4, "goal": [0.0] * 4}]}  # no id
     (d / "bad_query_data").mkdir()
     (d / "bad_query_data" / "campaign.json").write_text(json.dumps(meta))
     (d / "config_list").mkdir()
     (d / "config_list" / "campaign.json").write_text(json.dumps({**meta, "config": [1, 2]}))
+    (d / "no_seed").mkdir()
+    (d / "no_seed" / "campaign.json").write_text(json.dumps({**meta, "config": {"queries": None}}))
     return d
 
 
@@ -121,6 +123,7 @@ CASES = [
     ("name-too-long", ["--name", "x" * 300], 2, ["--name", "234 bytes"]),
     ("resume-bad-query-data", ["--resume", "{in}/bad_query_data"], 2, ["--resume", "query_data", "entry 0"]),
     ("resume-config-a-list", ["--resume", "{in}/config_list"], 2, ["--resume", "config"]),
+    ("resume-config-without-seed", ["--resume", "{in}/no_seed"], 2, ["--resume", "no seed"]),
 ]
 
 

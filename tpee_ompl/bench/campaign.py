@@ -238,6 +238,8 @@ def load_campaign(directory: str | os.PathLike) -> dict:
         raise ValueError(f"resume {directory}: written by an older version (no query_data): cannot resume")
     if not isinstance(meta["config"], dict):
         raise ValueError(f"resume {directory}: campaign.json has a bad config (not an object)")
+    if "seed" not in meta["config"]:  # a default would silently run other queries' runs than the campaign's
+        raise ValueError(f"resume {directory}: campaign.json's config has no seed (every query's runs derive from it)")
     meta["config"].setdefault("problem", "wearer")  # written before campaigns had problems
     try:
         config = CampaignConfig(**{k: tuple(v) if isinstance(v, list) else v for k, v in meta["config"].items()})
