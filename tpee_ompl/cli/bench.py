@@ -219,14 +219,10 @@ def run(args: argparse.Namespace) -> int:
         else:
             result = run_campaign(config, executor=executor, progress_bar=not args.no_progress, plan=plan)
     except KeyboardInterrupt as exc:  # a second Ctrl-C while the database was built
-        where = getattr(exc, "directory", None) or args.resume or "DIR"
-        print(f"{prog}: interrupted; finished logs are kept: finish the campaign with --resume {where}", file=sys.stderr)
-        return 130
+        return _interrupted(prog, getattr(exc, "directory", None) or args.resume)
     except Exception as exc:  # noqa: BLE001 (a runtime failure: one line, no traceback unless -v)
         if interrupts() > seen:  # the interrupt came back as another error (an ImportError of an import it stopped)
-            print(f"{prog}: interrupted; finished logs are kept: finish the campaign with --resume "
-                  f"{args.resume or 'DIR'}", file=sys.stderr)
-            return 130
+            return _interrupted(prog, args.resume)
         if getattr(args, "verbose", False):
             traceback.print_exc()
         print(f"{prog}: error: {type(exc).__name__}: {_user_message(exc)}", file=sys.stderr)
@@ -245,6 +241,13 @@ def run(args: argparse.Namespace) -> int:
               + f"; run them again with --resume {result.directory}", file=sys.stderr)
         return 1
     return 0
+
+
+def _interrupted(prog: str, where: object) -> int:
+    """Say that the campaign was interrupted and how to finish it; the exit code 130."""
+    print(f"{prog}: interrupted; finished logs are kept: finish the campaign with --resume {where or 'DIR'}",
+          file=sys.stderr)
+    return 130
 
 
 def _print_result(result) -> None:
