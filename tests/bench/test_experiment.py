@@ -73,3 +73,44 @@ def test_a_one_state_answer_short_of_the_goal_has_no_path_columns_and_one_at_the
     assert at_goal["raw_length REAL"] == 0.0 and at_goal["path_valid_dense INTEGER"] == 1
     two = _path_properties(si, {"waypoints": np.array([start, goal]), "best_cost": None}, start, goal, (0, 1), layout)
     assert two["reaches_goal INTEGER"] == 1 and two["raw_length REAL"] > 0
+
+
+def test_a_zero_length_path_short_of_the_goal_has_no_path_columns_and_an_approximate_path_no_best_cost(robot):
+    """AORRTC's "zero-length path" (ompl/ompl#1420: status invalid goal, its start twice, bestCost() 0) was
+    recorded with best_cost 0, raw_length 0 and path_valid_dense 1: Planner Arena showed it as a perfect path."""
+    from tpee_ompl.bench.experiment import _path_properties
+    from tpee_ompl.model.sectors import posture_preset
+    from tpee_ompl.planning.space_layout import RealVectorLayout
+    from tpee_ompl.planning.setup import make_simple_setup
+
+    start, goal = np.r_[posture_preset(1), 0.0, 0.0], np.r_[posture_preset(4), 0.0, 0.0]
+    si = make_simple_setup(robot, start, goal).getSpaceInformation()
+    layout = RealVectorLayout(si.getStateSpace())
+    assert _path_properties(si, {"waypoints": np.array([start, start]), "best_cost": 0.0}, start, goal, (0, 1), layout) == {}
+    half = 0.5 * (start + goal)
+    approx = _path_properties(si, {"waypoints": np.array([start, half]), "best_cost": 0.0}, start, goal, (0, 1), layout)
+    assert approx["reaches_goal INTEGER"] == 0 and approx["raw_length REAL"] > 0 and approx["best_cost REAL"] is None
+    exact = _path_properties(si, {"waypoints": np.array([start, goal]), "best_cost": float("inf")}, start, goal, (0, 1),
+                             layout)
+    assert exact["best_cost REAL"] == exact["raw_length REAL"] > 0  # no finite bestCost(): the path's length
+
+
+def test_a_run_whose_path_stops_short_of_the_goal_has_no_first_solution_time(robot):
+    """A native planner's first solution time is read from a finite bestCost(); AORRTC's is 0 without a path."""
+    from tpee_ompl.bench.experiment import _run_properties, _Setup
+    from tpee_ompl.bench.problems import get_problem
+    from tpee_ompl.model.sectors import posture_preset
+    from tpee_ompl.planning.space_layout import RealVectorLayout
+    from tpee_ompl.planning.setup import make_simple_setup
+
+    start, goal = np.r_[posture_preset(1), 0.0, 0.0], np.r_[posture_preset(4), 0.0, 0.0]
+    ss = make_simple_setup(robot, start, goal)
+    si = ss.getSpaceInformation()
+    setup = _Setup(get_problem("wearer"), ss, si, robot, RealVectorLayout(si.getStateSpace()), start, goal)
+    rec = {"waypoints": np.array([start, start]), "best_cost": 0.0, "first_solution_time": 0.001, "iterations": 5,
+           "samples": 5, "error": None, "checks_end": None}
+    props = _run_properties(setup, rec, robot.collision_checks)
+    assert props["first_solution_time REAL"] is None and props["best_cost REAL"] is None
+    assert props["reaches_goal INTEGER"] == 0 and props["path_valid_dense INTEGER"] is None
+    rec.update(waypoints=np.array([start, goal]), best_cost=float(np.linalg.norm(goal - start)))
+    assert _run_properties(setup, rec, robot.collision_checks)["first_solution_time REAL"] == 0.001

@@ -216,13 +216,17 @@ def _path_properties(si, rec: dict, start: np.ndarray, goal: np.ndarray, first: 
     if W is None or len(W) < 1:
         return {}
     ends = bool(np.all(np.abs(layout.delta(W[0], start)) <= 1e-6) and np.all(np.abs(layout.delta(W[-1], goal)) <= 1e-6))
-    if len(W) < 2 and not ends:  # one state short of the goal (AORRTC's timeout answer) is no path to measure
+    # a path that never leaves its first state and stops short of the goal is no path to measure: AORRTC's
+    # timeout answer (its start alone) and its "zero-length path" with status invalid goal (ompl/ompl#1420)
+    if not ends and not np.any(np.abs(layout.delta(W[:1], W)) > 0.0):
         return {}
     l4, l12, l34 = group_lengths(W, first, layout) if len(W) >= 2 else (0.0, 0.0, 0.0)
     ok = path_passes_motion_checks(si, W if layout.is_plain else layout.to_path(si, W))
-    best = rec["best_cost"]
-    if best is None or not math.isfinite(float(best)):  # a planner without bestCost(): its path's length, when
-        best = l4 if ends else None  # it reaches the goal (an approximate path's length is no best cost)
+    # a path short of the goal has no best cost, whatever the planner's bestCost() says (AORRTC's is 0 then);
+    # a planner without bestCost(): its path's length
+    best = rec["best_cost"] if ends else None
+    if best is not None and not math.isfinite(float(best)):
+        best = l4
     return {"reaches_goal INTEGER": int(ends), "best_cost REAL": best, "length_dof12 REAL": l12,
             "length_dof34 REAL": l34, "raw_length REAL": l4, "path_valid_dense INTEGER": int(ok)}
 
@@ -395,6 +399,8 @@ def _run_properties(setup: _Setup, rec: dict, checks_before: int) -> dict:
     props["graph motions INTEGER"] = rec.get("graph_motions")
     props["valid segment fraction REAL"] = rec.get("valid_fraction")
     props.update(setup.path_properties(setup.si, rec, setup.start, setup.goal))
+    if not props["reaches_goal INTEGER"]:  # never held an exact path (AORRTC's finite bestCost() without one)
+        props["first_solution_time REAL"] = None
     return props
 
 
