@@ -202,15 +202,16 @@ def add_plan_args(p: argparse.ArgumentParser, required: bool = False) -> None:
 # ---------------------------------------------------------------------------------------- aim / track
 def cmd_aim(args: argparse.Namespace) -> int:
     """Closed-form aiming IK for one target (eqs. 1-11) with the collision and line-of-sight verdict."""
-    from ..model.pointing import aim_errors, check_target
+    from ..model.pointing import PointingGeometry, aim_errors, check_target
     from ..model.sectors import select_sector
 
     robot = load_robot(args)
+    geometry = PointingGeometry.from_robot(robot)  # the loaded model's (--urdf), not the packaged one's
     with argument("--target"):
         target = check_target(np.array(args.target), robot)
     with argument("--target" if args.sector is None else f"--target with --sector {args.sector}"):
-        sector_ = args.sector if args.sector is not None else select_sector(target)
-        q = aim(target, sector_, pan_reference=args.pan_reference)  # a target the sector's arm cannot aim at
+        sector_ = args.sector if args.sector is not None else select_sector(target, origin=geometry.pivot)
+        q = aim(target, sector_, geometry=geometry, pan_reference=args.pan_reference)  # may be out of the arm's reach
     perp, _, ang = aim_errors(robot, q, target)
     result = {"target": target.tolist(), "sector": sector_, "q_rad": q.round(9).tolist(),
               "q_deg": np.degrees(q).round(4).tolist(), "collision_free": robot.is_valid(q),
