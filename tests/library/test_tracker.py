@@ -84,9 +84,9 @@ def test_target_jumping_between_sectors_switches_to_each_posture(robot, planner)
 def test_a_cross_sector_motion_arrives_aimed_at_its_target_in_the_new_sector(robot, planner):
     tracker = Tracker(robot, planner, initial_sector=3)
     target = sector_origin() + 6.0 * _direction(-60.0, -10.0)  # out of sector 3's reach: a posture change to 4
-    result = tracker.run([(0.0, sector_origin() + 6.0 * _direction(180.0, 0.0)), (1.0, target, True)])
+    result = tracker.run([(0.0, sector_origin() + 6.0 * _direction(180.0, 0.0)), (10.0, target, True)])
     _assert_safe_and_aimed(robot, result)
-    crossing = [e for e in result.events if e.kind == "cross-sector" and e.time == 1.0]
+    crossing = [e for e in result.events if e.kind == "cross-sector" and e.time == 10.0]
     assert [e.sector for e in crossing] == [4]
     # the motion's last row is the arrival: aimed at the target, in sector 4 (its other rows aim nowhere)
     assert result.sectors[-1] == 4 and np.allclose(result.targets[-1], target)
@@ -206,10 +206,28 @@ def test_a_planner_that_finds_no_path_gives_an_unreachable_event_and_the_arm_hol
         raise RuntimeError(f"no collision-free path {i}->{j}")
 
     tracker = Tracker(robot, no_path, initial_sector=3)
-    tracker.step(0.0, sector_origin() + 6.0 * _direction(-100.0, -10.0))  # another posture's target
+    tracker.step(0.0, sector_origin() + 6.0 * _direction(-60.0, 10.0))  # postures 1 and 4 can aim at it, 3 cannot
     result = tracker.result()
     assert result.count("unreachable") == 1 and "no collision-free path" in result.events[-1].detail
     np.testing.assert_array_equal(result.configurations[-1], tracker.q)
+
+
+def test_a_target_outside_the_pointing_sector_that_only_the_current_posture_reaches_is_aimed_at_from_there(robot):
+    """The tracker tried only the other postures once a target left the pointing sector, and called a target it
+    could aim at from where it was "unreachable" (a helper found targets only posture 1 can aim at in sectors 3/4)."""
+    from tpee_ompl.model.sectors import in_pointing_sector
+
+    def no_path(start, goal, i, j):
+        raise RuntimeError(f"no collision-free path {i}->{j}")
+
+    target = sector_origin() + 6.0 * _direction(-100.0, -10.0)  # another posture's target that posture 3 can aim at
+    tracker = Tracker(robot, no_path, initial_sector=3)
+    assert not in_pointing_sector(target, 3, tracker.geometry.pivot)
+    q0 = tracker.q.copy()
+    result = tracker.run([(0.0, target)])
+    assert [e.kind for e in result.events] == ["aim"] and tracker.sector == 3
+    assert aim_errors(robot, tracker.q, target)[2] < 1e-9
+    assert motion_is_valid(robot, np.array([q0, tracker.q]), tracker.check_step)
 
 
 def test_an_initial_configuration_off_its_sectors_preset_is_refused_and_the_check_step_is_capped(robot, planner):
@@ -249,3 +267,13 @@ def test_the_default_planner_leaves_ompls_log_level_and_seeds_ompl_once(robot, m
         assert seeds == [5] and "one seed per process" in caplog.text
     finally:
         ou.setLogLevel(before)
+
+
+def test_the_first_re_aim_from_the_initial_configuration_takes_the_time_joint_speed_allows(robot, planner):
+    """The clock started at -inf, so the first re-aim (a 2.4-rad pan swing) arrived at the sample's own time."""
+    tracker = Tracker(robot, planner, initial_sector=3)
+    q0 = tracker.q.copy()
+    result = tracker.run([(2.0, sector_origin() + 6.0 * _direction(150.0, 0.0))])
+    assert [e.kind for e in result.events] == ["aim"]
+    move = float(np.max(np.abs(result.configurations[0] - q0)))
+    assert move > 1.0 and result.times[0] == pytest.approx(2.0 + move / tracker.options.joint_speed)

@@ -174,12 +174,31 @@ class Tracker:
     def _motion_free(self, a: np.ndarray, b: np.ndarray) -> bool:
         return bool(self.robot.are_valid(motion_states(a, b, self.check_step)).all())
 
-    def _candidate_sectors(self, target: np.ndarray) -> list[int]:
-        """Sectors to try after the current one: the posture sector, other pointing sectors, the rest."""
-        home = int(posture_sector(target, self.geometry.pivot))
-        order = [home] + [k for k in SECTORS if k != home and in_pointing_sector(target, k, self.geometry.pivot)]
-        order += [k for k in SECTORS if k not in order]
-        return [k for k in order if k != self.sector]
+    def _candidate_sectors(self, target: np.ndarray, current_tried: bool) -> list[int]:
+        """Sectors to try: the posture sector, the other pointing sectors, then the current one (unless it was
+        tried already: the target is in its pointing sector), the rest.  A target outside every pointing sector
+        whose posture can aim at it is then aimed at from where the arm is, without crossing."""
+        pivot = self.geometry.pivot
+        home = int(posture_sector(target, pivot))
+        order = [home] + [k for k in SECTORS if k != home and in_pointing_sector(target, k, pivot)]
+        order = [k for k in order if k != self.sector] + ([] if current_tried else [self.sector])
+        return order + [k for k in SECTORS if k not in order and k != self.sector]
+
+    def _reaim(self, t: float, q: np.ndarray, target: np.ndarray) -> bool:
+        """Aim at target with q from the current posture: a direct re-aim when that motion is free, else one
+        planned inside the sector; False when the planner found no path."""
+        if self._motion_free(self.q, q):
+            self.events.append(TrackEvent(t, "aim", self.sector))
+            # a re-aim takes the time joint_speed allows (the rows' times increase while the arm moves)
+            t = max(t, self.time + float(np.max(np.abs(q - self.q))) / self.options.joint_speed)
+            self.q = q
+            self._record(t, q, target, self.sector)
+            self.time = t
+            return True
+        arrival = self._cross(t, q, self.sector, target, "re-aim motion collides")
+        if arrival is not None:
+            self.time = arrival
+        return arrival is not None
 
     def _cross(self, t: float, goal: np.ndarray, k: int, target: np.ndarray, why: str) -> float | None:
         """Run the planner from the current configuration to goal in sector k; return the arrival time, or None
@@ -227,6 +246,8 @@ class Tracker:
         raw = as_float_array(target, "target")
         if raw.shape != (3,):
             raise ValueError(f"target must have shape (3,); got {raw.shape}")
+        if self.time == -math.inf:  # the arm rests at its initial configuration until the first sample
+            self.time = float(t)
         t = max(float(t), self.time)
         try:
             target = check_target(target, self.robot)
@@ -237,7 +258,8 @@ class Tracker:
             return
         why = "new target outside the pointing sector" if new_target else "target left the pointing sector"
         self._no_path = []
-        if in_pointing_sector(target, self.sector, self.geometry.pivot):
+        here = in_pointing_sector(target, self.sector, self.geometry.pivot)
+        if here:
             try:
                 aim_batch(target[None], self.sector, geometry=self.geometry, pan_reference=self.q[2])
             except BlindAreaError as exc:
@@ -247,27 +269,21 @@ class Tracker:
                 why = f"not reachable from posture {self.sector} ({exc})"
             else:
                 q = self._aim_from(target, self.sector)
-                if q is not None and self._motion_free(self.q, q):
-                    self.events.append(TrackEvent(t, "aim", self.sector))
-                    # a re-aim takes the time joint_speed allows (the rows' times increase while the arm moves)
-                    t = max(t, self.time + float(np.max(np.abs(q - self.q))) / self.options.joint_speed)
-                    self.q = q
-                    self._record(t, q, target, self.sector)
-                    self.time = t
+                if q is not None and self._reaim(t, q, target):
                     return
-                if q is not None:  # the re-aim itself would collide: plan it inside the sector
-                    arrival = self._cross(t, q, self.sector, target, "re-aim motion collides")
-                    if arrival is not None:
-                        self.time = arrival
-                        return
                 why = "no collision-free aim with a clear line of sight from this posture"
-        for k in self._candidate_sectors(target):
+        for k in self._candidate_sectors(target, current_tried=here):
             q = self._aim_from(target, k)
-            if q is not None:
-                arrival = self._cross(t, q, k, target, why)
-                if arrival is not None:
-                    self.time = arrival
+            if q is None:
+                continue
+            if k == self.sector:  # outside its pointing sector, but this posture can aim at it
+                if self._reaim(t, q, target):
                     return
+                continue
+            arrival = self._cross(t, q, k, target, why)
+            if arrival is not None:
+                self.time = arrival
+                return
         detail = "no posture can aim at the target" if not self._no_path else "no path: " + "; ".join(self._no_path)
         self.events.append(TrackEvent(t, "unreachable", self.sector, detail))
         self._record(t, self.q, None, self.sector)
