@@ -120,6 +120,22 @@ def test_target_between_tilt_joint_and_muzzle_is_unreachable():
         aim(close, 4)
 
 
+def test_a_target_at_the_muzzle_is_refused_whatever_the_rounding():
+    """Half the targets exactly at the muzzle were accepted (reach <= L4 decided by rounding), aims off by up to 3 rad."""
+    from tpee_ompl.model.wearer_arm import default_robot
+
+    robot, rng = default_robot(), np.random.default_rng(0)
+    refused = 0
+    for k in SECTORS:
+        for _ in range(25):
+            q = aim(sector_origin() + rng.normal(size=3) * 3.0 + [0.0, 0.0, 1.0], k, pan_reference=rng.uniform(-3, 3))
+            muzzle, _ = robot.muzzle(q)
+            with pytest.raises(UnreachableTargetError, match="not beyond the muzzle"):
+                aim(muzzle, k, pan_reference=q[2])
+            refused += 1
+    assert refused == 100
+
+
 @pytest.mark.parametrize("bad", [[np.nan, 0, 1], [np.inf, 2, 1], [1, -np.inf, 0]])
 def test_non_finite_targets_raise_a_dedicated_value_error(bad):
     with pytest.raises(UnreachableTargetError, match="not finite"):

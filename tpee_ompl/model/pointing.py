@@ -62,7 +62,8 @@ __all__ = [
 ]
 
 BLIND_TOLERANCE = 1e-9
-"""Metres. Targets closer than L3 + this to the pan axis are in the blind area."""
+"""Metres. Targets closer than L3 + this to the pan axis are in the blind area, and those less than this beyond
+the muzzle are not beyond it (at the muzzle the direction to the target is rounding noise)."""
 
 
 class AimingError(ValueError):
@@ -302,7 +303,7 @@ def aim_batch(
     # eq. 11 (corrected): l_AB = sqrt(r^2 - l_OB^2), factored so it cannot overflow
     l_ab = np.where(ok, np.sqrt(np.abs(r - g.offset)) * np.sqrt(r + g.offset), 1.0)
     reach = np.hypot(l_ab, sz)  # distance from the tilt axis to the target along the barrel line
-    behind = ok & (reach <= g.barrel)
+    behind = ok & (reach <= g.barrel + BLIND_TOLERANCE)
     if strict and behind.any():
         k = int(np.flatnonzero(behind)[0])
         raise UnreachableTargetError(
