@@ -120,3 +120,14 @@ def test_plan_reports_its_samples_and_says_when_the_time_limit_came_before_the_s
     assert "stopped by --time 0.3 before --samples 10000000" in out
     assert main(_args("--planner", "dimension-rrt", "--samples", "300", "--json")) == 0
     assert json.loads(capsys.readouterr().out)["samples"] == 300
+
+
+def test_track_output_writes_the_sector_as_an_integer_and_times_exactly(tmp_path, capsys):
+    out = tmp_path / "traj.csv"
+    assert main(["track", "--script", "jump", "--duration", "2", "--rate", "2", "--planner", "dimension-rrt",
+                 "-o", str(out)]) == 0
+    lines = out.read_text(encoding="utf-8").splitlines()
+    assert lines[0] == "t,dof1,dof2,dof3,dof4,sector"
+    rows = [line.split(",") for line in lines[1:]]
+    assert rows and all(r[5] in {"0", "1", "2", "3", "4"} for r in rows)  # was 3.000000000000000000e+00 (0: in a motion)
+    assert all(float(r[0]) == float(repr(float(r[0]))) for r in rows)

@@ -247,8 +247,10 @@ def _scripted_targets(name: str, duration: float, rate: float) -> list[tuple]:
 
 def cmd_track(args: argparse.Namespace) -> int:
     """Run the Fig. 10 tracking strategy on a scripted target stream and report its events."""
-    from ..library.tracker import Tracker, make_default_planner
+    from ..library.tracker import MAX_TIME, Tracker, make_default_planner
 
+    if not args.duration <= MAX_TIME:  # the tracker takes sample times within +/- MAX_TIME
+        raise CliError(f"--duration {args.duration:g} s is beyond the tracker's {MAX_TIME:g} s")
     n_samples = args.duration * args.rate
     if not n_samples <= MAX_TRACK_SAMPLES:
         raise CliError(f"--duration {args.duration:g} x --rate {args.rate:g} = {n_samples:.3g} target samples; "
@@ -285,7 +287,7 @@ def cmd_track(args: argparse.Namespace) -> int:
         header = "t,dof1,dof2,dof3,dof4,sector"
         with atomic_path(args.output) as tmp:
             np.savetxt(tmp, np.c_[result.times, result.configurations, result.sectors], delimiter=",",
-                       header=header, comments="")
+                       header=header, comments="", fmt=["%.17g"] * 5 + ["%d"])
     if args.json:
         print(json.dumps({"script": args.script, "samples": len(stream), "trajectory_points": len(result.times),
                           "events": summary}))

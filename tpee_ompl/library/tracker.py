@@ -342,7 +342,10 @@ def make_default_planner(
     at most ``timeout`` seconds, simplified.  Every path is checked at the tracker's default step
     (:data:`~tpee_ompl.library.path_library.CHECK_STEP`, or the robot's motion step if smaller); raises
     RuntimeError if none is found.  OMPL's log level is left as the caller set it (its "Info:" lines are off
-    while a motion is planned), and OMPL's generator is seeded once per process.
+    while a motion is planned), and OMPL's generator is seeded once per process.  ``seed`` fixes the samples,
+    not the time: the library step stops after ``library_time`` seconds of wall-clock time, so how far it
+    refined a path, and so the tracker's trajectory, can differ between runs (``library=None``, or a planner
+    capped by samples, repeats exactly).
     """
     from ompl import geometric as og
 
