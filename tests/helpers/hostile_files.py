@@ -57,6 +57,24 @@ def _scaled(name: str, value: float) -> Callable[[dict], None]:
     return change
 
 
+def _shifted(name: str, dof: int, by: float) -> Callable[[dict], None]:
+    """A change adding ``by`` to DOF ``dof`` (0-based) of every row of pair (1, 2)'s array ``name``."""
+    def change(a: dict) -> None:
+        x = a[PAIR + name].copy()
+        x[..., dof] += by
+        a[PAIR + name] = x
+    return change
+
+
+def _other_presets(a: dict) -> None:
+    """Pair (1, 2)'s demonstrations moved to start at sector 3's Table-1 preset (another pair's)."""
+    from tpee_ompl.model.sectors import posture_preset
+
+    x = a[PAIR + "starts"].copy()
+    x[:, :2] = posture_preset(3)
+    a[PAIR + "starts"] = x
+
+
 LIBRARY_DEFECTS: dict[str, tuple[Callable[[dict], None], str]] = {
     # name: (change, what the refusal must name)
     "meta-is-a-list": (lambda a: _set(a, "meta", json.dumps([1, 2, 3])), "meta"),
@@ -80,6 +98,12 @@ LIBRARY_DEFECTS: dict[str, tuple[Callable[[dict], None], str]] = {
     "scaled-not-bool": (lambda a: _set(a, PAIR + "fwd_scaled", a[PAIR + "fwd_scaled"].astype(float)), "p12_fwd_scaled"),
     "format-version-true": (lambda a: _set(a["meta"], "format_version", True), "format version"),
     "build-stats-a-list": (lambda a: _set(a["meta"], "build_stats", [1]), "build_stats"),
+    "build-stats-count-null": (lambda a: a["meta"]["build_stats"].update(stored=None), "build_stats"),
+    "build-stats-count-a-string": (lambda a: a["meta"]["build_stats"].update(stored="x"), "build_stats"),
+    "query-stride-beyond-the-rollout": (lambda a: _set(a["meta"], "query_stride", 10**9), "query_stride"),
+    "waypoints-off-the-joint-limits": (_shifted("waypoints", 3, 50.0), "p12_waypoints"),
+    "starts-of-another-sector": (_other_presets, "p12_starts"),
+    "starts-not-the-waypoints-first": (_shifted("starts", 3, 0.01), "p12_waypoints"),
 }
 
 

@@ -137,6 +137,25 @@ def test_demo_order_rejects_bad_input_clearly(library: PathLibrary, args, match:
         library.demo_order(pd.starts[0] if start is None else start, pd.goals[0] if goal is None else goal, a, b)
 
 
+@pytest.mark.parametrize("kw, match", [
+    ({"per_step": 0}, "per_step"), ({"per_step": 50}, "per_step 50 gives DMPs of 301"),
+    ({"options": "x"}, "options must be DMPOptions"), ({"plan": 5}, "plan must be"),
+    ({"query_stride": 1.5}, "query_stride"), ({"query_stride": "2"}, "query_stride"),
+    ({"query_stride": 10**9}, "query_stride"),
+])
+def test_the_constructor_refuses_settings_that_would_fail_later(robot: WearerArm, library: PathLibrary, kw,
+                                                                match: str) -> None:
+    """per_step=50 on 100-step DMPs was taken, then a query failed in numpy's concatenate and save in a reshape."""
+    with pytest.raises(ValueError, match=match):
+        PathLibrary(robot, library.pairs, **{"per_step": library.per_step, **kw})
+
+
+def test_save_takes_force_as_a_bool_only(library: PathLibrary, tmp_path) -> None:
+    f = library.save(tmp_path / "lib.npz")
+    with pytest.raises(ValueError, match="force"):
+        library.save(f, force="no")  # a string was true: the file was replaced
+
+
 def test_with_options_needs_dmp_options(library: PathLibrary) -> None:
     with pytest.raises(ValueError, match="DMPOptions"):
         library.with_options(None)  # type: ignore[arg-type]

@@ -121,3 +121,44 @@ def test_a_library_its_loader_would_refuse_is_not_saved(robot: WearerArm, librar
     finally:
         dmp.weights[...] = kept
     assert not (tmp_path / "lib.npz").exists() and not list(tmp_path.iterdir())
+
+
+def _add_member(path, name: str, shape: tuple[int, ...]) -> None:
+    """Append to the .npz file at ``path`` a member ``name`` whose header declares ``shape`` (float64) over 8 bytes."""
+    import io
+    import zipfile
+
+    header = io.BytesIO()
+    np.lib.format.write_array_header_1_0(header, {"descr": "<f8", "fortran_order": False, "shape": shape})
+    with zipfile.ZipFile(path, "a", compression=zipfile.ZIP_DEFLATED) as z:
+        z.writestr(name + ".npy", header.getvalue() + bytes(8))
+
+
+def test_an_array_declaring_a_huge_shape_is_refused_before_it_is_unpacked(robot: WearerArm, tmp_path) -> None:
+    """A header declaring 745 GiB gave a MemoryError naming neither the file nor the array."""
+    f = write_library_file(tmp_path / "lib.npz", lambda a: a.pop("p12_goals"))
+    _add_member(f, "p12_goals", (10**11, 4))
+    with pytest.raises(LibraryFileError, match="p12_goals.*GiB") as exc:
+        PathLibrary.load(f, robot)
+    assert str(f) in str(exc.value)
+    other = write_library_file(tmp_path / "other.npz", lambda a: a.pop("p12_goals"))
+    _add_member(other, "p12_goals", (21, 4))  # the data holds one float: refused by its declared shape alone
+    with pytest.raises(LibraryFileError, match="p12_goals.*shape \\(21, 4\\), expected"):
+        PathLibrary.load(other, robot)
+
+
+def test_members_the_reader_does_not_use_are_never_unpacked(robot: WearerArm, tmp_path) -> None:
+    """Every member used to be unpacked: a 3 MB file with 800 MB of zeros in an extra member took 900 MB to load."""
+    f = write_library_file(tmp_path / "lib.npz")
+    _add_member(f, "junk", (10**12,))  # 8 TB declared: unpacking it would fail at once
+    assert len(PathLibrary.load(f, robot)) == len(PathLibrary.load(write_library_file(tmp_path / "plain.npz"), robot))
+
+
+def test_a_pipe_is_refused_at_once_instead_of_read(robot: WearerArm, tmp_path) -> None:
+    """np.load on a FIFO waits for a writer forever."""
+    import os
+
+    fifo = tmp_path / "lib.npz"
+    os.mkfifo(fifo)
+    with pytest.raises(LibraryFileError, match="not a regular file"):
+        PathLibrary.load(fifo, robot)

@@ -199,8 +199,12 @@ def default_of(func: Callable[..., Any], name: str) -> Any:
 def check_input_file(path: str | Path, option: str, what: str = "file", hint: str = "") -> Path:
     """``path`` if it is an existing file; else a :class:`CliError` naming ``option`` (a usage error)."""
     p = Path(path)
+    if str(path) == "":
+        raise CliError(f"{option}: give a file name, not an empty string")
     if p.is_dir():
         raise CliError(f"{option} {p}: is a folder, not a {what}")
+    if p.exists() and not p.is_file():
+        raise CliError(f"{option} {p}: is not a regular file (a pipe or a device), not a {what}")
     if not p.is_file():
         raise CliError(f"{option} {p}: {what} not found{hint}")
     return p

@@ -191,14 +191,14 @@ def register(subparsers: argparse._SubParsersAction, formatter_class: type = arg
     sub = lib.add_subparsers(dest="library_command", metavar="{build,query,stats}", required=True)
 
     def common(p: argparse.ArgumentParser) -> None:
-        p.add_argument("--library", type=Path, default=DEFAULT_LIBRARY, metavar="FILE",
+        p.add_argument("--library", type=nonempty, default=DEFAULT_LIBRARY, metavar="FILE",
                        help=f"library file (.npz), default {DEFAULT_LIBRARY}")
 
     b = sub.add_parser("build", help="build a library (dimension-RRT demonstrations)", epilog=_BUILD_EXAMPLE,
                        formatter_class=formatter_class)
     # no default: the packaged library lives inside the installed package, which a build must not write into
     # unasked (``make library`` names it on purpose); queries and stats read it by default
-    b.add_argument("--library", type=Path, required=True, metavar="FILE",
+    b.add_argument("--library", type=nonempty, required=True, metavar="FILE",
                    help=f"the library file (.npz) to write (the packaged one, read by default elsewhere: {DEFAULT_LIBRARY})")
     d = _BUILD_DEFAULTS
     b.add_argument("--per-pair", type=positive_int, default=d.per_pair,

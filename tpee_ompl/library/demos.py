@@ -31,6 +31,7 @@ __all__ = [
     "MAX_PER_STEP",
     "N_FAKE_TIME_STEPS",
     "POINTING_LINKS",
+    "max_query_stride",
     "DemoPlanner",
     "PairDemos",
     "Plan",
@@ -48,6 +49,14 @@ N_FAKE_TIME_STEPS = 7
 MAX_PER_STEP = 1000
 """Most samples per fake-time step a library takes: its DMPs' grid (6 x per_step + 1 samples, half as many basis
 functions by default) must stay within ``dmp.MAX_GRID_ENTRIES`` (1000: 6001 x 3000).  The packaged library: 100."""
+
+
+def max_query_stride(per_step: int) -> int:
+    """The largest useful ``query_stride`` of a library with ``per_step`` samples per fake-time step: the length
+    of its rollouts between their first and last sample (a longer stride keeps only those two)."""
+    return (N_FAKE_TIME_STEPS - 1) * int(per_step)
+
+
 POINTING_LINKS: tuple[str, ...] = ("link3", "link4")
 """Links moved by DOF3/DOF4, the DOFs the DMPs generate (DOF1/DOF2 follow Table 3 for every query)."""
 DEMO_MARGINS: tuple[float, ...] = (0.05, 0.04, 0.03, 0.025)

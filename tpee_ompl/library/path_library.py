@@ -30,9 +30,10 @@ import numpy as np
 from ..model.sectors import check_sector, cross_sector_trajectory
 from ..model.wearer_arm import WearerArm
 from ..planning.paths import motion_is_valid, motion_step, planned_waypoints, resample_waypoints
-from ..validation import check_int
+from ..validation import check_bool, check_int
 from .build import LIBRARY_DMP_OPTIONS, LibraryBuildOptions, collect_default_demos, default_build_params, learn_demos
-from .demos import N_FAKE_TIME_STEPS, PairDemos, Plan, SampleQuery, collect_pair, dimension_rrt_planner
+from .demos import (MAX_PER_STEP, N_FAKE_TIME_STEPS, PairDemos, Plan, SampleQuery, collect_pair, dimension_rrt_planner,
+                    max_query_stride)
 from .dmp import DMPOptions, generate_blended
 from .storage import read_library, write_library
 
@@ -104,15 +105,23 @@ class PathLibrary:
     ) -> None:
         self.robot = robot
         self.pairs = pairs
-        self.per_step = int(per_step)
+        self.per_step = check_int("per_step", per_step, minimum=1, maximum=MAX_PER_STEP)
+        n_steps = (N_FAKE_TIME_STEPS - 1) * self.per_step + 1
+        for (i, j), pd in pairs.items():  # every DMP of a pair is learned on one grid: the first one tells
+            dmp = next(iter(pd.forward), None)
+            if dmp is not None and dmp.n_steps != n_steps:
+                raise ValueError(f"per_step {self.per_step} gives DMPs of {n_steps} samples, but pair {i}->{j}'s "
+                                 f"have {dmp.n_steps}")
+        if options is not None and not isinstance(options, DMPOptions):
+            raise ValueError(f"options must be DMPOptions, got {type(options).__name__}")
         self.options = options or LIBRARY_DMP_OPTIONS
+        if plan is not None and not callable(plan):
+            raise ValueError(f"plan must be a planner callable or None, got {type(plan).__name__}")
         self.plan = plan
         self.n_candidates = check_int("n_candidates", n_candidates, minimum=1)  # a library file's bound too
         self.build_stats = dict(build_stats or {})
         self.build_params = dict(build_params or {})
-        if query_stride < 1:
-            raise ValueError(f"query_stride must be >= 1, got {query_stride}")
-        self.query_stride = int(query_stride)
+        self.query_stride = check_int("query_stride", query_stride, minimum=1, maximum=max_query_stride(self.per_step))
         self._counts: Counter[str] = Counter()
         self._dof12_cache: dict[tuple[int, int], np.ndarray] = {}
 
@@ -345,7 +354,7 @@ class PathLibrary:
     def save(self, path: str | Path, *, force: bool = True) -> Path:
         """Write the library to one ``.npz`` file, atomically (:func:`tpee_ompl.library.storage.write_library`);
         with ``force=False`` an existing file is refused (:class:`~tpee_ompl.files.OutputExistsError`)."""
-        return write_library(self, path, force=force)
+        return write_library(self, path, force=check_bool("force", force))
 
     @classmethod
     def load(cls, path: str | Path, robot: WearerArm, plan: Plan | None = None) -> PathLibrary:

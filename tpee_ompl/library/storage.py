@@ -19,10 +19,10 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..files import OutputExistsError, atomic_path
-from ..model.sectors import SECTOR_PAIRS
+from ..model.sectors import SECTOR_PAIRS, posture_preset
 from ..model.wearer_arm import WearerArm
 from ..validation import check_int
-from .demos import MAX_PER_STEP, N_FAKE_TIME_STEPS, PairDemos
+from .demos import MAX_PER_STEP, N_FAKE_TIME_STEPS, PairDemos, max_query_stride
 from .dmp import DMP, DMPOptions
 
 if TYPE_CHECKING:
@@ -41,6 +41,13 @@ class LibraryFileError(ValueError):
 
 MAX_CANDIDATES = 10_000
 """Largest ``n_candidates`` a file may give."""
+MAX_LIBRARY_BYTES = 2**31
+"""Most bytes the arrays of a library file may unpack to (the packaged library: about 9 MB); a file whose
+array headers declare more is refused before any of them is unpacked."""
+_MAX_META_BYTES = 2**20
+"""Most bytes of the ``meta`` record (the packaged library's: about 2 kB)."""
+_BUILD_STAT_MAX = 10**12
+"""Largest count a library's ``build_stats`` may hold."""
 _META_KEYS = frozenset({"format_version", "model_hash", "per_step", "n_candidates", "options", "pairs", "build_stats",
                         "build_params", "query_stride"})
 _PAIR_ARRAYS = ("starts", "goals", "waypoints", "margins", "fwd_weights", "fwd_scaled", "rev_weights", "rev_scaled")
@@ -96,8 +103,10 @@ def _check_meta(meta: Any, path: Path) -> dict[str, Any]:
     if unknown:
         raise bad(unknown[0], f"is unknown (the fields are {', '.join(sorted(_META_KEYS))})")
     for name, top in (("per_step", MAX_PER_STEP), ("n_candidates", MAX_CANDIDATES), ("query_stride", None)):
-        if name == "query_stride" and name not in meta:
-            continue
+        if name == "query_stride":
+            if name not in meta:
+                continue
+            top = max_query_stride(meta["per_step"])  # a stride past the rollout's length leaves its two ends
         try:
             check_int(name, meta.get(name), minimum=1, maximum=top)
         except ValueError as exc:
@@ -123,6 +132,9 @@ def _check_meta(meta: Any, path: Path) -> dict[str, Any]:
     for name in ("build_stats", "build_params"):
         if not isinstance(meta.get(name), (dict, type(None))):
             raise bad(name, f"must be a JSON object, got {type(meta.get(name)).__name__}")
+    for k, v in (meta.get("build_stats") or {}).items():
+        if type(v) is not int or not 0 <= v <= _BUILD_STAT_MAX:
+            raise bad("build_stats", f"entry {k!r} must be a count in [0, {_BUILD_STAT_MAX:g}], got {v!r}"[:300])
     return {"per_step": meta["per_step"], "options": dmp_options, "n_candidates": meta["n_candidates"],
             "build_stats": meta.get("build_stats"), "query_stride": meta.get("query_stride", 10),
             "build_params": meta.get("build_params"), "pairs": [tuple(p) for p in pairs]}
@@ -134,20 +146,23 @@ _MAX_ABS = {**dict.fromkeys(_ANGLES, 100.0), "fwd_weights": 1e9, "rev_weights": 
 (the packaged library: 3.3 rad, weights 2.1e4), short of what overflows the DMP's arithmetic."""
 
 
-def _pair_arrays(arrays: dict[str, np.ndarray], i: int, j: int, n_basis: int, path: Path) -> dict[str, np.ndarray]:
-    """Pair (i, j)'s arrays, shapes, dtypes and values checked; LibraryFileError naming the array."""
-    p = f"p{i}{j}_"
-    missing = [p + n for n in _PAIR_ARRAYS if p + n not in arrays]
+def _pair_arrays(archive: _Archive, i: int, j: int, n_basis: int, robot: WearerArm) -> dict[str, np.ndarray]:
+    """Pair (i, j)'s arrays: declared shapes checked before unpacking, then dtypes and values (finite, inside the
+    robot's joint limits, starting and ending at the pair's Table-1 presets); LibraryFileError naming the array."""
+    p, path = f"p{i}{j}_", archive.path
+    missing = [p + n for n in _PAIR_ARRAYS if p + n not in archive.keys]
     if missing:
         raise LibraryFileError(f"path library {path}: array {missing[0]!r} is missing")
-    a = {n: arrays[p + n] for n in _PAIR_ARRAYS}
-    m = a["starts"].shape[0] if a["starts"].ndim else -1
+    first = archive.shape(p + "starts")
+    m = first[0] if first else -1
     shapes = {"starts": (m, 4), "goals": (m, 4), "waypoints": (m, N_FAKE_TIME_STEPS, 4), "margins": (m,),
               "fwd_weights": (m, 2, n_basis), "rev_weights": (m, 2, n_basis), "fwd_scaled": (m, 2), "rev_scaled": (m, 2)}
     for name, shape in shapes.items():
-        x = a[name]
-        if x.shape != shape:
-            raise LibraryFileError(f"path library {path}: array {p + name!r} has shape {x.shape}, expected {shape}")
+        declared = archive.shape(p + name)
+        if declared != shape:
+            raise LibraryFileError(f"path library {path}: array {p + name!r} has shape {declared}, expected {shape}")
+    a = {name: archive.read(p + name) for name in shapes}
+    for name, x in a.items():
         if name.endswith("_scaled"):
             if x.dtype != bool:
                 raise LibraryFileError(f"path library {path}: array {p + name!r} must be booleans, got {x.dtype}")
@@ -159,7 +174,66 @@ def _pair_arrays(arrays: dict[str, np.ndarray], i: int, j: int, n_basis: int, pa
         too_big = _beyond_limit(name, x)
         if too_big:
             raise LibraryFileError(f"path library {path}: array {p + name!r} {too_big}")
+    tol = 1e-6
+    for name in _ANGLES:  # demonstrations are planned inside the limits; a DMP learned off them cannot be used
+        x = a[name]
+        if x.size and not (np.all(x >= robot.lower - tol) and np.all(x <= robot.upper + tol)):
+            raise LibraryFileError(f"path library {path}: array {p + name!r} leaves the robot's joint limits")
+    for name, k, rows in (("starts", i, a["starts"]), ("goals", j, a["goals"]),
+                          ("waypoints", i, a["waypoints"][:, 0]), ("waypoints", j, a["waypoints"][:, -1])):
+        if rows.size and not np.allclose(rows[:, :2], posture_preset(k), rtol=0.0, atol=tol):
+            raise LibraryFileError(f"path library {path}: array {p + name!r} holds a demonstration of pair {i}->{j} "
+                                   f"whose DOF1/DOF2 end is not sector {k}'s Table-1 preset")
+    if not (np.allclose(a["waypoints"][:, 0], a["starts"], rtol=0.0, atol=tol)
+            and np.allclose(a["waypoints"][:, -1], a["goals"], rtol=0.0, atol=tol)):
+        raise LibraryFileError(f"path library {path}: array {p + 'waypoints'!r} does not run from its demonstration's "
+                               "start to its goal")
     return a
+
+
+class _Archive:
+    """The arrays of an open ``.npz`` file, read one at a time: each one's header is read (and its declared size
+    counted against :data:`MAX_LIBRARY_BYTES`) before it is unpacked, so a file cannot make the reader unpack more
+    than that, and members the reader does not ask for are never unpacked."""
+
+    def __init__(self, z: np.lib.npyio.NpzFile, path: Path) -> None:
+        self.z, self.path, self.keys = z, path, frozenset(z.files)
+        self._headers: dict[str, tuple[tuple[int, ...], np.dtype]] = {}
+        self._declared = 0
+
+    def header(self, key: str) -> tuple[tuple[int, ...], np.dtype]:
+        """The declared shape and dtype of array ``key`` (nothing unpacked; its size counted)."""
+        if key not in self._headers:
+            try:
+                with self.z.zip.open(key + ".npy") as f:
+                    version = np.lib.format.read_magic(f)
+                    read = {(1, 0): np.lib.format.read_array_header_1_0,
+                            (2, 0): np.lib.format.read_array_header_2_0}.get(version)
+                    if read is None:
+                        raise ValueError(f"array {key!r} has .npy format version {version}")
+                    shape, _, dtype = read(f)
+            except (zipfile.BadZipFile, EOFError, OSError, ValueError, KeyError) as exc:
+                raise LibraryFileError(f"path library {self.path} is unreadable (truncated or not a library file): "
+                                       f"{exc}") from exc
+            self._declared += int(np.prod(shape, dtype=object)) * dtype.itemsize
+            if self._declared > MAX_LIBRARY_BYTES:
+                raise LibraryFileError(f"path library {self.path}: array {key!r} of shape {shape} would unpack the "
+                                       f"file's arrays to more than {MAX_LIBRARY_BYTES / 2**30:g} GiB")
+            self._headers[key] = (tuple(int(v) for v in shape), dtype)
+        return self._headers[key]
+
+    def shape(self, key: str) -> tuple[int, ...]:
+        """The declared shape of array ``key`` (nothing unpacked)."""
+        return self.header(key)[0]
+
+    def read(self, key: str) -> np.ndarray:
+        """Array ``key``, unpacked after its header was checked."""
+        self.header(key)
+        try:
+            return self.z[key]
+        except (zipfile.BadZipFile, EOFError, OSError, ValueError, KeyError) as exc:
+            raise LibraryFileError(f"path library {self.path} is unreadable (truncated or not a library file): "
+                                   f"{exc}") from exc
 
 
 def _beyond_limit(name: str, x: np.ndarray) -> str | None:
@@ -187,18 +261,32 @@ def read_library(path: str | Path, robot: WearerArm) -> tuple[dict[tuple[int, in
         or array is malformed (the message names it).
     """
     path = Path(path)
+    if path.exists() and not path.is_file():  # a folder, a pipe (np.load would wait on it forever), a device
+        raise LibraryFileError(f"path library {path} is not a regular file")
     if path.is_file() and not zipfile.is_zipfile(path):  # numpy's own message would advise loading it with pickle
         raise LibraryFileError(f"path library {path} is unreadable (truncated or not a library file): not an .npz archive")
     try:
-        with np.load(path, allow_pickle=False) as z:
-            arrays = {k: z[k] for k in z.files}
+        z = np.load(path, allow_pickle=False)
     except FileNotFoundError:
         raise
     except (zipfile.BadZipFile, EOFError, OSError, ValueError, KeyError) as exc:
         raise LibraryFileError(f"path library {path} is unreadable (truncated or not a library file): {exc}") from exc
+    with z:
+        return _read_archive(_Archive(z, path), robot)
+
+
+def _read_archive(archive: _Archive, robot: WearerArm) -> tuple[dict[tuple[int, int], PairDemos], dict[str, Any]]:
+    """:func:`read_library` on the open file."""
+    path = archive.path
+    if "meta" not in archive.keys:
+        raise LibraryFileError(f"path library {path} has no valid metadata: no 'meta' record")
+    shape, dtype = archive.header("meta")
+    if shape != () or dtype.kind != "U" or dtype.itemsize > _MAX_META_BYTES:
+        raise LibraryFileError(f"path library {path} has no valid metadata: 'meta' must be one JSON text of at "
+                               f"most {_MAX_META_BYTES} bytes, got {dtype} of shape {shape}")
     try:
-        meta = json.loads(str(arrays["meta"]))
-    except (KeyError, json.JSONDecodeError, RecursionError) as exc:
+        meta = json.loads(str(archive.read("meta")))
+    except (json.JSONDecodeError, RecursionError) as exc:
         raise LibraryFileError(f"path library {path} has no valid metadata: {exc}") from exc
     version = meta.get("format_version") if isinstance(meta, dict) else None
     if isinstance(meta, dict) and (type(version) is not int or version != FORMAT_VERSION):
@@ -217,7 +305,7 @@ def read_library(path: str | Path, robot: WearerArm) -> tuple[dict[tuple[int, in
     n_basis = options.basis_count(n_steps)
     data: dict[tuple[int, int], PairDemos] = {}
     for i, j in settings.pop("pairs"):
-        a = _pair_arrays(arrays, i, j, n_basis, path)
+        a = _pair_arrays(archive, i, j, n_basis, robot)
         pd = PairDemos(a["starts"], a["goals"], a["waypoints"], a["margins"])
         try:
             for W, fw, fs, rw, rs in zip(pd.waypoints, a["fwd_weights"], a["fwd_scaled"], a["rev_weights"],
