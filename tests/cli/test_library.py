@@ -124,3 +124,48 @@ def test_build_never_replaces_a_library_without_force(robot, small_file: str, tm
     assert _run([*argv, "--force"]) == 0
     assert PathLibrary.load(target, robot).build_params["seed"] == 3
     assert [p.name for p in tmp_path.iterdir()] == ["lib.npz"]  # no temporary file left
+
+
+@pytest.fixture(scope="module")
+def other_model(tmp_path_factory) -> tuple[str, str]:
+    """The packaged URDF with a comment added (another model hash) and the packaged SRDF."""
+    from tpee_ompl.resources import model_file
+
+    folder = tmp_path_factory.mktemp("model")
+    text = model_file("wearer_arm.urdf").read_text(encoding="utf-8")
+    urdf = folder / "copy.urdf"
+    urdf.write_text(text.replace("\n", "\n<!-- my copy -->\n", 1), encoding="utf-8")
+    srdf = folder / "copy.srdf"
+    srdf.write_text(model_file("wearer_arm.srdf").read_text(encoding="utf-8"), encoding="utf-8")
+    return str(urdf), str(srdf)
+
+
+def test_a_library_for_another_urdf_is_built_inspected_and_planned_with(other_model, tmp_path, capsys) -> None:
+    """With a custom URDF no command could build, show or pass a library for it (they all used the packaged model)."""
+    from helpers.cli_queries import start_goal_args
+
+    urdf, srdf = other_model
+    model = ["--urdf", urdf, "--srdf", srdf]
+    lib = tmp_path / "mine.npz"
+    assert main(["library", "build", "--pairs", "1-4", "--per-pair", "1", "--max-samples", "200", "--workers", "1",
+                 "--library", str(lib), *model]) == 0
+    capsys.readouterr()
+    assert main(["library", "stats", "--library", str(lib), *model]) == 0
+    assert "1 demonstrations" in capsys.readouterr().out
+    assert main(["library", "stats", "--library", str(lib)]) == 1  # the packaged model: another hash
+    assert "built for model" in capsys.readouterr().err
+    assert main(["plan", "--from", "1", "--to", "4", *start_goal_args(), *model, "--library", str(lib), "--time", "0.05",
+                 "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["planner"] == "library"
+
+
+def test_plan_with_another_urdf_and_no_library_plans_with_dimension_rrt(other_model, capsys) -> None:
+    """The default planner loaded the packaged library, built for the packaged model: every plan failed."""
+    from helpers.cli_queries import start_goal_args
+
+    urdf, srdf = other_model
+    assert main(["plan", "--from", "1", "--to", "4", *start_goal_args(), "--urdf", urdf, "--srdf", srdf,
+                 "--time", "0.05", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["planner"] == "dimension-rrt"
+    assert main(["plan", "--from", "1", "--to", "2", "--planner", "rrtconnect", "--library", "x.npz"]) == 2
+    assert "--library is read by --planner library" in capsys.readouterr().err

@@ -59,6 +59,8 @@ class PlannerContext:
     dimension_rrt_overrides: tuple[tuple[str, Any], ...] = ()
     """(field, value) pairs of ``DimensionRRTOptions`` a problem's dimension-RRT is built with (a variant's name
     and settings, e.g. ``DimensionRRTReleased``'s)."""
+    library: str | None = None
+    """``LibraryDimensionRRT``'s path library file (None: the packaged one, built for the packaged model)."""
 
 
 PlannerFactory = Callable[[ob.SpaceInformation, PlannerContext], ob.Planner]
@@ -90,8 +92,8 @@ def _dimension_rrt_no_shortcuts(si, ctx: PlannerContext):
     return _dimension_rrt(si, dataclasses.replace(ctx, dimension_rrt_overrides=overrides))
 
 
-_LIBRARIES: dict[str, object] = {}
-"""The default path library, loaded once per process (by model hash) for LibraryDimensionRRT."""
+_LIBRARIES: dict[tuple[str, str], object] = {}
+"""The path libraries LibraryDimensionRRT was built with, loaded once per process (by file and model hash)."""
 
 
 def _library_dimension_rrt(si, ctx: PlannerContext):
@@ -102,9 +104,10 @@ def _library_dimension_rrt(si, ctx: PlannerContext):
 
     get_problem(ctx.problem).check_planner("LibraryDimensionRRT")
     robot = getattr(si.getStateValidityChecker(), "robot", None) or default_robot()
-    lib = _LIBRARIES.get(robot.model_hash)
+    key = (str(ctx.library or default_library_path()), robot.model_hash)
+    lib = _LIBRARIES.get(key)
     if lib is None:
-        lib = _LIBRARIES[robot.model_hash] = PathLibrary.load(default_library_path(), robot)
+        lib = _LIBRARIES[key] = PathLibrary.load(key[0], robot)
     q = ctx.query
     return LibraryDimensionRRT(si, lib, int(q["from_sector"]), int(q["to_sector"]), max_samples=ctx.max_samples,
                                seed=ctx.seed, stall_samples=ctx.stall_samples)

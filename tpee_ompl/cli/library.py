@@ -13,6 +13,7 @@ import json
 import logging
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -26,17 +27,22 @@ from ._common import (
     CliError,
     Parser,
     add_force_arg,
+    add_model_args,
     argument,
     check_input_file,
     check_output,
     finite,
     index,
+    load_robot,
     nonempty,
     numpy_seed,
     on_postures,
     positive_int,
     sector,
 )
+
+if TYPE_CHECKING:
+    from ..model.wearer_arm import WearerArm
 
 __all__ = ["DEFAULT_LIBRARY", "build_parser", "register", "run_build", "run_query", "run_stats"]
 
@@ -76,11 +82,9 @@ def _check_library_file(path: Path) -> Path:
                             hint=": build one with 'tpee-ompl library build --library FILE' ('make library' in a source checkout)")
 
 
-def _load(path: Path, fallback: bool = True, max_samples: int = _BUILD_DEFAULTS.max_samples) -> PathLibrary:
-    from ..model.wearer_arm import default_robot
-
+def _load(path: Path, robot: WearerArm, fallback: bool = True,
+          max_samples: int = _BUILD_DEFAULTS.max_samples) -> PathLibrary:
     _check_library_file(path)
-    robot = default_robot()
     plan = dimension_rrt_planner(robot, max_samples=max_samples) if fallback else None
     return PathLibrary.load(path, robot, plan=plan)
 
@@ -105,12 +109,11 @@ def _build_options(args: argparse.Namespace) -> LibraryBuildOptions:
 
 def run_build(args: argparse.Namespace) -> int:
     """Build a library with the default sampler and dimension-RRT and save it."""
-    from ..model.wearer_arm import default_robot
-
     options = _build_options(args)
     out = check_output(args.library, "--library", args.force, (".npz",))
+    robot = load_robot(args)
     t0 = time.perf_counter()
-    lib = PathLibrary.build_default(default_robot(), options)
+    lib = PathLibrary.build_default(robot, options)
     lib.save(out, force=args.force)
     s = lib.stats()
     print(f"wrote {out}: {len(lib)} demonstrations in {len(lib.pairs)} pairs "
@@ -122,9 +125,8 @@ def run_build(args: argparse.Namespace) -> int:
 
 def run_query(args: argparse.Namespace) -> int:
     """Answer one query from the library and print the outcome (and the path with --json)."""
-    from ..model.wearer_arm import default_robot
-
     _check_library_file(Path(args.library))
+    robot = load_robot(args)
     given = [n for n, v in (("--from", args.from_sector), ("--to", args.to_sector), ("--start", args.start),
                             ("--goal", args.goal)) if v is not None]
     if args.query_set is not None:
@@ -133,7 +135,7 @@ def run_query(args: argparse.Namespace) -> int:
         if given:
             raise CliError(f"give --query-set NAME --index K, or --from --to --start --goal, not both ({' '.join(given)})")
         try:
-            queries = load_queries(args.query_set, default_robot())
+            queries = load_queries(args.query_set, robot)
         except FileNotFoundError as exc:
             raise CliError(f"--query-set: {exc}") from None
         k = 0 if args.index is None else args.index
@@ -152,12 +154,11 @@ def run_query(args: argparse.Namespace) -> int:
         i, j = args.from_sector, args.to_sector
         start, goal, off_posture = on_postures(args.start, args.goal, i, j)
         with argument("--start/--goal"):
-            robot = default_robot()
             robot.check_free(start, "start")
             robot.check_free(goal, "goal")
         if off_posture:
             raise CliError(off_posture)
-    lib = _load(Path(args.library), fallback=not args.no_fallback)
+    lib = _load(Path(args.library), robot, fallback=not args.no_fallback)
     res = lib.query(start, goal, i, j)
     if args.json:
         print(json.dumps({"from": i, "to": j, "outcome": res.outcome, "demo_index": res.demo_index,
@@ -173,7 +174,7 @@ def run_query(args: argparse.Namespace) -> int:
 def run_stats(args: argparse.Namespace) -> int:
     """Print what a library file holds: demonstrations per pair, build parameters and counters."""
     path = _check_library_file(Path(args.library))
-    lib = _load(path, fallback=False)
+    lib = _load(path, load_robot(args), fallback=False)
     print(f"{path}: {len(lib)} demonstrations, {path.stat().st_size / 1e6:.2f} MB, model {lib.robot.model_hash}")
     print("per pair: " + ", ".join(f"{i}->{j}: {len(pd.starts)}" for (i, j), pd in sorted(lib.pairs.items())))
     print(f"per_step {lib.per_step}, query_stride {lib.query_stride}, n_candidates {lib.n_candidates}")
@@ -193,6 +194,7 @@ def register(subparsers: argparse._SubParsersAction, formatter_class: type = arg
     def common(p: argparse.ArgumentParser) -> None:
         p.add_argument("--library", type=nonempty, default=DEFAULT_LIBRARY, metavar="FILE",
                        help=f"library file (.npz), default {DEFAULT_LIBRARY}")
+        add_model_args(p)  # a library is made for one model: its file records the model's hash
 
     b = sub.add_parser("build", help="build a library (dimension-RRT demonstrations)", epilog=_BUILD_EXAMPLE,
                        formatter_class=formatter_class)
@@ -200,6 +202,7 @@ def register(subparsers: argparse._SubParsersAction, formatter_class: type = arg
     # unasked (``make library`` names it on purpose); queries and stats read it by default
     b.add_argument("--library", type=nonempty, required=True, metavar="FILE",
                    help=f"the library file (.npz) to write (the packaged one, read by default elsewhere: {DEFAULT_LIBRARY})")
+    add_model_args(b)
     d = _BUILD_DEFAULTS
     b.add_argument("--per-pair", type=positive_int, default=d.per_pair,
                    help=f"demonstrations per ordered sector pair (default {d.per_pair})")

@@ -53,7 +53,7 @@ PLANNERS = CLI_PLANNER_NAMES
 
 # ---------------------------------------------------------------------------------------- plan
 def _make_planner(name: str, si: Any, from_sector: int, to_sector: int, samples: int | None, seed: int,
-                  stall: int | None = None):
+                  stall: int | None = None, library: str | None = None):
     """Planner instance (built like the benchmark's, :mod:`tpee_ompl.bench.planners`) and a
     termination-condition factory for a sample cap, if any."""
     from ompl import base as ob
@@ -66,7 +66,8 @@ def _make_planner(name: str, si: Any, from_sector: int, to_sector: int, samples:
         raise CliError(f"--samples needs a planner that counts iterations; {name} does not (use --time)")
     capped_by_samples = name in ("dimension-rrt", "library")  # our planners take the cap themselves
     ctx = PlannerContext(query={"from_sector": from_sector, "to_sector": to_sector},
-                         max_samples=samples if capped_by_samples else None, seed=seed, stall_samples=stall or None)
+                         max_samples=samples if capped_by_samples else None, seed=seed, stall_samples=stall or None,
+                         library=library)
     planner = planner_factory(PLANNERS[name])(si, ctx)
     if samples is None or capped_by_samples:
         return planner, None
@@ -82,6 +83,12 @@ def check_plan_args(args: argparse.Namespace) -> None:
     if args.from_sector == args.to_sector:
         raise CliError(f"--from and --to are both sector {args.from_sector}: a cross-sector motion needs two sectors")
     check_model_args(args)
+    if args.planner is None:  # the packaged library was built for the packaged model: another --urdf needs its own
+        args.planner = "dimension-rrt" if getattr(args, "urdf", None) and not args.library else "library"
+    if args.library is not None:
+        if args.planner != "library":
+            raise CliError(f"--library is read by --planner library, not {args.planner}")
+        check_input_file(args.library, "--library", "path library")
 
 
 def _start_and_goal(args: argparse.Namespace, robot: WearerArm) -> tuple[np.ndarray, np.ndarray, str | None]:
@@ -131,7 +138,7 @@ def plan_motion(args: argparse.Namespace) -> tuple[dict, WearerArm]:
         ss = make_simple_setup(robot, start, goal)
     si = ss.getSpaceInformation()
     planner, ptc_factory = _make_planner(args.planner, si, args.from_sector, args.to_sector, args.samples, args.seed,
-                                         args.stall)
+                                         args.stall, args.library)
     ss.setPlanner(planner)
     checks0 = robot.collision_checks
     if ptc_factory is not None:
@@ -182,9 +189,13 @@ def add_plan_args(p: argparse.ArgumentParser, required: bool = False) -> None:
     p.add_argument("--from", dest="from_sector", type=sector, required=required, default=1,
                    help="start posture sector (1-4)")
     p.add_argument("--to", dest="to_sector", type=sector, required=required, default=4, help="goal posture sector (1-4)")
-    p.add_argument("--planner", choices=tuple(PLANNERS), default="library",
-                   help="library: the DMP path library's validated path, refined by dimension-RRT (default); "
-                        "rrtconnect-simplify: RRTConnect + OMPL's PathSimplifier; the others: OMPL's planners")
+    p.add_argument("--planner", choices=tuple(PLANNERS), default=None,
+                   help="library: the DMP path library's validated path, refined by dimension-RRT (default; with "
+                        "--urdf and no --library: dimension-rrt); rrtconnect-simplify: RRTConnect + OMPL's "
+                        "PathSimplifier; the others: OMPL's planners")
+    p.add_argument("--library", type=nonempty, default=None, metavar="FILE",
+                   help="path library of --planner library (default: the packaged one, for the packaged model; "
+                        "'tpee-ompl library build --urdf U --srdf S --library FILE' builds one for another)")
     p.add_argument("--time", type=seconds, default=5.0, help="time limit in seconds, at most a day (default 5)")
     p.add_argument("--samples", type=positive_int, default=None, help="sample / iteration cap")
     p.add_argument("--stall", type=count, default=DEFAULT_STALL,
@@ -257,7 +268,12 @@ def cmd_track(args: argparse.Namespace) -> int:
                        f"at most {MAX_TRACK_SAMPLES} are tracked")
     if args.output:
         check_output(args.output, "--output", args.force)
-    if args.planner in ("default", "library"):
+    if args.library is None and not getattr(args, "urdf", None):  # the packaged library fits the packaged model only
+        args.library = str(default_library_path())
+    if args.planner == "library" and args.library is None:
+        raise CliError("--planner library with --urdf needs --library FILE, a library built for that model "
+                       "('tpee-ompl library build --urdf U --srdf S --library FILE')")
+    if args.library is not None and args.planner in ("default", "library"):
         check_input_file(args.library, "--library", "path library")
     robot = load_robot(args)
     if args.planner == "dimension-rrt":
@@ -330,8 +346,9 @@ def register(sub: argparse._SubParsersAction, fmt: type) -> None:
     p.add_argument("--planner", choices=("default", "dimension-rrt", "library"), default="default",
                    help="cross-sector planner: default (LibraryDimensionRRT for 0.05 s, then Table 3's straight "
                         "motion, else RRTConnect), dimension-rrt, library (PathLibrary.query alone)")
-    p.add_argument("--library", type=nonempty, default=str(default_library_path()),
-                   help="path library file (default and library planners; default: the packaged one)")
+    p.add_argument("--library", type=nonempty, default=None, metavar="FILE",
+                   help="path library file (default and library planners; default: the packaged one, or none with "
+                        "--urdf: the default planner then plans without it)")
     p.add_argument("--samples", type=positive_int, default=default_of(dimension_rrt_planner, "max_samples"),
                    help="dimension-RRT sample cap")
     p.add_argument("--duration", type=positive_float, default=20.0, help=f"seconds of target motion (duration x rate <= {MAX_TRACK_SAMPLES})")
