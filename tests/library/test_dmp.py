@@ -156,3 +156,18 @@ def test_generation_is_closed_form_and_batched(rng: np.random.Generator, monkeyp
     assert batch.shape == (200, fwd.n_steps, 2) and np.all(np.isfinite(batch))
     for k in (0, 99, 199):
         np.testing.assert_array_equal(batch[k], generate_blended(fwd, rev, starts[k], goals[k]))
+
+
+def test_a_demo_or_rollout_too_large_for_the_arithmetic_is_refused_not_turned_into_inf() -> None:
+    """learn_dmp(demo * 1e200) returned non-finite weights and generate a non-finite path, with a RuntimeWarning only."""
+    import warnings
+
+    t = np.linspace(0.0, 1.0, 61)[:, None]
+    demo = np.hstack([np.sin(3 * t), t**2])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # and no numpy overflow warning on the way
+        with pytest.raises(ValueError, match="overflow"):
+            learn_dmp(demo * 1e200)
+        dmp = learn_dmp(demo)
+        with pytest.raises(ValueError, match="overflow"):
+            generate(dmp, np.array([1e308, 0.0]), np.array([-1e308, 1.0]))

@@ -320,25 +320,27 @@ def learn_dmp(demo: np.ndarray, options: DMPOptions | None = None) -> DMP:
     )
     S = np.where(scaled, amplitude, 1.0)
 
-    # (i) eq. 16 numerator for the discrete step: v[k+1] = v[k] + dt acc[k], y[k+1] = y[k] + dt v[k+1]
-    v = np.vstack([np.zeros((1, D)), np.diff(demo, axis=0) / dt])
-    acc = np.diff(v, axis=0) / dt
-    f_target = acc - ay * (by * (g - demo[:-1]) - v[:-1])  # (P-1, D)
+    with np.errstate(over="ignore", invalid="ignore"):  # a demo too large for the arithmetic is refused below
+        # (i) eq. 16 numerator for the discrete step: v[k+1] = v[k] + dt acc[k], y[k+1] = y[k] + dt v[k+1]
+        v = np.vstack([np.zeros((1, D)), np.diff(demo, axis=0) / dt])
+        acc = np.diff(v, axis=0) / dt
+        f_target = acc - ay * (by * (g - demo[:-1]) - v[:-1])  # (P-1, D)
 
-    # (ii) LWR, eq. 17 (the grid's phase, normalised basis, free and impulse responses: shared, cached)
-    x, phi, free, response = _grid(P, options)
-    psi = basis_functions(x, N, options.alpha_x, options.width)
-    zeta = x[:-1, None] * S  # (P-1, D)
-    num = psi[:-1].T @ (zeta * f_target)
-    den = psi[:-1].T @ (zeta**2)
-    weights = (num / np.maximum(den, np.finfo(float).tiny)).T  # (D, N)
+        # (ii) LWR, eq. 17 (the grid's phase, normalised basis, free and impulse responses: shared, cached)
+        x, phi, free, response = _grid(P, options)
+        psi = basis_functions(x, N, options.alpha_x, options.width)
+        zeta = x[:-1, None] * S  # (P-1, D)
+        num = psi[:-1].T @ (zeta * f_target)
+        den = psi[:-1].T @ (zeta**2)
+        weights = (num / np.maximum(den, np.finfo(float).tiny)).T  # (D, N)
 
-    # (iii) exact end: response at T of each unit basis forcing x phi_i (S = 1) is linear in w; by time
-    # invariance, y(T) after a unit impulse at step k is the impulse response at step P-1-k
-    c = (response[:0:-1] * x[:-1]) @ phi[:-1]  # (N,)
-    target = free[-1] * amplitude / S  # scaled: a(T); absolute: a(T) (g - y0)
-    weights = weights + np.outer(target - weights @ c, c) / (c @ c)
-
+        # (iii) exact end: response at T of each unit basis forcing x phi_i (S = 1) is linear in w; by time
+        # invariance, y(T) after a unit impulse at step k is the impulse response at step P-1-k
+        c = (response[:0:-1] * x[:-1]) @ phi[:-1]  # (N,)
+        target = free[-1] * amplitude / S  # scaled: a(T); absolute: a(T) (g - y0)
+        weights = weights + np.outer(target - weights @ c, c) / (c @ c)
+    if not np.all(np.isfinite(weights)):
+        raise ValueError(f"demo values up to {np.max(np.abs(demo)):.3g} overflow the DMP's arithmetic")
     return DMP.from_weights(weights, y0.copy(), g.copy(), scaled, P, options)  # what loading a library does too
 
 
@@ -357,12 +359,15 @@ def generate(dmp: DMP, start: np.ndarray, goal: np.ndarray) -> np.ndarray:
         raise ValueError(f"start and goal must have shape ({dmp.n_dims},) or (B, {dmp.n_dims}); got {start.shape}, {goal.shape}")
     if not (np.all(np.isfinite(start)) and np.all(np.isfinite(goal))):
         raise ValueError("start or goal contains NaN or inf")
-    S = np.where(dmp.scaled, goal - start, 1.0)
-    y = (
-        goal[..., None, :]
-        + (start - goal)[..., None, :] * dmp.free_response[:, None]
-        + S[..., None, :] * dmp.forcing_response
-    )
+    with np.errstate(over="ignore", invalid="ignore"):  # refused below
+        S = np.where(dmp.scaled, goal - start, 1.0)
+        y = (
+            goal[..., None, :]
+            + (start - goal)[..., None, :] * dmp.free_response[:, None]
+            + S[..., None, :] * dmp.forcing_response
+        )
+    if not np.all(np.isfinite(y)):
+        raise ValueError("start and goal overflow the rollout's arithmetic")
     y[..., 0, :] = start
     y[..., -1, :] = goal
     return y
