@@ -161,17 +161,29 @@ def test_settling_sweeps_start_again_with_full_checks_when_a_screened_move_fails
     assert checker.states(W).all() and checker.check_motions(W[:-1], W[1:]).all()
 
 
-def test_settling_sweeps_end_after_the_sweep_in_which_the_termination_condition_holds(monkeypatch: pytest.MonkeyPatch) -> None:
+def _false_for(n: int):
+    """A termination condition that holds from its (n + 1)-th call on."""
+    calls = iter(range(10**6))
+    return lambda: next(calls) >= n
+
+
+def test_sweeps_end_at_the_batch_of_candidates_at_which_the_termination_condition_holds(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The condition is asked before each batch of candidates (a whole sweep took 2-3 ms at a 10-ms budget)."""
     W, L, grouped, checker = _zigzag()
+    W0 = W.copy()
+    assert sweep_until_settled(W, L, np.array([0, 1]), grouped.layout, checker, max_sweeps=100, stop=lambda: True) == 0
+    assert np.array_equal(W, W0)  # held from the start: nothing is tried
     one_W, one_L = W.copy(), L.copy()
-    shortcut_waypoints(one_W, one_L, np.array([0, 1]), grouped.layout, checker)
-    sweep_until_settled(W, L, np.array([0, 1]), grouped.layout, checker, max_sweeps=100, stop=lambda: True)
-    assert np.array_equal(W, one_W)  # one sweep, then its motions checked in full: it passes
+    full = shortcut_waypoints(one_W, one_L, np.array([0, 1]), grouped.layout, checker)
+    before = float(L.sum())
+    part = sweep_until_settled(W, L, np.array([0, 1]), grouped.layout, checker, max_sweeps=100, stop=_false_for(1))
+    assert 0 < part < full and L.sum() < before  # one batch taken, then stopped
+    assert np.allclose(L, grouped.layout.distance(W[:-1], W[1:])) and checker.check_motions(W[:-1], W[1:]).all()
     # a failed final check with the condition holding: the path stays where it was, no sweeps in full
     W, L, grouped, checker = _zigzag()
     W0 = W.copy()
     monkeypatch.setattr(checker, "check_motions", lambda A, B: np.zeros(len(A), dtype=bool))
-    assert sweep_until_settled(W, L, np.array([0, 1]), grouped.layout, checker, max_sweeps=100, stop=lambda: True) == 0
+    assert sweep_until_settled(W, L, np.array([0, 1]), grouped.layout, checker, max_sweeps=100, stop=_false_for(1)) == 0
     assert np.array_equal(W, W0) and np.allclose(L, grouped.layout.distance(W[:-1], W[1:]))
 
 
@@ -300,7 +312,8 @@ def test_settling_sweeps_skip_unmoved_waypoints_with_the_same_paths_and_fewer_ch
 
     skipping = run()
     real = waypoint_shortcuts.shortcut_waypoints
-    monkeypatch.setattr(waypoint_shortcuts, "shortcut_waypoints", lambda W, L, d, lay, c, dirty=None, screen_only=False: real(W, L, d, lay, c, None, screen_only))
+    monkeypatch.setattr(waypoint_shortcuts, "shortcut_waypoints", lambda W, L, d, lay, c, dirty=None, screen_only=False, stop=None: real(W, L, d, lay, c, None, screen_only,
+                                                                                    stop))
     full = run()
     assert [p for p, _ in skipping] == [p for p, _ in full]
     assert sum(c for _, c in skipping) < sum(c for _, c in full)

@@ -181,6 +181,8 @@ class LibraryDimensionRRT(PythonPlanner):
         if cross and (i, j) in lib.pairs and len(lib.pairs[(i, j)].starts):
             closest = None
             for rank, k, W in lib.candidate_paths(start, goal, i, j):
+                if rank > 0 and ptc():  # the closest demonstration's path is always tried: it is the answer in ms
+                    break
                 stats["candidates_tried"] += 1
                 closest = k if closest is None else closest
                 path = array_to_path(si, W)
@@ -192,6 +194,9 @@ class LibraryDimensionRRT(PythonPlanner):
             # near the space's bounds (the joint limits) a DMP seed can leave them; it is only a head start: clip it
             bounds = si.getStateSpace().getBounds()
             seed = np.clip(seed, np.array(bounds.low, dtype=float), np.array(bounds.high, dtype=float))
+        if not have_exact and ptc():
+            stats["library_outcome"] = "failed"
+            return planner_status(ob.PlannerStatus.TIMEOUT)
         if cross and not have_exact:  # Table 3's straight motion: often free when the library's paths are not
             path = array_to_path(si, straight_motion(start, goal, i, j))
             if path_passes_motion_checks(si, path, in_bounds=True):

@@ -66,7 +66,8 @@ def shortcut_targets(A: np.ndarray, X: np.ndarray, B: np.ndarray, dims: np.ndarr
 
 
 def shortcut_waypoints(W: np.ndarray, L: np.ndarray, dims: np.ndarray, layout: RealVectorLayout, checker: Checker,
-                       dirty: np.ndarray | None = None, screen_only: bool = False) -> int:
+                       dirty: np.ndarray | None = None, screen_only: bool = False,
+                       stop: Callable[[], bool] | None = None) -> int:
     """Move the intermediate waypoints of the valid path W (h, n) towards their shortest points, in place.
 
     The odd steps go first, then the even ones, so no two neighbours move at once (the motion between
@@ -77,8 +78,9 @@ def shortcut_waypoints(W: np.ndarray, L: np.ndarray, dims: np.ndarray, layout: R
     place: only the waypoints marked are tried (the others, with themselves and their neighbours where
     they were when last tried, get the same candidates; with full checks also the same verdicts, while
     a screen's verdict can depend on whether the candidate was screened alone or with others); a tried
-    waypoint is unmarked, and a moved one marks itself and its neighbours.  Returns the number of
-    waypoints moved."""
+    waypoint is unmarked, and a moved one marks itself and its neighbours.  ``stop()`` (the planner's termination
+    condition) is asked before each batch of candidates is checked: once it holds, the sweep ends where it is (W
+    stays a valid path).  Returns the number of waypoints moved."""
     moved = 0
     for first in (1, 2):
         ts = np.arange(first, len(W) - 1, 2)
@@ -96,6 +98,8 @@ def shortcut_waypoints(W: np.ndarray, L: np.ndarray, dims: np.ndarray, layout: R
             sel = np.flatnonzero(todo & (dl + dr < L[ts - 1] + L[ts] - 1e-12))
             if not len(sel):
                 break
+            if stop is not None and stop():
+                return moved
             yes = np.ones(len(sel), dtype=bool)
             vc, left, right = checker.candidates(C[sel], A[sel], B[sel], yes, yes, yes, screen_only=screen_only)
             for k in sel[vc & left & right]:
@@ -142,7 +146,7 @@ def _sweeps(W: np.ndarray, L: np.ndarray, dims: np.ndarray, layout: RealVectorLa
     dirty = np.ones(len(W), dtype=bool)
     for _ in range(n):
         before = float(L.sum())
-        m = shortcut_waypoints(W, L, dims, layout, checker, dirty, screen_only)
+        m = shortcut_waypoints(W, L, dims, layout, checker, dirty, screen_only, stop)
         moved += m
         if not m or before - float(L.sum()) < SWEEP_MIN_GAIN * before or (stop is not None and stop()):
             break
