@@ -8,6 +8,7 @@ checks along a motion) and of the whole-path check (:func:`path_passes_motion_ch
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING
@@ -23,6 +24,8 @@ __all__ = [
     "MIN_JOINT_STEP",
     "array_to_path",
     "batched_motion_states",
+    "bisection_levels",
+    "bisection_order",
     "counted_motion_states",
     "motion_interior_states",
     "motion_is_valid",
@@ -354,3 +357,25 @@ def path_length(path: np.ndarray) -> float:
     For a compound space's weighted metric see :meth:`~tpee_ompl.planning.space_layout.RealVectorLayout.path_length`.
     """
     return float(np.linalg.norm(np.diff(np.asarray(path, dtype=float), axis=0), axis=1).sum())
+
+
+@functools.lru_cache(maxsize=256)
+def bisection_levels(m: int) -> np.ndarray:
+    """Level of each of m evenly spaced points in bisection order: the middle one 0, the middles of
+    the two halves 1, and so on (OMPL's discrete motion validator visits a motion's states this way)."""
+    levels = np.zeros(m, dtype=int)
+    todo = [(0, m - 1, 0)]
+    while todo:
+        lo, hi, level = todo.pop()
+        if lo <= hi:
+            mid = (lo + hi) // 2
+            levels[mid] = level
+            todo += [(lo, mid - 1, level + 1), (mid + 1, hi, level + 1)]
+    return levels
+
+
+@functools.lru_cache(maxsize=256)
+def bisection_order(m: int) -> np.ndarray:
+    """Indices of m evenly spaced points in bisection order, level by level (the order OMPL's discrete motion
+    validator checks a motion's states in, so that a collision is found after few of them)."""
+    return np.argsort(bisection_levels(m), kind="stable")

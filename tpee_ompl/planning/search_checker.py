@@ -9,13 +9,12 @@ failure) for screens that only need the first failure, and the project's motion 
 
 from __future__ import annotations
 
-import functools
 import math
 
 import numpy as np
 from ompl import base as ob
 
-from .paths import motion_interior_states
+from .paths import bisection_levels, motion_interior_states
 from .space_layout import RealVectorLayout
 
 __all__ = ["Checker", "segment_key"]
@@ -41,25 +40,10 @@ verdicts; 16 -> 4 took 0.90 of the time for the library pipeline (5,000 samples 
 checks) and 0.95 for the paper's dimension-RRT (2,500): ``experiments/speed_switches.py candidate-stride``."""
 
 
-@functools.lru_cache(maxsize=256)
-def _bisection_levels(m: int) -> np.ndarray:
-    """Level of each of m evenly spaced points in bisection order: the middle one 0, the middles of
-    the two halves 1, and so on (OMPL's discrete motion validator visits a motion's states this way)."""
-    levels = np.zeros(m, dtype=int)
-    todo = [(0, m - 1, 0)]
-    while todo:
-        lo, hi, level = todo.pop()
-        if lo <= hi:
-            mid = (lo + hi) // 2
-            levels[mid] = level
-            todo += [(lo, mid - 1, level + 1), (mid + 1, hi, level + 1)]
-    return levels
-
-
 def _screen_levels(idx: np.ndarray, K: int) -> np.ndarray:
     """Bisection level of each screened state, given its motion idx (in motion order, K motions)."""
     counts = np.bincount(idx, minlength=K).tolist()
-    return np.concatenate([_bisection_levels(m) for m in counts if m])
+    return np.concatenate([bisection_levels(m) for m in counts if m])
 
 
 def _longest_stretch_key(level: np.ndarray, length: np.ndarray) -> np.ndarray:
