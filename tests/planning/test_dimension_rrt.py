@@ -181,6 +181,34 @@ def test_invalid_start_and_goal_statuses(robot: WearerArm) -> None:
         assert not ss.haveSolutionPath()
 
 
+def test_an_invalid_start_is_reported_by_ompl_once(robot: WearerArm, capfd) -> None:
+    """OMPL's "Skipping invalid start state" warning came twice: the start states were restarted after it."""
+    from ompl import util as ou
+
+    q0, q1 = cross_sector_query(robot, 1, 2, np.random.default_rng(5))
+    ss = make_simple_setup(robot, np.zeros(4), q1, check_endpoints=False)
+    level = ou.getLogLevel()
+    ou.setLogLevel(ou.LOG_WARN)
+    try:
+        capfd.readouterr()
+        assert _status_of(ss, DimensionRRT(ss.getSpaceInformation(), max_samples=10)) == ob.PlannerStatus.INVALID_START
+        assert capfd.readouterr().err.count("Skipping invalid start state") == 1
+    finally:
+        ou.setLogLevel(level)
+
+
+def test_a_path_as_short_as_the_start_goal_distance_ends_the_search() -> None:
+    """Nothing is shorter than the straight start-goal distance: start = goal, or a free direct motion without a
+    prescribed group, used the whole time budget (0.3 of 0.3 s, where RRTConnect returns at once)."""
+    for start, goal in (((0.3, 0.2, 0, 0), (0.3, 0.2, 0, 0)), ((0.3, 0.2, 0, 0), (0.5, 0.1, 0.2, 0))):
+        ss = make_planar_arm_setup(start=start, goal=goal, obstacles=((5.0, 5.0, 0.1),))  # far out of reach
+        planner = DimensionRRT(ss.getSpaceInformation(), seed=0)
+        ss.setPlanner(planner)
+        assert ss.solve(30.0) == ob.PlannerStatus.EXACT_SOLUTION
+        assert planner.last_run_stats()["samples"] == 0
+        assert ss.getSolutionPath().length() == pytest.approx(np.linalg.norm(np.subtract(goal, start)), abs=1e-12)
+
+
 def test_start_off_the_prescribed_trajectory_is_invalid_start(robot: WearerArm) -> None:
     q0, q1 = cross_sector_query(robot, 1, 2, np.random.default_rng(6))
     ss = make_simple_setup(robot, q0, q1)

@@ -82,7 +82,10 @@ class GoalLoop:
                 poster.offer(run.search.W, run.best, time.perf_counter())
         self.record(time.perf_counter())
         cap = self.limits.cap
+        shortest = min(run.bound for run in self.runs)  # no path is shorter than the straight start-goal distance
         while not poster.satisfied and not ptc() and (cap is None or self.drawn < cap):
+            if poster.found_cost <= shortest * (1.0 + 1e-12) + 1e-12:  # reached it (start = goal, a free direct path)
+                break
             if not self.step(ptc):
                 break
         poster.flush()

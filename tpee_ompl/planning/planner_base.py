@@ -99,10 +99,9 @@ class PythonPlanner(ob.Planner):
     def _start(self) -> ob.State | ob.PlannerStatus:
         """The next valid start state within bounds (the problem's first on a new run), or INVALID_START."""
         pis = self.getPlannerInputStates()
+        if pis.getSeenStartStatesCount() > 0:  # solve() again without clear(): the start states were handed out
+            pis.restart()  # (before nextStart, which warns about an invalid start: once, not twice)
         start = pis.nextStart()
-        if start is None and pis.getSeenStartStatesCount() > 0:  # solve() again without clear()
-            pis.restart()
-            start = pis.nextStart()
         if start is None:  # nextStart() skips start states out of bounds or invalid (OMPL checks them itself)
             return planner_status(ob.PlannerStatus.INVALID_START)
         if not finite_state(self.getSpaceInformation(), start):  # OMPL's bounds check lets NaN through
