@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import sys
+import types
 
 import pytest
 
@@ -91,3 +92,26 @@ def test_validator_a_problem_lacks_is_refused_naming_the_option(capsys, tmp_path
     err = capsys.readouterr().err.strip()
     assert "--checkers" in err and "arm4" in err and len(err.splitlines()) == 1
     assert not list(tmp_path.iterdir())
+
+
+def test_resume_keeps_the_campaigns_worker_count_unless_workers_is_given(tmp_path, robot, monkeypatch):
+    """The default --workers 2 overwrote a --workers 1 campaign's count on every resume, and with it the checker's
+    threads: one database then mixed timings taken under two set-ups."""
+    from helpers.bench_standins import tiny_config, write_query_file
+
+    import json
+
+    import tpee_ompl.bench.campaign as campaign
+
+    cfg = tiny_config(write_query_file(tmp_path / "q.json", robot, n=1), tmp_path, sample_caps=(30,), anytime_budgets=())
+    folder = campaign.run_campaign(cfg, report=False, progress_bar=False).directory
+    meta = json.loads((folder / "campaign.json").read_text(encoding="utf-8"))
+    meta["config"]["workers"] = 3  # as if run with --workers 3
+    (folder / "campaign.json").write_text(json.dumps(meta), encoding="utf-8")
+    seen: list = []
+    done = types.SimpleNamespace(interrupted=False, failed_tasks=[], skipped_logs=[])
+    monkeypatch.setattr(campaign, "resume_campaign", lambda d, executor, workers, **kw: seen.append(workers) or done)
+    monkeypatch.setattr("tpee_ompl.cli.bench._print_result", lambda result: None)
+    assert main(["--resume", str(folder), "--no-progress"]) == 0
+    assert main(["--resume", str(folder), "--workers", "2", "--no-progress"]) == 0
+    assert seen == [3, 2]

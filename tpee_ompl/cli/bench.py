@@ -103,8 +103,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--max-queries", type=positive_int, default=_default("max_queries"),
                    help="use N queries, round-robin over the ordered sector pairs")
     p.add_argument("--runs", type=positive_int, default=_default("runs"), help="runs per planner per experiment (default: %(default)s)")
-    p.add_argument("--workers", type=positive_int, default=_default("workers"),
-                   help="worker processes, one fresh process per query (default: %(default)s)")
+    p.add_argument("--workers", type=positive_int, default=None,
+                   help=f"worker processes, one fresh process per query (default: {_default('workers')}; with "
+                        "--resume: the campaign's own, unless given)")
     p.add_argument("--seed", type=seed, default=_default("seed"),
                    help="campaign seed in [1, 2**32-1]; query k's process uses seed + k (default: %(default)s)")
     p.add_argument("--max-time", type=seconds, default=_default("max_time"), help="safety limit per iteration-capped run, s")
@@ -120,7 +121,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.set_defaults(bench_prog=p.prog)
     p.add_argument("--resume", metavar="DIR", type=nonempty, default=None,
                    help="finish an interrupted campaign in DIR: run only its missing experiments (configuration "
-                        "from DIR/campaign.json; the other campaign options are ignored)")
+                        "from DIR/campaign.json; the other campaign options are ignored, --workers and the "
+                        "executor options apply)")
 
 
 def build_parser(prog: str | None = None) -> argparse.ArgumentParser:
@@ -161,7 +163,7 @@ def config_from_args(args: argparse.Namespace) -> CampaignConfig:
         anytime_queries=args.anytime_queries,
         max_queries=args.max_queries,
         runs=args.runs,
-        workers=args.workers,
+        workers=_default("workers") if args.workers is None else args.workers,
         seed=args.seed,
         out=args.out,
         max_time=args.max_time,
@@ -200,13 +202,15 @@ def run(args: argparse.Namespace) -> int:
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     prog = getattr(args, "bench_prog", "bench")
     try:
-        if args.resume:
-            load_campaign(args.resume)
+        if args.resume:  # its own worker count (the checker's threads follow it) unless --workers is given
+            saved = load_campaign(args.resume)["config"].get("workers", _default("workers"))
+            workers = saved if args.workers is None else args.workers
             config = plan = None
         else:
             config = config_from_args(args)
+            workers = config.workers
             plan = prepare_campaign(config)
-        executor = make_executor(args.workers, dask=args.scheduler or args.dask, dask_workers=args.dask_workers,
+        executor = make_executor(workers, dask=args.scheduler or args.dask, dask_workers=args.dask_workers,
                                  retries=args.retries)
     except (ValueError, FileNotFoundError, ImportError) as exc:
         print(f"{prog}: error: {_user_message(exc)}", file=sys.stderr)
@@ -214,7 +218,7 @@ def run(args: argparse.Namespace) -> int:
     seen = interrupts()
     try:
         if args.resume:
-            result = resume_campaign(args.resume, executor=executor, workers=args.workers,
+            result = resume_campaign(args.resume, executor=executor, workers=workers,
                                      progress_bar=not args.no_progress)
         else:
             result = run_campaign(config, executor=executor, progress_bar=not args.no_progress, plan=plan)
