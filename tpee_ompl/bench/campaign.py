@@ -38,6 +38,7 @@ from .database import build_database, set_aside_broken_logs
 from .experiment import experiment_specs, log_name, run_query_task
 from ..files import check_writable_folder, write_new_file
 from ..signals import interrupts, sigterm_as_keyboard_interrupt
+from .._version import code_version
 from .results import append_json_line, make_results_dir, package_versions, utc_now, write_json
 
 if TYPE_CHECKING:  # hints only: the model imports pinocchio, the executors are imported when a campaign runs
@@ -321,7 +322,7 @@ def _tasks(meta: dict, log_dir: Path, done_names: set[str], n_threads, shared_fs
     for k, q in enumerate(meta["query_data"]):
         specs = [s for s in experiment_specs(cfg, k) if log_name(q, k, s) not in done_names]
         if specs:
-            tasks.append({"config": cfg, "query": q, "qpos": k, "query_set": meta["query_set"],
+            tasks.append({"config": cfg, "query": q, "qpos": k, "query_set": meta["query_set"], "code_version": code_version(),
                           "seed": cfg["seed"] + k, "specs": specs, "n_threads": n_threads,
                           "log_dir": str(log_dir) if shared_fs else None, "time_limit_s": task_time_limit(cfg, specs),
                           "sys_path": [p for p in sys.path if p]})

@@ -205,7 +205,8 @@ def _experiment_parameters(cfg: dict, task: dict, spec: dict, straight: float, m
         "campaign_seed INTEGER": str(cfg["seed"]),
         "process_seed INTEGER": str(task["seed"]),
         "model_hash TEXT": str(model_hash),
-        "tpee_ompl_version TEXT": __version__,  # the log's version line is OMPL's
+        # the log's version line is OMPL's; this is the package's, with its git commit when run from a checkout
+        "tpee_ompl_version TEXT": task.get("code_version") or __version__,
     }
 
 

@@ -96,8 +96,10 @@ def package_versions() -> dict[str, str]:
     """Versions of Python and the packages the results depend on."""
     from importlib import metadata
 
-    out = {"python": platform.python_version(), "platform": platform.platform()}
-    for dist in ("tpee_ompl", "ompl", "pin", "coal", "numpy", "matplotlib"):
+    from .._version import code_version
+
+    out = {"python": platform.python_version(), "platform": platform.platform(), "tpee_ompl": code_version()}
+    for dist in ("ompl", "pin", "coal", "numpy", "matplotlib"):
         try:
             out[dist] = metadata.version(dist)
         except metadata.PackageNotFoundError:

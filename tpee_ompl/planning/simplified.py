@@ -55,7 +55,7 @@ class SimplifiedPlanner(PythonPlanner):
 
     def settings(self) -> dict[str, str]:
         """Parameter name -> value as text (for the benchmark's ``plannerConfigs``)."""
-        return {"inner": self.inner.getName(), "simplifier": "PathSimplifier.simplify(path, ptc)"}
+        return {"inner": self.inner.getName(), "simplifier": "PathSimplifier.simplify(path, ptc, atLeastOnce=False)"}
 
     def last_run_stats(self) -> dict[str, Any]:
         """first_solution_time (s, the inner planner's exact path), raw_cost, best_cost (after
