@@ -199,3 +199,12 @@ def test_loading_a_missing_database_says_so_and_creates_nothing(tmp_path):
     with pytest.raises(ValueError, match="not a benchmark database"):
         report.load_runs(odd / "b.db")
     assert sorted(p.name for p in odd.iterdir()) == ["b.db"]
+
+
+def test_table4_says_what_the_dimension_rrt_it_compares_is():
+    """The report put the paper's figures beside "DimensionRRT", which has shortcut sweeps the paper does not."""
+    runs = [run("DimensionRRT", q, 500, 1.0, 2.0, 1.0, 1.0) for q in (0, 1)]
+    runs += [run("RRTstar", q, 500, 2.0, 4.0, 2.0, 2.0) for q in (0, 1)]
+    table = ratio_table(runs, "DimensionRRT", "RRTstar")
+    text = report._markdown(table, [], [], [], "DimensionRRT", "RRTstar", "batched")
+    assert "`DimensionRRT`: the paper's dimension-RRT" in text and "DimensionRRTNoShortcuts" in text

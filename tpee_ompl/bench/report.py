@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from ..files import atomic_path, atomic_write_text
+from .config import OUR_PLANNER_NOTES
 from .results import planner_name
 
 __all__ = [
@@ -329,6 +330,8 @@ def _ratio_markdown(ratios: list[dict], planner: str, reference: str, headline: 
     has_paper = any(not math.isnan(r["paper"]) for r in ratios)
     lines.append(f"Mean of per-query ratios{' (paper in brackets)' if has_paper else ''}, then median [Q1, Q3]; "
                  "n = queries where both succeeded. Lengths are raw planner output in joint space (rad).")
+    if planner in OUR_PLANNER_NOTES:
+        lines += ["", f"`{planner}`: {OUR_PLANNER_NOTES[planner]}."]
     labels = {r["metric"]: r["label"] for r in ratios}
     checkers = sorted({r["checker"] for r in ratios}, key=lambda c: (c != headline, c))
     for chk in checkers:
