@@ -49,6 +49,13 @@ def test_rrtconnect_first_solution_is_the_end_of_its_run():
     assert rec["exact"] and rec["first_solution_time"] is not None and math.isfinite(rec["first_solution_time"])
 
 
+def test_a_graph_the_planner_does_not_report_is_null_not_empty():
+    """AORRTC's planner data hold no state after a run that made hundreds: the DB said its graph was empty."""
+    aorrtc, rrtstar = _solve(og.AORRTC, 0.1), _solve(og.RRTstar, 0.1)
+    assert aorrtc["exact"] and aorrtc["graph_states"] is None and aorrtc["graph_motions"] is None
+    assert rrtstar["graph_states"] > 1 and rrtstar["graph_motions"] > 0
+
+
 def test_a_run_without_an_exact_solution_records_no_first_solution_time():
     rec = _solve(og.RRTstar, 5.0, cap=1)  # one iteration: no path from one sample
     assert not rec["exact"] and rec["first_solution_time"] is None

@@ -328,9 +328,11 @@ class RecordingPlanner(ob.Planner):
         try:
             pd = ob.PlannerData(self.getSpaceInformation())
             self.inner.getPlannerData(pd)
-            return {"graph_states": int(pd.numVertices()), "graph_motions": int(pd.numEdges())}
         except Exception:  # noqa: BLE001 (a planner without planner data)
             return {"graph_states": None, "graph_motions": None}
+        if pd.numVertices() == 0:  # any graph a solve keeps holds its start: none is given (AORRTC's, 490 states)
+            return {"graph_states": None, "graph_motions": None}
+        return {"graph_states": int(pd.numVertices()), "graph_motions": int(pd.numEdges())}
 
     def _run_stats(self, elapsed: float, progress: list, has_cost: bool, first: float | None) -> dict:
         """Iterations, samples, best cost, first-solution time and progress of the run that just ended."""
