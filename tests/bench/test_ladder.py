@@ -164,3 +164,15 @@ def test_checkpoint_columns_write_waypoints_of_a_compound_so2_space():
     short_way = 2 * (2 * 3.141592653589793 - 6.0)  # each joint wraps round through pi
     assert float(row["solution length REAL"]) == pytest.approx(short_way)
     assert row["correct solution BOOLEAN"] in ("1", "True", "true")
+
+
+def test_a_checkpoints_progress_never_holds_a_row_from_after_it():
+    """The planner's clock starts a little after the wrapper's: a row at 0.09999 s (66,701 samples) came after the
+    0.10002-s checkpoint (66,665), and the database's iterations went down."""
+    from tpee_ompl.bench.ladder import progress_until
+
+    progress = [(0.05, 3.0, 30000), (0.09, 2.9, 60000), (0.09999, 2.8, 66701), (0.2, 2.7, 130000)]
+    snap = {"time": 0.10002, "best_cost": 2.9, "iterations": 66665}
+    rows = progress_until(progress, snap)
+    assert rows == [(0.05, 3.0, 30000), (0.09, 2.9, 60000), (0.10002, 2.9, 66665)]
+    assert [r[2] for r in rows] == sorted(r[2] for r in rows)

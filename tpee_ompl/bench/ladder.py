@@ -46,7 +46,7 @@ from .database import NO_PATH_COLUMNS, log_text, progress_rows
 from .planners import PlannerContext, RecordingPlanner, planner_factory
 from .results import format_value, planner_name
 
-__all__ = ["LADDER_PLANNERS", "CheckpointPlanner", "DeriveContext", "Ladder", "group_ladders"]
+__all__ = ["LADDER_PLANNERS", "CheckpointPlanner", "DeriveContext", "Ladder", "group_ladders", "progress_until"]
 
 log = logging.getLogger(__name__)
 
@@ -401,9 +401,19 @@ def derived_run(ctx: DeriveContext, w: CheckpointPlanner, i: int, row: dict, rec
     row.update({k: format_value(v) for k, v in props.items()})
     prog = snap.get("progress")
     if prog is None:
-        prog = [p for p in rec["progress"] if p[0] <= snap["time"]]
-        prog.append((snap["time"], snap["best_cost"], snap["iterations"]))
+        prog = progress_until(rec["progress"], snap)
     return row, prog, props
+
+
+def progress_until(progress: list[tuple[float, float, int | None]], snap: dict) -> list[tuple[float, float, int | None]]:
+    """A run's progress rows as they stood at a checkpoint snapshot, ending with the snapshot's own row.
+
+    The planner times its rows from its own start and the snapshot from the wrapper's, a little earlier, so a row
+    a few microseconds before the snapshot's time can come after it: rows past the snapshot's iterations are
+    left out too (a row of 66,701 samples was followed by the checkpoint's 66,665)."""
+    n = snap["iterations"]
+    out = [p for p in progress if p[0] <= snap["time"] and (n is None or p[2] is None or p[2] <= n)]
+    return out + [(snap["time"], snap["best_cost"], n)]
 
 
 def derive_planner_runs(source: ot.PlannerExperiment, target: ot.PlannerExperiment, w: CheckpointPlanner,
