@@ -403,4 +403,5 @@ def _apply_srdf(model: pin.Model, gmodel: pin.GeometryModel, srdf: Path, unknown
         raise ValueError(f"SRDF {srdf} names unknown link {name!r} ({len(foreign)} of its {len(pairs)} disabled pairs "
                          "name links the URDF lacks: an SRDF of another or a larger robot? keep only the pairs of "
                          "this URDF's links, or pass srdf_unknown_links='skip')")
-    pin.removeCollisionPairs(model, gmodel, str(srdf))
+    # from the text, not the path: Pinocchio's path reader refuses a file not named *.srdf (an SRDF saved as .xml)
+    pin.removeCollisionPairsFromXML(model, gmodel, srdf.read_text(encoding="utf-8"))
