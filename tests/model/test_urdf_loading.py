@@ -13,3 +13,18 @@ def test_an_srdf_not_named_srdf_is_read_like_one(tmp_path):
     xml.write_bytes(srdf.read_bytes())
     packaged, renamed = WearerArm(urdf, srdf), WearerArm(urdf, xml)
     assert len(renamed.gmodel.collisionPairs) == len(packaged.gmodel.collisionPairs)
+
+
+def test_a_joint_to_a_missing_link_is_named_before_urdfdom_fails_vaguely(tmp_path):
+    """urdfdom printed "child link [l2x] of joint [j2] not found" on stderr and the error said only "not a valid URDF"."""
+    import pytest
+
+    from tpee_ompl.model.robot_checker import RobotChecker
+    from tpee_ompl.resources import model_file
+
+    text = model_file("wearer_arm.urdf").read_text(encoding="utf-8")
+    first_child = text.index('<child link="')
+    broken = text[:first_child] + '<child link="nowhere"/>' + text[text.index("/>", first_child) + 2:]
+    (tmp_path / "broken.urdf").write_text(broken, encoding="utf-8")
+    with pytest.raises(ValueError, match="child link 'nowhere', which is not a <link>"):
+        RobotChecker(tmp_path / "broken.urdf")

@@ -152,6 +152,15 @@ def _parse_urdf(urdf: Path) -> ET.Element:
                 and _finite_numbers(axis.get("xyz", "1 0 0")) and not any(float(v) for v in axis.get("xyz", "1 0 0").split()):
             raise ValueError(f"URDF {urdf}: joint {joint.get('name')!r} has <axis xyz=\"{axis.get('xyz')}\">: a zero axis "
                              "moves nothing (a revolute joint would scale its child instead of turning it)")
+    links = {link.get("name") for link in root.findall("link")}
+    for joint in root.findall("joint"):  # (not a <transmission>'s) urdfdom prints "Failed to build tree" and says only
+        # "not a valid URDF model"
+        for end in ("parent", "child"):
+            el = joint.find(end)
+            name = None if el is None else el.get("link")
+            if name not in links:
+                raise ValueError(f"URDF {urdf}: joint {joint.get('name')!r} has {end} link {name!r}, which is not a "
+                                 "<link> of the file")
     for owner in (*root.iter("link"), *root.iter("joint")):
         for el in owner.iter():
             for attr in _NUMBERS.get(el.tag, ()):
