@@ -73,6 +73,7 @@ def test_a_one_state_answer_short_of_the_goal_has_no_path_columns_and_one_at_the
     assert at_goal["raw_length REAL"] == 0.0 and at_goal["path_valid_dense INTEGER"] == 1
     two = _path_properties(si, {"waypoints": np.array([start, goal]), "best_cost": None}, start, goal, (0, 1), layout)
     assert two["reaches_goal INTEGER"] == 1 and two["raw_length REAL"] > 0
+    assert two["best_cost REAL"] == two["raw_length REAL"]  # a planner without bestCost() (RRTConnect): its length
 
 
 def test_a_zero_length_path_short_of_the_goal_has_no_path_columns_and_an_approximate_path_no_best_cost(robot):

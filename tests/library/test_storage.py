@@ -162,3 +162,31 @@ def test_a_pipe_is_refused_at_once_instead_of_read(robot: WearerArm, tmp_path) -
     os.mkfifo(fifo)
     with pytest.raises(LibraryFileError, match="not a regular file"):
         PathLibrary.load(fifo, robot)
+
+
+def test_a_corrupt_compressed_array_is_a_library_file_error(robot: WearerArm, tmp_path) -> None:
+    """A damaged deflate stream escaped as zlib.error ("unexpected error" from the command line, no file named)."""
+    import zipfile
+
+    f = write_library_file(tmp_path / "lib.npz")
+    with zipfile.ZipFile(f) as z:
+        info = z.getinfo("p12_waypoints.npy")
+    raw = bytearray(f.read_bytes())
+    start = info.header_offset + 30 + len(info.filename) + len(info.extra)  # the member's compressed data
+    for k in range(200, 400):
+        raw[start + k] ^= 0x55
+    f.write_bytes(bytes(raw))
+    with pytest.raises(LibraryFileError, match="unreadable"):
+        PathLibrary.load(f, robot)
+
+
+def test_a_file_without_query_stride_gets_one_its_rollouts_allow(robot: WearerArm, tmp_path) -> None:
+    """The default stride 10 was taken unchecked: with per_step 1 (rollouts of 6 steps) the constructor refused it."""
+    def change(a: dict) -> None:
+        a["meta"].pop("query_stride", None)
+        a["meta"].update(per_step=1, pairs=[])
+        for key in [k for k in a if k.startswith("p12_")]:
+            a.pop(key)
+
+    lib = PathLibrary.load(write_library_file(tmp_path / "lib.npz", change), robot)
+    assert lib.per_step == 1 and lib.query_stride == 6

@@ -224,9 +224,9 @@ def _path_properties(si, rec: dict, start: np.ndarray, goal: np.ndarray, first: 
     l4, l12, l34 = group_lengths(W, first, layout) if len(W) >= 2 else (0.0, 0.0, 0.0)
     ok = path_passes_motion_checks(si, W if layout.is_plain else layout.to_path(si, W))
     # a path short of the goal has no best cost, whatever the planner's bestCost() says (AORRTC's is 0 then);
-    # a planner without bestCost(): its path's length
+    # a planner without bestCost() (RRTConnect): its path's length
     best = rec["best_cost"] if ends else None
-    if best is not None and not math.isfinite(float(best)):
+    if ends and (best is None or not math.isfinite(float(best))):
         best = l4
     return {"reaches_goal INTEGER": int(ends), "best_cost REAL": best, "length_dof12 REAL": l12,
             "length_dof34 REAL": l34, "raw_length REAL": l4, "path_valid_dense INTEGER": int(ok)}

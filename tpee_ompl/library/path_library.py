@@ -88,7 +88,8 @@ class PathLibrary:
     query whose DMP candidates all collide is "failed".  ``query_stride``: a query returns every
     ``query_stride``-th sample of the ``per_step``-dense DMP rollout (plus the last), i.e. a
     polyline of ``(N_FAKE_TIME_STEPS - 1) per_step / query_stride + 1`` points; that polyline is
-    what is checked and returned, so the stride changes cost, never the guarantee.
+    what is checked and returned, so the stride changes cost, never the guarantee (default: 10, or the rollout's
+    length when shorter).
     """
 
     def __init__(
@@ -100,7 +101,7 @@ class PathLibrary:
         plan: Plan | None = None,
         n_candidates: int = 3,
         build_stats: dict[str, int] | None = None,
-        query_stride: int = 10,
+        query_stride: int | None = None,
         build_params: dict | None = None,
     ) -> None:
         self.robot = robot
@@ -121,7 +122,9 @@ class PathLibrary:
         self.n_candidates = check_int("n_candidates", n_candidates, minimum=1)  # a library file's bound too
         self.build_stats = dict(build_stats or {})
         self.build_params = dict(build_params or {})
-        self.query_stride = check_int("query_stride", query_stride, minimum=1, maximum=max_query_stride(self.per_step))
+        longest = max_query_stride(self.per_step)
+        self.query_stride = min(10, longest) if query_stride is None else check_int("query_stride", query_stride,
+                                                                                    minimum=1, maximum=longest)
         self._counts: Counter[str] = Counter()
         self._dof12_cache: dict[tuple[int, int], np.ndarray] = {}
 

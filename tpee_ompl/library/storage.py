@@ -12,6 +12,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import zipfile
+import zlib
 from dataclasses import asdict
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -136,7 +137,7 @@ def _check_meta(meta: Any, path: Path) -> dict[str, Any]:
         if type(v) is not int or not 0 <= v <= _BUILD_STAT_MAX:
             raise bad("build_stats", f"entry {k!r} must be a count in [0, {_BUILD_STAT_MAX:g}], got {v!r}"[:300])
     return {"per_step": meta["per_step"], "options": dmp_options, "n_candidates": meta["n_candidates"],
-            "build_stats": meta.get("build_stats"), "query_stride": meta.get("query_stride", 10),
+            "build_stats": meta.get("build_stats"), "query_stride": meta.get("query_stride"),
             "build_params": meta.get("build_params"), "pairs": [tuple(p) for p in pairs]}
 
 
@@ -154,7 +155,10 @@ def _pair_arrays(archive: _Archive, i: int, j: int, n_basis: int, robot: WearerA
     if missing:
         raise LibraryFileError(f"path library {path}: array {missing[0]!r} is missing")
     first = archive.shape(p + "starts")
-    m = first[0] if first else -1
+    if len(first) != 2:
+        raise LibraryFileError(f"path library {path}: array {p + 'starts'!r} has shape {first}, expected (m, 4) for "
+                               "m demonstrations")
+    m = first[0]
     shapes = {"starts": (m, 4), "goals": (m, 4), "waypoints": (m, N_FAKE_TIME_STEPS, 4), "margins": (m,),
               "fwd_weights": (m, 2, n_basis), "rev_weights": (m, 2, n_basis), "fwd_scaled": (m, 2), "rev_scaled": (m, 2)}
     for name, shape in shapes.items():
@@ -191,6 +195,14 @@ def _pair_arrays(archive: _Archive, i: int, j: int, n_basis: int, robot: WearerA
     return a
 
 
+_READ_ERRORS = (zipfile.BadZipFile, zlib.error, EOFError, OSError, ValueError, KeyError)
+"""What reading a damaged ``.npz`` raises (a corrupt deflate stream: ``zlib.error``)."""
+
+
+def _unreadable(path: Path, why: object) -> LibraryFileError:
+    return LibraryFileError(f"path library {path} is unreadable (truncated or not a library file): {why}")
+
+
 class _Archive:
     """The arrays of an open ``.npz`` file, read one at a time: each one's header is read (and its declared size
     counted against :data:`MAX_LIBRARY_BYTES`) before it is unpacked, so a file cannot make the reader unpack more
@@ -212,9 +224,8 @@ class _Archive:
                     if read is None:
                         raise ValueError(f"array {key!r} has .npy format version {version}")
                     shape, _, dtype = read(f)
-            except (zipfile.BadZipFile, EOFError, OSError, ValueError, KeyError) as exc:
-                raise LibraryFileError(f"path library {self.path} is unreadable (truncated or not a library file): "
-                                       f"{exc}") from exc
+            except _READ_ERRORS as exc:
+                raise _unreadable(self.path, exc) from exc
             self._declared += int(np.prod(shape, dtype=object)) * dtype.itemsize
             if self._declared > MAX_LIBRARY_BYTES:
                 raise LibraryFileError(f"path library {self.path}: array {key!r} of shape {shape} would unpack the "
@@ -231,9 +242,8 @@ class _Archive:
         self.header(key)
         try:
             return self.z[key]
-        except (zipfile.BadZipFile, EOFError, OSError, ValueError, KeyError) as exc:
-            raise LibraryFileError(f"path library {self.path} is unreadable (truncated or not a library file): "
-                                   f"{exc}") from exc
+        except _READ_ERRORS as exc:
+            raise _unreadable(self.path, exc) from exc
 
 
 def _beyond_limit(name: str, x: np.ndarray) -> str | None:
@@ -264,13 +274,13 @@ def read_library(path: str | Path, robot: WearerArm) -> tuple[dict[tuple[int, in
     if path.exists() and not path.is_file():  # a folder, a pipe (np.load would wait on it forever), a device
         raise LibraryFileError(f"path library {path} is not a regular file")
     if path.is_file() and not zipfile.is_zipfile(path):  # numpy's own message would advise loading it with pickle
-        raise LibraryFileError(f"path library {path} is unreadable (truncated or not a library file): not an .npz archive")
+        raise _unreadable(path, "not an .npz archive")
     try:
         z = np.load(path, allow_pickle=False)
     except FileNotFoundError:
         raise
-    except (zipfile.BadZipFile, EOFError, OSError, ValueError, KeyError) as exc:
-        raise LibraryFileError(f"path library {path} is unreadable (truncated or not a library file): {exc}") from exc
+    except _READ_ERRORS as exc:
+        raise _unreadable(path, exc) from exc
     with z:
         return _read_archive(_Archive(z, path), robot)
 
