@@ -12,12 +12,14 @@ __version__ = "0.1.0"
 @functools.lru_cache(maxsize=1)
 def code_version() -> str:
     """What a result was made with: ``__version__``, plus ``+g<commit>`` (``.dirty`` with uncommitted changes to
-    tracked files) when the package runs from a git checkout that tracks it; ``__version__`` alone from a wheel."""
+    tracked files, ``.unknown`` when git could not tell) when the package runs from a git checkout that tracks it;
+    ``__version__`` alone from a wheel."""
     here = Path(__file__).resolve().parent
 
     def git(*args: str) -> str | None:
-        try:
-            out = subprocess.run(["git", "-C", str(here), *args], capture_output=True, text=True, timeout=10)
+        try:  # no optional locks: a status taking index.lock could make a commit running meanwhile fail
+            out = subprocess.run(["git", "--no-optional-locks", "-C", str(here), *args], capture_output=True,
+                                 text=True, timeout=10)
         except (OSError, subprocess.SubprocessError):
             return None
         return out.stdout.strip() if out.returncode == 0 else None
@@ -28,5 +30,5 @@ def code_version() -> str:
     sha = git("rev-parse", "--short=12", "HEAD")
     if not sha:
         return __version__
-    dirty = git("status", "--porcelain", "--untracked-files=no")
-    return f"{__version__}+g{sha}{'.dirty' if dirty else ''}"
+    status = git("status", "--porcelain", "--untracked-files=no")
+    return f"{__version__}+g{sha}{'.unknown' if status is None else '.dirty' if status else ''}"

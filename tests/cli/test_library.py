@@ -169,3 +169,17 @@ def test_plan_with_another_urdf_and_no_library_plans_with_dimension_rrt(other_mo
     assert json.loads(capsys.readouterr().out)["planner"] == "dimension-rrt"
     assert main(["plan", "--from", "1", "--to", "2", "--planner", "rrtconnect", "--library", "x.npz"]) == 2
     assert "--library is read by --planner library" in capsys.readouterr().err
+    assert main(["plan", "--from", "1", "--to", "4", *start_goal_args(), "--urdf", urdf, "--srdf", srdf,
+                 "--planner", "library", "--time", "0.05"]) == 2
+    assert "give --library FILE" in capsys.readouterr().err
+
+
+def test_plan_with_the_packaged_model_named_explicitly_keeps_the_packaged_library(capsys):
+    """The default is chosen by the model's hash, not by whether --urdf was given."""
+    from helpers.cli_queries import start_goal_args
+
+    from tpee_ompl.resources import model_file
+
+    assert main(["plan", "--from", "1", "--to", "4", *start_goal_args(), "--urdf", str(model_file("wearer_arm.urdf")),
+                 "--srdf", str(model_file("wearer_arm.srdf")), "--time", "0.05", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["planner"] == "library"

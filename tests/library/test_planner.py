@@ -57,6 +57,21 @@ def test_first_solution_stops_at_the_library_path_under_ompls_exact_solution_con
     assert planner.last_run_stats()["samples"] == 0  # no dimension-RRT sample was drawn
 
 
+def test_with_the_time_up_only_the_closest_demonstrations_path_is_tried(robot, library, monkeypatch):
+    """The pipeline asked its termination condition only after every library candidate, the straight and the direct
+    motion (2-3 ms past a 10-ms budget); the closest demonstration's path is still tried: it is the answer."""
+    import tpee_ompl.library.planner as pipeline
+
+    checked: list[int] = []
+    monkeypatch.setattr(pipeline, "path_passes_motion_checks", lambda si, path, **kw: checked.append(1) and False)
+    start, goal = _query(robot, 1, 2, 0)
+    ss, planner, status = _solve(robot, library, start, goal, ptc=lambda ss: ob.PlannerTerminationCondition(lambda: True))
+    stats = planner.last_run_stats()
+    assert status == ob.PlannerStatus.TIMEOUT and not ss.haveSolutionPath()
+    assert len(checked) == 1 and stats["candidates_tried"] == 1 and stats["samples"] == 0
+    assert stats["library_outcome"] == "failed" and stats["library_seconds"] is not None
+
+
 def test_a_satisfied_cost_threshold_stops_at_the_library_path(robot, library):
     start, goal = _query(robot, 1, 2, 1)
     ss = make_simple_setup(robot, start, goal)

@@ -83,12 +83,27 @@ def check_plan_args(args: argparse.Namespace) -> None:
     if args.from_sector == args.to_sector:
         raise CliError(f"--from and --to are both sector {args.from_sector}: a cross-sector motion needs two sectors")
     check_model_args(args)
-    if args.planner is None:  # the packaged library was built for the packaged model: another --urdf needs its own
-        args.planner = "dimension-rrt" if getattr(args, "urdf", None) and not args.library else "library"
     if args.library is not None:
-        if args.planner != "library":
+        if args.planner not in (None, "library"):
             raise CliError(f"--library is read by --planner library, not {args.planner}")
+        args.planner = "library"
         check_input_file(args.library, "--library", "path library")
+
+
+def _default_planner(args: argparse.Namespace, robot: WearerArm) -> str:
+    """--planner, or by default ``library`` when a library for the model is at hand (--library, or the packaged one
+    for its model), else ``dimension-rrt``; --planner library without one for the model is a usage error."""
+    if args.library is not None or args.planner not in (None, "library"):
+        return args.planner
+    from ..library.storage import library_model_hash
+
+    if library_model_hash(default_library_path()) == robot.model_hash:
+        return "library"
+    if args.planner == "library":
+        raise CliError("--planner library: the packaged path library was built for the packaged model, not this "
+                       "--urdf/--srdf; give --library FILE built for it ('tpee-ompl library build --urdf U --srdf S "
+                       "--library FILE')")
+    return "dimension-rrt"
 
 
 def _start_and_goal(args: argparse.Namespace, robot: WearerArm) -> tuple[np.ndarray, np.ndarray, str | None]:
@@ -127,6 +142,7 @@ def plan_motion(args: argparse.Namespace) -> tuple[dict, WearerArm]:
     ou.setLogLevel(ou.LOG_WARN)
     ou.RNG.setSeed(args.seed)
     robot = load_robot(args)
+    args.planner = _default_planner(args, robot)
     start, goal, qid = _start_and_goal(args, robot)
     if qid is None:
         start, goal, off_posture = on_postures(start, goal, args.from_sector, args.to_sector)
@@ -190,9 +206,9 @@ def add_plan_args(p: argparse.ArgumentParser, required: bool = False) -> None:
                    help="start posture sector (1-4)")
     p.add_argument("--to", dest="to_sector", type=sector, required=required, default=4, help="goal posture sector (1-4)")
     p.add_argument("--planner", choices=tuple(PLANNERS), default=None,
-                   help="library: the DMP path library's validated path, refined by dimension-RRT (default; with "
-                        "--urdf and no --library: dimension-rrt); rrtconnect-simplify: RRTConnect + OMPL's "
-                        "PathSimplifier; the others: OMPL's planners")
+                   help="library: the DMP path library's validated path, refined by dimension-RRT (default when a "
+                        "library for the model is at hand, else dimension-rrt); rrtconnect-simplify: RRTConnect + "
+                        "OMPL's PathSimplifier; the others: OMPL's planners")
     p.add_argument("--library", type=nonempty, default=None, metavar="FILE",
                    help="path library of --planner library (default: the packaged one, for the packaged model; "
                         "'tpee-ompl library build --urdf U --srdf S --library FILE' builds one for another)")
@@ -268,14 +284,19 @@ def cmd_track(args: argparse.Namespace) -> int:
                        f"at most {MAX_TRACK_SAMPLES} are tracked")
     if args.output:
         check_output(args.output, "--output", args.force)
-    if args.library is None and not getattr(args, "urdf", None):  # the packaged library fits the packaged model only
-        args.library = str(default_library_path())
-    if args.planner == "library" and args.library is None:
-        raise CliError("--planner library with --urdf needs --library FILE, a library built for that model "
-                       "('tpee-ompl library build --urdf U --srdf S --library FILE')")
     if args.library is not None and args.planner in ("default", "library"):
         check_input_file(args.library, "--library", "path library")
     robot = load_robot(args)
+    if args.library is None:  # the packaged library, when it was built for this model
+        from ..library.storage import library_model_hash
+
+        packaged = default_library_path()
+        if library_model_hash(packaged) == robot.model_hash:
+            args.library = str(packaged)
+        elif args.planner == "library":
+            raise CliError("--planner library: the packaged path library was built for the packaged model, not this "
+                           "--urdf/--srdf; give --library FILE built for it ('tpee-ompl library build --urdf U "
+                           "--srdf S --library FILE')")
     if args.planner == "dimension-rrt":
         plan = dimension_rrt_planner(robot, max_samples=args.samples, seed=args.seed)
 
@@ -347,8 +368,8 @@ def register(sub: argparse._SubParsersAction, fmt: type) -> None:
                    help="cross-sector planner: default (LibraryDimensionRRT for 0.05 s, then Table 3's straight "
                         "motion, else RRTConnect), dimension-rrt, library (PathLibrary.query alone)")
     p.add_argument("--library", type=nonempty, default=None, metavar="FILE",
-                   help="path library file (default and library planners; default: the packaged one, or none with "
-                        "--urdf: the default planner then plans without it)")
+                   help="path library file (default and library planners; default: the packaged one when it was "
+                        "built for the model, else none: the default planner then plans without it)")
     p.add_argument("--samples", type=positive_int, default=default_of(dimension_rrt_planner, "max_samples"),
                    help="dimension-RRT sample cap")
     p.add_argument("--duration", type=positive_float, default=20.0, help=f"seconds of target motion (duration x rate <= {MAX_TRACK_SAMPLES})")

@@ -194,8 +194,8 @@ class LibraryDimensionRRT(PythonPlanner):
             # near the space's bounds (the joint limits) a DMP seed can leave them; it is only a head start: clip it
             bounds = si.getStateSpace().getBounds()
             seed = np.clip(seed, np.array(bounds.low, dtype=float), np.array(bounds.high, dtype=float))
-        if not have_exact and ptc():
-            stats["library_outcome"] = "failed"
+        if not have_exact and ptc():  # time is up before the straight, the direct motion and the planning
+            stats.update(library_outcome="failed", library_seconds=time.perf_counter() - t0)
             return planner_status(ob.PlannerStatus.TIMEOUT)
         if cross and not have_exact:  # Table 3's straight motion: often free when the library's paths are not
             path = array_to_path(si, straight_motion(start, goal, i, j))

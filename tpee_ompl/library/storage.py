@@ -29,7 +29,8 @@ from .dmp import DMP, DMPOptions
 if TYPE_CHECKING:
     from .path_library import PathLibrary
 
-__all__ = ["FORMAT_VERSION", "MAX_CANDIDATES", "MAX_PER_STEP", "LibraryFileError", "read_library", "write_library"]
+__all__ = ["FORMAT_VERSION", "MAX_CANDIDATES", "MAX_PER_STEP", "LibraryFileError", "library_model_hash", "read_library",
+           "write_library"]
 
 FORMAT_VERSION = 2
 """Version of the ``.npz`` layout written by :func:`write_library` (2: per-demo planning margins)."""
@@ -255,6 +256,16 @@ def _beyond_limit(name: str, x: np.ndarray) -> str | None:
     if m <= _MAX_ABS[name]:
         return None
     return f"holds {m:g}, beyond +/-{_MAX_ABS[name]:g} ({'joint angles, rad' if name in _ANGLES else 'DMP weights'})"
+
+
+def library_model_hash(path: str | Path) -> str | None:
+    """The model hash a library file was built for, read from its metadata alone (None when the file does not say)."""
+    try:
+        with np.load(Path(path), allow_pickle=False) as z:
+            meta = json.loads(str(_Archive(z, Path(path)).read("meta")))
+    except (*_READ_ERRORS, LibraryFileError, json.JSONDecodeError):
+        return None
+    return meta.get("model_hash") if isinstance(meta, dict) else None
 
 
 def read_library(path: str | Path, robot: WearerArm) -> tuple[dict[tuple[int, int], PairDemos], dict[str, Any]]:
