@@ -122,7 +122,13 @@ def test_plan_reports_its_samples_and_says_when_the_time_limit_came_before_the_s
     assert json.loads(capsys.readouterr().out)["samples"] == 300
 
 
-def test_track_output_writes_the_sector_as_an_integer_and_times_exactly(tmp_path, capsys):
+def test_track_output_writes_the_sector_as_an_integer_and_times_exactly(tmp_path, capsys, monkeypatch):
+    import tpee_ompl.library.tracker as tracker_module
+
+    results = []
+    real_run = tracker_module.Tracker.run
+    monkeypatch.setattr(tracker_module.Tracker, "run", lambda self, stream: results.append(real_run(self, stream))
+                        or results[-1])
     out = tmp_path / "traj.csv"
     assert main(["track", "--script", "jump", "--duration", "2", "--rate", "2", "--planner", "dimension-rrt",
                  "-o", str(out)]) == 0
@@ -130,4 +136,5 @@ def test_track_output_writes_the_sector_as_an_integer_and_times_exactly(tmp_path
     assert lines[0] == "t,dof1,dof2,dof3,dof4,sector"
     rows = [line.split(",") for line in lines[1:]]
     assert rows and all(r[5] in {"0", "1", "2", "3", "4"} for r in rows)  # was 3.000000000000000000e+00 (0: in a motion)
-    assert all(float(r[0]) == float(repr(float(r[0]))) for r in rows)
+    written = np.array([[float(v) for v in r[:5]] for r in rows])
+    np.testing.assert_array_equal(written, np.c_[results[0].times, results[0].configurations])  # to the last bit

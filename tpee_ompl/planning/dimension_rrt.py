@@ -82,7 +82,9 @@ already checked in an earlier posted path passed ``si.checkMotion``
 (:func:`~tpee_ompl.planning.paths.path_passes_motion_checks`); after the first, improvements are
 posted while posting costs at most 10 % of the run time and the best one always at the end.  The
 planner stops once ``opt.isSatisfied(cost)`` (a cost threshold of ``inf`` = first solution; with an
-objective other than path length, which the search still minimises, its own cost of the path);
+objective other than path length, which the search still minimises, its own cost of the path), and once its
+path is as short as the straight start-goal distance (nothing is shorter).  The termination condition is asked
+between batches of samples and, in the shortcut sweeps, before each batch of candidates;
 :meth:`DimensionRRT.set_intermediate_solution_callback` stands in for OMPL's (refused from Python).
 
 Goal regions: a goal that is not one state (``GoalStates``, e.g. several IK solutions, or any other

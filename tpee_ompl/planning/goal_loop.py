@@ -55,8 +55,8 @@ class LoopLimits:
 
 class GoalLoop:
     """The loop of one solve over its goal runs (nearest goal first, in turns of :data:`GOAL_TURN` samples when
-    there are several), until the objective is satisfied, the termination condition holds, the cap is reached or
-    every goal has stopped."""
+    there are several), until the objective is satisfied, the termination condition holds, the cap is reached, the
+    path is as short as the nearest goal's straight distance, or every goal has stopped."""
 
     def __init__(self, runs: list[GoalRun], poster: SolutionPoster, new_search: NewSearch, q0: np.ndarray,
                  limits: LoopLimits, stats: dict[str, Any], t0: float,

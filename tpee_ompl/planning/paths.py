@@ -371,6 +371,7 @@ def bisection_levels(m: int) -> np.ndarray:
             mid = (lo + hi) // 2
             levels[mid] = level
             todo += [(lo, mid - 1, level + 1), (mid + 1, hi, level + 1)]
+    levels.setflags(write=False)  # cached: shared by every caller
     return levels
 
 
@@ -378,4 +379,6 @@ def bisection_levels(m: int) -> np.ndarray:
 def bisection_order(m: int) -> np.ndarray:
     """Indices of m evenly spaced points in bisection order, level by level (the order OMPL's discrete motion
     validator checks a motion's states in, so that a collision is found after few of them)."""
-    return np.argsort(bisection_levels(m), kind="stable")
+    order = np.argsort(bisection_levels(m), kind="stable")
+    order.setflags(write=False)  # cached: shared by every caller
+    return order

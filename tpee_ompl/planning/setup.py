@@ -115,7 +115,8 @@ class BatchedMotionValidator(ob.MotionValidator):
     By default the states are screened first where that pays on the robot (``screen_levels``,
     :func:`~tpee_ompl.model.clearance_balls.screened_all_valid`): one state checked at margins
     inflated for a ball of a few steps certifies its neighbours, and only the states no ball covers
-    are checked themselves; the verdict is the same.  ``screen_levels=()`` checks every state.
+    are checked themselves; the verdict is the same.  ``screen_levels=()`` checks the states themselves: one
+    motion in bisection order up to its first invalid state (as ``DiscreteMotionValidator``), several in one batch.
     """
 
     def __init__(self, si: ob.SpaceInformation, robot: RobotChecker, step: float,
@@ -223,11 +224,8 @@ class BatchedMotionValidator(ob.MotionValidator):
             spacing = np.linalg.norm(D, axis=1) / counts
             ok = screened_lines_valid(self.robot, self.robot.ball_screen(), S, counts, spacing, self.step,
                                       self.screen_levels)
-        elif len(counts) == 1:  # si.checkMotion's case: up to the first invalid state, in bisection order
-            ok = np.array([self.robot.first_invalid(S[bisection_order(len(S))]) < 0])
         else:
-            valid = self.robot.are_valid(S)
-            ok = np.array([c.all() for c in np.split(valid, np.cumsum(counts)[:-1])], dtype=bool) if len(counts) else valid
+            ok = self.all_valid(np.split(S, np.cumsum(counts)[:-1]) if len(counts) else [])
         return self._tally(np.asarray(ok, dtype=bool))
 
     def _tally(self, ok):
@@ -236,7 +234,8 @@ class BatchedMotionValidator(ob.MotionValidator):
         return ok
 
     def all_valid(self, chunks: list[np.ndarray]) -> np.ndarray:
-        """Per chunk of evenly spaced states along a line (a motion's dense states), True iff all are valid."""
+        """Per chunk of evenly spaced states along a line (a motion's dense states), True iff all are valid: screened
+        (``screen_levels``), else one chunk in bisection order up to its first invalid state, several in one batch."""
         if not chunks:
             return np.zeros(0, dtype=bool)
         if self.screen_levels:

@@ -123,8 +123,9 @@ def sweep_until_settled(W: np.ndarray, L: np.ndarray, dims: np.ndarray, layout: 
     (the candidate and every 4th or 8th state of its motions) and the motions that changed are checked in
     full once, at the end: a waypoint often moves several times, and its passing motions need no full
     check.  If one of them fails, W goes back to where it was and the sweeps run again with every move
-    checked in full.  ``stop()`` (the planner's termination condition) is asked after each sweep: once it
-    holds, no further sweep runs (a failed final check then leaves W where it was).  Returns the number
+    checked in full.  ``stop()`` (the planner's termination condition) is asked before each batch of candidates
+    and after each sweep: once it holds, no further candidates are tried (a failed final check then leaves W where
+    it was).  Returns the number
     of waypoint moves; W stays a valid path."""
     n = MAX_SWEEPS if max_sweeps is None else max_sweeps
     lazy = n > 1 and checker.batched
