@@ -152,8 +152,8 @@ def test_a_library_for_another_urdf_is_built_inspected_and_planned_with(other_mo
     capsys.readouterr()
     assert main(["library", "stats", "--library", str(lib), *model]) == 0
     assert "1 demonstrations" in capsys.readouterr().out
-    assert main(["library", "stats", "--library", str(lib)]) == 1  # the packaged model: another hash
-    assert "built for model" in capsys.readouterr().err
+    assert main(["library", "stats", "--library", str(lib)]) == 2  # the packaged model: another hash
+    assert "give the --urdf/--srdf it was built for" in capsys.readouterr().err
     assert main(["plan", "--from", "1", "--to", "4", *start_goal_args(), *model, "--library", str(lib), "--time", "0.05",
                  "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["planner"] == "library"
@@ -183,3 +183,23 @@ def test_plan_with_the_packaged_model_named_explicitly_keeps_the_packaged_librar
     assert main(["plan", "--from", "1", "--to", "4", *start_goal_args(), "--urdf", str(model_file("wearer_arm.urdf")),
                  "--srdf", str(model_file("wearer_arm.srdf")), "--time", "0.05", "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["planner"] == "library"
+
+
+def test_another_model_gets_clear_errors_and_a_default_tracker_planner_without_the_packaged_library(other_model,
+                                                                                                    capsys):
+    """plan --urdf without --start/--goal failed at run time on the packaged query set's model ("regenerate the
+    set"), track ignored a --library its planner does not read, and make_default_planner raised LibraryFileError."""
+    from tpee_ompl import WearerArm
+    from tpee_ompl.library.tracker import make_default_planner
+
+    urdf, srdf = other_model
+    assert main(["plan", "--from", "1", "--to", "4", "--urdf", urdf, "--srdf", srdf, "--time", "0.05"]) == 2
+    assert "with --urdf give --start and --goal" in capsys.readouterr().err
+    assert main(["track", "--planner", "dimension-rrt", "--library", "x.npz", "--duration", "1"]) == 2
+    assert "--library is read by --planner default and library" in capsys.readouterr().err
+    robot = WearerArm(urdf, srdf)
+    plan = make_default_planner(robot, seed=1)
+    from tpee_ompl.model.sectors import posture_preset
+
+    path = plan(np.r_[posture_preset(1), 0.0, 0.0], np.r_[posture_preset(4), 0.0, 0.0], 1, 4)
+    assert robot.are_valid(path).all()

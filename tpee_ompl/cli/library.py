@@ -84,7 +84,13 @@ def _check_library_file(path: Path) -> Path:
 
 def _load(path: Path, robot: WearerArm, fallback: bool = True,
           max_samples: int = _BUILD_DEFAULTS.max_samples) -> PathLibrary:
+    from ..library.storage import library_model_hash
+
     _check_library_file(path)
+    built_for = library_model_hash(path)
+    if built_for is not None and built_for != robot.model_hash:
+        raise CliError(f"--library {path}: built for model {built_for!r}, not the loaded model {robot.model_hash!r}: "
+                       "give the --urdf/--srdf it was built for")
     plan = dimension_rrt_planner(robot, max_samples=max_samples) if fallback else None
     return PathLibrary.load(path, robot, plan=plan)
 
@@ -118,7 +124,7 @@ def run_build(args: argparse.Namespace) -> int:
     s = lib.stats()
     print(f"wrote {out}: {len(lib)} demonstrations in {len(lib.pairs)} pairs "
           f"({s['build_sampled']} drawn, {s['build_rejected_similar']} too similar, "
-          f"{s['build_plan_failed']} not planned) in {time.perf_counter() - t0:.0f} s, "
+          f"{s['build_plan_failed']} not planned) in {time.perf_counter() - t0:.1f} s, "
           f"{out.stat().st_size / 1e6:.2f} MB")
     return 0
 

@@ -113,12 +113,17 @@ def _start_and_goal(args: argparse.Namespace, robot: WearerArm) -> tuple[np.ndar
     """
     if args.start is not None and args.goal is not None:
         return np.array(args.start), np.array(args.goal), None
-    from ..model.queries import load_queries
+    from ..model.queries import QuerySetError, load_queries
 
     try:
         queries = load_queries(args.queries, robot)
     except FileNotFoundError as exc:
         raise CliError(f"--queries: {exc}") from None
+    except QuerySetError as exc:
+        if getattr(args, "urdf", None) and "made for model_hash" in str(exc):  # the packaged sets are the packaged model's
+            raise CliError(f"--queries {args.queries}: {exc}; with --urdf give --start and --goal, or --queries FILE "
+                           "made for that model") from None
+        raise
     pair = (args.from_sector, args.to_sector)
     matching = [q for q in queries if (q.from_sector, q.to_sector) == pair]
     if not matching:
@@ -284,7 +289,9 @@ def cmd_track(args: argparse.Namespace) -> int:
                        f"at most {MAX_TRACK_SAMPLES} are tracked")
     if args.output:
         check_output(args.output, "--output", args.force)
-    if args.library is not None and args.planner in ("default", "library"):
+    if args.library is not None:
+        if args.planner not in ("default", "library"):
+            raise CliError(f"--library is read by --planner default and library, not {args.planner}")
         check_input_file(args.library, "--library", "path library")
     robot = load_robot(args)
     if args.library is None:  # the packaged library, when it was built for this model
@@ -361,7 +368,10 @@ def register(sub: argparse._SubParsersAction, fmt: type) -> None:
 
     p = sub.add_parser("track", help="run the tracking strategy (Fig. 10) on a scripted target", formatter_class=fmt,
                        description="Track a scripted target: re-aim inside a pointing sector, plan cross-sector motions "
-                                   "when it leaves.\n\nexample:\n  tpee-ompl track --script circle\n"
+                                   "when it leaves.  -o writes the trajectory as CSV, columns t,dof1..dof4,sector: one "
+                                   "row per configuration the arm reaches, t its arrival (s; samples that come while the "
+                                   "arm moves share it), sector 0 on the waypoints of a cross-sector motion.\n\n"
+                                   "example:\n  tpee-ompl track --script circle\n"
                                    "  tpee-ompl track --script jump --planner dimension-rrt -o traj.csv")
     p.add_argument("--script", choices=("circle", "jitter", "jump"), default="circle")
     p.add_argument("--planner", choices=("default", "dimension-rrt", "library"), default="default",

@@ -335,8 +335,8 @@ def make_default_planner(
 
     A cross-sector motion goes to :class:`~tpee_ompl.library.planner.LibraryDimensionRRT` (the DMP
     library's validated path, refined by dimension-RRT) for ``library_time`` seconds; ``library`` is
-    the packaged default library (``"default"``), a file, a loaded :class:`PathLibrary`, or None to
-    skip this step.  Otherwise, and for same-sector re-aims: Table 3's straight motion
+    the packaged default library (``"default"``; skipped for a robot of another model, which it was not built
+    for), a file, a loaded :class:`PathLibrary`, or None to skip this step.  Otherwise, and for same-sector re-aims: Table 3's straight motion
     (:func:`tpee_ompl.model.queries.straight_motion`; within a sector a straight joint motion) when
     collision-free, else OMPL RRTConnect on :func:`tpee_ompl.planning.setup.make_simple_setup` for
     at most ``timeout`` seconds, simplified.  Every path is checked at the tracker's default step
@@ -362,10 +362,17 @@ def make_default_planner(
     lib: PathLibrary | None = None
     if isinstance(library, PathLibrary):
         lib = library
-    elif library is not None:
+    elif library == "default":  # the packaged library, when it was built for this model (else none, as track does)
         from ..resources import default_library_path
+        from .storage import library_model_hash
 
-        lib = PathLibrary.load(default_library_path() if library == "default" else library, robot)
+        if library_model_hash(default_library_path()) == robot.model_hash:
+            lib = PathLibrary.load(default_library_path(), robot)
+        else:
+            log.info("the packaged path library was built for another model: cross-sector motions are planned "
+                     "without it")
+    elif library is not None:
+        lib = PathLibrary.load(library, robot)
 
     def plan(start: np.ndarray, goal: np.ndarray, i: int, j: int) -> np.ndarray:
         with quieter_ompl():  # no "Info:" line per tracker motion
