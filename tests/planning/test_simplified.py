@@ -103,3 +103,22 @@ def test_the_simplifier_starts_no_pass_after_the_termination_condition(robot, mo
     si = ss.getSpaceInformation()
     ss.setPlanner(SimplifiedPlanner(si, og.RRTConnect(si)))
     assert ss.solve(5.0) == ob.PlannerStatus.EXACT_SOLUTION and calls == [False]
+
+
+def test_a_new_start_and_goal_without_clear_are_answered_not_the_old_query():
+    """RRTConnect keeps its trees across solves: after ss.setStartAndGoalStates the wrapper posted the old query's
+    path as an exact solution (it passes checkMotion, it just joins other states)."""
+    from tpee_ompl.examples.planar_arm import make_planar_arm_setup
+
+    ss = make_planar_arm_setup()
+    si = ss.getSpaceInformation()
+    ss.setPlanner(SimplifiedPlanner(si, og.RRTConnect(si)))
+    assert ss.solve(2.0) == ob.PlannerStatus.EXACT_SOLUTION
+    start, goal = si.allocState(), si.allocState()
+    for k, (a, b) in enumerate(zip((0.4, 0.0, 0.0, 0.0), (-0.5, 0.2, 0.1, 0.0))):
+        start[k], goal[k] = a, b
+    ss.setStartAndGoalStates(start, goal)
+    assert ss.solve(2.0) == ob.PlannerStatus.EXACT_SOLUTION
+    W = path_to_array(ss.getSolutionPath(), 4)
+    np.testing.assert_allclose(W[0], (0.4, 0.0, 0.0, 0.0))
+    np.testing.assert_allclose(W[-1], (-0.5, 0.2, 0.1, 0.0))

@@ -80,6 +80,12 @@ class SimplifiedPlanner(PythonPlanner):
             self.inner.setup()
             self._inner_setup = True
         status = self.inner.solve(ptc)
+        if pdef.hasExactSolution() and not _answers(pdef):
+            # native planners keep their trees across solves: after a new start or goal without clear(), RRTConnect
+            # answered the old query's path as an exact solution
+            pdef.clearSolutionPaths()
+            self.inner.clear()
+            status = self.inner.solve(ptc)
         if not pdef.hasExactSolution():
             return status
         # a plain og.SimpleSetup has no objective: the raw and simplified paths are compared by length
@@ -102,3 +108,9 @@ class SimplifiedPlanner(PythonPlanner):
             stats["best_cost"] = cost
         stats["progress"].append((time.perf_counter() - t0, stats["best_cost"], 0))
         return planner_status(ob.PlannerStatus.EXACT_SOLUTION)
+
+
+def _answers(pdef: ob.ProblemDefinition) -> bool:
+    """Whether the problem definition's solution path runs from one of its start states into its goal."""
+    states = pdef.getSolutionPath().getStates()  # the path's own states (never pdef.getStartState: it frees them)
+    return bool(states) and pdef.hasStartState(states[0], 0) and pdef.getGoal().isSatisfied(states[-1])
