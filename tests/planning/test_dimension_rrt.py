@@ -323,3 +323,42 @@ def test_the_first_path_does_not_depend_on_how_the_planned_dofs_are_grouped(conn
         assert planner.last_run_stats()["solutions_posted"] == 1
     for W in paths[1:]:
         np.testing.assert_array_equal(W, paths[0])
+
+
+def test_settings_fixed_at_construction_refuse_assignment_instead_of_being_ignored() -> None:
+    """p.h = 4 changed settings() (what a benchmark records) while the search went on with h = 7."""
+    ss = make_planar_arm_setup()
+    planner = DimensionRRT(ss.getSpaceInformation(), seed=3)
+    for name, value in (("h", 4), ("seed", 5), ("groups", [[0, 1, 2, 3]]), ("prescribed", {})):
+        with pytest.raises(AttributeError, match=f"pass {name}="):
+            setattr(planner, name, value)
+    assert planner.h == 7 and planner.seed == 3 and planner.settings()["h"] == "7"
+    planner.max_samples = 50  # read at every solve: honoured
+    ss.setPlanner(planner)
+    ss.solve(10.0)
+    assert planner.last_run_stats()["samples"] <= 50
+
+
+def test_a_run_ended_by_a_raising_validity_checker_still_reports_what_it_posted() -> None:
+    """The statistics were written after the loop only: a crash left 'nothing posted' beside an exact path in pdef."""
+    ss = make_planar_arm_setup()
+    checker = ss.getStateValidityChecker()
+    calls = {"n": 0}
+
+    class Failing(ob.StateValidityChecker):
+        def isValid(self, state):  # noqa: N802 (OMPL override)
+            calls["n"] += 1
+            if calls["n"] > 3000:
+                raise RuntimeError("the checker broke")
+            return checker.isValid(state)
+
+    si = ss.getSpaceInformation()
+    failing = Failing(si)
+    ss.setStateValidityChecker(failing)
+    planner = DimensionRRT(si, seed=0, batch=False)
+    ss.setPlanner(planner)
+    status = ss.solve(30.0)
+    stats = planner.last_run_stats()
+    assert status == ob.PlannerStatus.CRASH and ss.haveExactSolutionPath()  # a path was posted before the crash
+    assert stats["solutions_posted"] >= 1 and stats["first_solution_time"] is not None
+    assert stats["best_cost"] == pytest.approx(ss.getProblemDefinition().getSolutionPath().length())

@@ -70,6 +70,19 @@ def test_real_vector_space_without_bounds_is_refused() -> None:
         RealVectorLayout(ob.RealVectorStateSpace(3))
 
 
+def test_a_dimension_locked_by_bounds_of_width_zero_is_refused_saying_so() -> None:
+    """OMPL users lock a joint with low == high; the error said "no valid bounds: call space.setBounds" (they were set)."""
+    space = ob.RealVectorStateSpace(3)
+    bounds = ob.RealVectorBounds(3)
+    bounds.setLow(-1.0)
+    bounds.setHigh(1.0)
+    bounds.setLow(1, 0.5)
+    bounds.setHigh(1, 0.5)
+    space.setBounds(bounds)
+    with pytest.raises(ValueError, match=r"bounds of width 0 for dimension\(s\) \[1\].*locked"):
+        RealVectorLayout(space)
+
+
 def test_so2_leaves_wrap_around_like_the_space() -> None:
     cs = ob.CompoundStateSpace()
     cs.addSubspace(ob.SO2StateSpace(), 1.0)

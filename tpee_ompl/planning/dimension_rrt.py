@@ -92,7 +92,8 @@ Goal regions: a goal that is not one state (``GoalStates``, e.g. several IK solu
 ``max_goals`` drawn), and each gets its own search
 (:mod:`tpee_ompl.planning.goal_runs`), nearest to the start first, in turns of 100 samples; every
 search's shorter paths go to the same problem definition, and a goal whose start-goal distance is no
-shorter than the best path found stops.  A goal off a prescribed row is skipped.
+shorter than the best path found stops.  A goal off a prescribed row is skipped.  Of several start states
+the first valid one is planned from (OMPL's RRTConnect grows its start tree from all of them).
 
 Spaces: bounded RealVector, SO2 (the short way round, like ``SO2StateSpace``) and compounds of them;
 the bounds are read again at each solve (as OMPL's samplers read them).  No approximate solutions: a
@@ -141,6 +142,14 @@ def _drop_callbacks() -> None:
     for planner in list(_WITH_CALLBACKS):
         planner._callback = None
 
+def _fixed(name: str, get: Callable[[Any], Any], doc: str) -> property:
+    """A read-only attribute of :class:`DimensionRRT` whose assignment says where it is set."""
+    def refuse(self: Any, value: Any) -> None:
+        raise AttributeError(f"DimensionRRT.{name} is fixed when the planner is built: pass {name}=... to "
+                             "DimensionRRT(si, ...) (or DimensionRRTOptions)")
+    return property(get, refuse, doc=doc)
+
+
 class DimensionRRT(PythonPlanner):
     """Dimension-RRT (paper sec. 4.1.2): anytime, fake-time, DOF-grouped path optimisation.
 
@@ -188,11 +197,7 @@ class DimensionRRT(PythonPlanner):
         super().__init__(si, opts.name)
         self.options = opts
         self.grouped = grouped
-        self.h = self.grouped.h
-        self.groups = self.grouped.groups
-        self.prescribed = self.grouped.prescribed
         self.max_samples = opts.max_samples
-        self.seed = opts.seed
         self.narrow_after = opts.narrow_after
         self.narrowing = opts.narrowing
         self.range_ = rng_full
@@ -204,6 +209,13 @@ class DimensionRRT(PythonPlanner):
         self._callback_failed = False
         self._sample_checkpoints: tuple[int, ...] = ()
         self._samples_drawn = 0
+
+    # fixed at construction (the groups, the steps and the random generator are built from them): read-only, so that
+    # an assignment cannot change settings() while the search goes on with the old value
+    h = _fixed("h", lambda self: self.grouped.h, "Fake-time steps (``DimensionRRTOptions.h``).")
+    groups = _fixed("groups", lambda self: self.grouped.groups, "The DOF groups (``DimensionRRTOptions.groups``).")
+    prescribed = _fixed("prescribed", lambda self: self.grouped.prescribed, "Groups with a prescribed trajectory.")
+    seed = _fixed("seed", lambda self: self.options.seed, "The seed of the planner's random generator.")
 
     @staticmethod
     def _full_range(opts: DimensionRRTOptions, grouped: GroupedSpace) -> np.ndarray:
@@ -404,16 +416,17 @@ class DimensionRRT(PythonPlanner):
         limits = LoopLimits(self.max_samples if grouped.planned else 0, self.options.max_h or 0,
                             self.options.stall_samples, self._sample_checkpoints)
         loop = GoalLoop(runs, poster, new_search, q0, limits, self._stats, t0, self._set_samples_drawn)
-        loop.run(ptc)
-        stats = self._stats
-        stats.update(
-            h=max(run.grouped.h for run in runs),
-            samples=loop.drawn,
-            iterations=loop.drawn,
-            collision_checks=checker.counter() - checks0,
-            first_solution_time=poster.first_time,
-            best_cost=poster.best_cost,
-            solutions_posted=poster.posted,
-            goals=len(runs),
-        )
+        try:
+            loop.run(ptc)
+        finally:  # also when the user's validity checker raised: the paths posted before it are in the problem
+            self._stats.update(
+                h=max(run.grouped.h for run in runs),
+                samples=loop.drawn,
+                iterations=loop.drawn,
+                collision_checks=checker.counter() - checks0,
+                first_solution_time=poster.first_time,
+                best_cost=poster.best_cost,
+                solutions_posted=poster.posted,
+                goals=len(runs),
+            )
         return planner_status(ob.PlannerStatus.EXACT_SOLUTION if poster.posted else ob.PlannerStatus.TIMEOUT)

@@ -2,7 +2,8 @@
 
 ``SimplifiedPlanner(si, og.RRTConnect(si))`` plans with RRTConnect until its first exact path, then
 shortens it with ``og.PathSimplifier.simplify`` until the simplifier converges or the termination
-condition ends it.  The simplification is part of the planner's time (so a benchmark compares it at
+condition ends it.  An inner planner that returns only at the termination condition (an anytime one such as
+RRT*) leaves the simplifier no time.  The simplification is part of the planner's time (so a benchmark compares it at
 equal time with an anytime planner), and the simplified path is added to the problem definition
 after it passed ``si.checkMotion`` over the whole path.
 """

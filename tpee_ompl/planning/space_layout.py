@@ -86,10 +86,13 @@ class RealVectorLayout:
             bad = [i for i in range(len(lo)) if not (math.isfinite(lo[i]) and math.isfinite(hi[i]) and lo[i] < hi[i])]
             where = f" (subspace {list(path)})" if path else ""
             if bad:
-                raise ValueError(
-                    f"RealVectorStateSpace{where} has no valid bounds "
-                    f"for dimension(s) {bad} (low must be < high, both finite): call space.setBounds(low, high) first"
-                )
+                locked = [i for i in bad if math.isfinite(lo[i]) and lo[i] == hi[i]]
+                why = (f"bounds of width 0 for dimension(s) {locked} (a joint locked this way): dimension-RRT samples "
+                       "every dimension of the space; leave a locked joint out of the space (RobotChecker(..., "
+                       "locked={joint: value}) does) or give it a width" if locked else
+                       f"no valid bounds for dimension(s) {bad} (low must be < high, both finite): call "
+                       "space.setBounds(low, high) first")
+                raise ValueError(f"RealVectorStateSpace{where} has {why}")
             huge = [i for i in range(len(lo)) if max(abs(lo[i]), abs(hi[i])) > MAX_BOUND]
             if huge:
                 raise ValueError(f"RealVectorStateSpace{where} has bounds beyond +/-{MAX_BOUND:g} for dimension(s) {huge}: "
