@@ -141,12 +141,14 @@ class SceneMesh:
         return lo, hi
 
 
-_MESH_CACHE: dict[int, SceneMesh] = {}
+_MESH_CACHE: dict[str, SceneMesh] = {}
+"""Scene meshes by model hash (the model's files and settings): a robot freed and another built at its address got
+its drawing when they were keyed by ``id(robot)``."""
 
 
 def scene_mesh(robot: WearerArm) -> SceneMesh:
-    """The robot's :class:`SceneMesh`, computed on the first call and then returned from a cache."""
-    key = id(robot)
+    """The robot's :class:`SceneMesh`, computed on the first call for its model and then returned from a cache."""
+    key = robot.model_hash
     if key in _MESH_CACHE:
         return _MESH_CACHE[key]
     polys, colors, arm_ids, barrel_ids = [], [], [], set()
