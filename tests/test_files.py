@@ -133,3 +133,21 @@ def test_a_failed_write_of_a_new_file_leaves_no_part_file(tmp_path):
         write_new_file(tmp_path / "x.txt", "a\ud800")  # a lone surrogate cannot be written as UTF-8
     assert list(tmp_path.iterdir()) == []
     assert write_new_file(tmp_path / "y.txt", "é") and (tmp_path / "y.txt").read_text(encoding="utf-8") == "é"
+
+
+def test_a_file_written_by_someone_else_while_this_wrote_is_not_replaced_without_force(tmp_path):
+    """The existence check ran before the work only: a file appearing meanwhile was replaced without --force."""
+    from tpee_ompl.files import OutputExistsError, atomic_path
+
+    out = tmp_path / "out.png"
+    with pytest.raises(OutputExistsError, match="written while this ran"):
+        with atomic_path(out, force=False) as tmp:
+            tmp.write_text("mine")
+            out.write_text("precious")  # another process, during the work
+    assert out.read_text() == "precious" and [p.name for p in tmp_path.iterdir()] == ["out.png"]
+    loop = tmp_path / "loop.png"
+    loop.symlink_to(loop.name)  # a link to itself: no file behind it
+    with pytest.raises(OutputExistsError):
+        with atomic_path(loop, force=False) as tmp:
+            tmp.write_text("mine")
+    assert loop.is_symlink()

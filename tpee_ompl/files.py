@@ -89,7 +89,8 @@ def atomic_path(path: str | os.PathLike, *, force: bool = True, suffix_last: boo
     The file gets the mode a plain ``open`` would give (0666 less the umask), not ``mkstemp``'s 0600.
     ``suffix_last`` ends the temporary name with ``path``'s suffix (``.m.gif.XXXX.part.gif``) for
     writers that choose the format by the file name and cannot be told otherwise (Pillow, ffmpeg).
-    With ``force=False`` an existing ``path`` raises :class:`OutputExistsError` before anything is written.  A
+    With ``force=False`` an existing ``path`` raises :class:`OutputExistsError` before anything is written, and one
+    that appeared while the caller wrote (another process) when the file is put in place: it is not replaced.  A
     ``path`` that is a symbolic link is written through: the file it points to is replaced, the link stays;
     a device, pipe or socket is refused (ValueError), never replaced by a file.
     """
@@ -110,7 +111,13 @@ def atomic_path(path: str | os.PathLike, *, force: bool = True, suffix_last: boo
         yield tmp
         with open(tmp, "rb+") as f:
             os.fsync(f.fileno())
-        os.replace(tmp, target)
+        if force:
+            os.replace(tmp, target)
+        else:  # a hard link is created only where no name is: a file written meanwhile stays
+            try:
+                os.link(tmp, target)
+            except FileExistsError:
+                raise OutputExistsError(f"{target} exists (written while this ran); pass --force to replace it") from None
     except OSError as exc:
         if exc.filename is not None and Path(exc.filename).name.startswith(f".{target.name}."):
             # the error names the temporary file: name the file the caller asked for

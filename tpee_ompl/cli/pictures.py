@@ -58,7 +58,7 @@ def cmd_show(args: argparse.Namespace) -> int:
             target = optional_target(args.target)
     else:
         target = np.array(DEFAULT_SCENE_TARGET) if args.q is None else None
-    out = save_scene(robot, q, args.output, target=target, sectors=args.sectors)
+    out = save_scene(robot, q, args.output, target=target, sectors=args.sectors, force=args.force)
     print(f"wrote {out} (q = {np.round(q, 4).tolist()} rad, valid: {robot.is_valid(q)})")
     return 0
 
@@ -116,7 +116,8 @@ def cmd_animate(args: argparse.Namespace) -> int:
             raise RuntimeError(f"{args.planner} found no exact path ({result['status']}); nothing to animate")
         W = np.asarray(result["path"])
     (pa, ua), (pb, ub) = robot.muzzle(W[0]), robot.muzzle(W[-1])
-    out = animate_path(robot, W, args.output, target_a=pa + 3 * ua, target_b=pb + 3 * ub, frames=args.frames)
+    out = animate_path(robot, W, args.output, target_a=pa + 3 * ua, target_b=pb + 3 * ub, frames=args.frames,
+                       force=args.force)
     print(f"wrote {out} ({len(W)} waypoints, {args.frames} frames)")
     return 0
 
@@ -128,7 +129,7 @@ def cmd_workspace(args: argparse.Namespace) -> int:
 
     check_output(args.output, "--output", args.force, image_suffixes())
     robot = load_robot(args)
-    pointing_workspace(robot, args.samples, np.random.default_rng(args.seed), args.output)
+    pointing_workspace(robot, args.samples, np.random.default_rng(args.seed), args.output, force=args.force)
     print(f"wrote {args.output} ({args.samples} samples, seed {args.seed})")
     return 0
 

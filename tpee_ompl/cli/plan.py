@@ -329,7 +329,7 @@ def cmd_track(args: argparse.Namespace) -> int:
         from ..files import atomic_path
 
         header = "t,dof1,dof2,dof3,dof4,sector"
-        with atomic_path(args.output) as tmp:
+        with atomic_path(args.output, force=args.force) as tmp:
             np.savetxt(tmp, np.c_[result.times, result.configurations, result.sectors], delimiter=",",
                        header=header, comments="", fmt=["%.17g"] * 5 + ["%d"])
     if args.json:

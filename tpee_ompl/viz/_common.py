@@ -94,7 +94,7 @@ def check_waypoints(robot: WearerArm, waypoints: Any) -> np.ndarray:
 
 
 # ---------------------------------------------------------------------------- files
-def output_path(out_path: str | os.PathLike, suffixes: tuple[str, ...] | None = None) -> Path:
+def output_path(out_path: str | os.PathLike, suffixes: tuple[str, ...] | None = None, force: bool = True) -> Path:
     """``out_path`` as a Path that can be written (:func:`~tpee_ompl.files.check_output_path`; its missing folders
     are made when the file is written); ValueError when it is no path, cannot be written or, with ``suffixes``, its
     name ends in none of them.  Nothing is created here: a later argument error leaves no empty folder behind."""
@@ -105,7 +105,7 @@ def output_path(out_path: str | os.PathLike, suffixes: tuple[str, ...] | None = 
     out = Path(out_path)
     if suffixes is not None:
         _check_image_suffix(out, suffixes)
-    return check_output_path(out, force=True, what="figure file")
+    return check_output_path(out, force=force, what="figure file")
 
 
 def _check_image_suffix(out: Path, suffixes: tuple[str, ...]) -> None:
@@ -122,16 +122,17 @@ def image_suffixes() -> tuple[str, ...]:
     return (*common, *others)
 
 
-def write_figure(fig: Figure, out: Path, dpi: int, **savefig_kwargs: Any) -> Path:
+def write_figure(fig: Figure, out: Path, dpi: int, force: bool = True, **savefig_kwargs: Any) -> Path:
     """Save ``fig`` to exactly ``out`` (format from its suffix), atomically; log it and return ``out``.
 
     A name without a known image suffix is refused (matplotlib would add ``.png`` and write another
-    file than the one named); an existing file is replaced in one step, never left half-written.
+    file than the one named); an existing file is replaced in one step, never left half-written (``force=False``:
+    refused, also one written meanwhile).
     """
     from ..files import atomic_path
 
     _check_image_suffix(out, image_suffixes())
-    with atomic_path(out) as tmp:
+    with atomic_path(out, force=force) as tmp:
         fig.savefig(tmp, dpi=dpi, format=out.suffix[1:].lower(), **savefig_kwargs)
     log.info("wrote %s", out)
     return out

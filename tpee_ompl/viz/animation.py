@@ -76,6 +76,7 @@ def animate_path(
     azim: float = DEFAULT_AZIM,
     dpi: int = 80,
     title: str | None = None,
+    force: bool = True,
 ) -> Path:
     """Animate a joint-space path (e.g. a cross-sector motion) with the muzzle trace.
 
@@ -86,7 +87,8 @@ def animate_path(
         Any planner's or the DMP library's path; resampled to ``frames`` configurations evenly
         spaced in joint-space arc length (:func:`resample_path`), so the file size is bounded.
     out_path : path
-        ``.gif`` (Pillow, always available) or ``.mp4`` (needs ffmpeg on PATH).
+        ``.gif`` (Pillow, always available) or ``.mp4`` (needs ffmpeg on PATH); ``force=False`` refuses an existing
+        file (also one written while the animation was drawn).
     target_a, target_b : array_like, shape (3,), metres, optional
         The start and goal targets.  The line of sight is drawn to ``target_a`` during the first half
         of the motion and to ``target_b`` during the second (green clear / red blocked).
@@ -164,8 +166,8 @@ def animate_path(
         txt.set_text(f"{head}  frame {i + 1}/{frames}  {state}")
         txt.set_color("k" if valid[i] else LOS_BLOCKED)
 
-    output_path(out)
-    with atomic_path(out, suffix_last=True) as tmp, writer.saving(fig, str(tmp), dpi):
+    output_path(out, force=force)
+    with atomic_path(out, suffix_last=True, force=force) as tmp, writer.saving(fig, str(tmp), dpi):
         for i in range(frames):
             draw(i)
             writer.grab_frame()

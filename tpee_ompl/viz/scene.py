@@ -179,12 +179,13 @@ def render_sectors(
     elev: float = DEFAULT_ELEV,
     azim: float = DEFAULT_AZIM,
     dpi: int = 100,
+    force: bool = True,
 ) -> Figure:
     """Draw the four posture sectors side by side: each preset's arm and its pointing range (paper Figs. 8-9).
 
     Each panel shows the arm at the Table 1 (DOF1, DOF2) preset and the barrel directions it can
     reach there (:func:`sector_pointing_range`) as dots on a sphere around the chest, blind
-    directions as grey crosses.  Saved to ``out_path`` if given.
+    directions as grey crosses.  Saved to ``out_path`` if given (``force=False``: an existing file is refused).
 
     Returns
     -------
@@ -194,7 +195,7 @@ def render_sectors(
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
     check_view(elev, azim, dpi)
-    out = None if out_path is None else output_path(out_path, image_suffixes())  # before the drawing
+    out = None if out_path is None else output_path(out_path, image_suffixes(), force)  # before the drawing
     mesh = scene_mesh(robot)
     fig = Figure(figsize=(11.0, 10.0), dpi=dpi)
     lo, hi = mesh.view_box([FAN_CENTRE - FAN_RADIUS, FAN_CENTRE + FAN_RADIUS], 10.0)
@@ -221,7 +222,7 @@ def render_sectors(
         ax.legend(loc="upper left", fontsize=7, markerscale=2)
     fig.tight_layout()
     if out is not None:
-        write_figure(fig, out, dpi)
+        write_figure(fig, out, dpi, force)
     return fig
 
 
@@ -234,13 +235,15 @@ def save_scene(
     path: Any = None,
     *,
     dpi: int = 110,
+    force: bool = True,
     **kwargs: Any,
 ) -> Path:
     """Render :func:`render_scene` to an image file (format from the suffix: .png, .pdf, .svg, ...).
 
-    Returns the written path.  Extra keyword arguments go to :func:`render_scene`.
+    Returns the written path (``force=False``: an existing file is refused).  Extra keyword arguments go to
+    :func:`render_scene`.
     """
-    out = output_path(out_path, image_suffixes())
+    out = output_path(out_path, image_suffixes(), force)
     check_view(kwargs.get("elev", DEFAULT_ELEV), kwargs.get("azim", DEFAULT_AZIM), dpi)
     fig = render_scene(robot, q, target=target, sectors=sectors, path=path, **kwargs)
-    return write_figure(fig, out, dpi, bbox_inches="tight")
+    return write_figure(fig, out, dpi, force, bbox_inches="tight")

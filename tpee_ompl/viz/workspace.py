@@ -186,12 +186,13 @@ def pointing_workspace(
     color_by: str = "sector",
     presets_only: bool = False,
     dpi: int = 110,
+    force: bool = True,
 ) -> Figure:
     """Draw the analogue of the paper's Fig. 4: a 3D view and three projections of the pointing workspace.
 
     Samples with :func:`sample_pointing_workspace`, then scatters the points coloured by posture
     sector (``color_by="sector"``) or by range from the muzzle (``color_by="range"``), over a faint
-    wearer.  Saved to ``out_path`` if given.
+    wearer.  Saved to ``out_path`` if given (``force=False``: an existing file is refused).
 
     Returns
     -------
@@ -204,7 +205,7 @@ def pointing_workspace(
     if color_by not in ("sector", "range"):
         raise ValueError(f"color_by must be 'sector' or 'range', got {color_by!r}")
     check_view(DEFAULT_ELEV, DEFAULT_AZIM, dpi)
-    out = None if out_path is None else output_path(out_path, image_suffixes())  # before sampling and drawing
+    out = None if out_path is None else output_path(out_path, image_suffixes(), force)  # before sampling and drawing
     t0 = time.perf_counter()
     s = sample_pointing_workspace(robot, n_samples, rng, ranges=ranges, presets_only=presets_only)
     mesh = scene_mesh(robot)
@@ -266,7 +267,7 @@ def pointing_workspace(
     )
     fig.tight_layout(rect=(0, 0, 1, 0.95))
     if out is not None:
-        write_figure(fig, out, dpi)
+        write_figure(fig, out, dpi, force)
     log.info(
         "pointing_workspace: %d samples, %d valid, %d points, %.2f s",
         s.n_samples,
