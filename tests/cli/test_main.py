@@ -188,3 +188,18 @@ def test_ctrl_c_while_the_command_line_loads_ends_it_with_130_and_one_line():
     proc = subprocess.run([sys.executable, "-c", code, "plan", "--from", "1", "--to", "4"], capture_output=True,
                           text=True, timeout=120)
     assert proc.returncode == 130 and proc.stderr == "tpee-ompl: interrupted\n" and proc.stdout == ""
+
+
+def test_an_interrupt_while_the_command_cleans_up_after_its_work_ends_with_130(monkeypatch, capsys):
+    """The last clean-up (a garbage collection) ran after the interrupt handling: Ctrl-C there printed a traceback
+    or was lost (exit 0)."""
+    import importlib
+
+    cli_main = importlib.import_module("tpee_ompl.cli.main")  # the module (the package exports its main())
+
+    def interrupted() -> int:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(cli_main.gc, "collect", interrupted)
+    assert cli_main.main(["aim", "--target", "5", "2", "1.5"]) == 130
+    assert capsys.readouterr().err.strip().endswith("interrupted")

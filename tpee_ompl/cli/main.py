@@ -60,8 +60,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     seen = interrupts()
     try:
         with sigterm_as_keyboard_interrupt():  # kill / a scheduler: the same cleanup as Ctrl-C (temporary files, workers)
-            code = int(args.func(args) or 0)
-            sys.stdout.flush()  # a closed pipe shows here, not in the interpreter's own flush at exit
+            try:
+                code = int(args.func(args) or 0)
+                sys.stdout.flush()  # a closed pipe shows here, not in the interpreter's own flush at exit
+            finally:  # in here: an interrupt during it is said like any other (it printed a traceback, or exit 0)
+                gc.collect()  # break si <-> Python checker cycles before exit (nanobind leak warnings otherwise)
             if interrupts() > seen and code != 130:  # its KeyboardInterrupt was dropped (raised in a weakref callback)
                 raise KeyboardInterrupt
             return code
@@ -77,8 +80,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         print(f"{args.prog}: interrupted", file=sys.stderr)
         return 130
-    finally:
-        gc.collect()  # break si <-> Python checker cycles before exit (nanobind leak warnings otherwise)
 
 
 def _command_parser(parser: argparse.ArgumentParser, args: argparse.Namespace) -> argparse.ArgumentParser:
