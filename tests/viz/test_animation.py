@@ -61,3 +61,31 @@ def test_animation_settings_are_value_errors_before_any_frame_is_drawn(robot, tm
 def test_resample_path_refuses_a_count_it_could_not_hold():
     with pytest.raises(ValueError, match="n"):
         resample_path([[0.0, 0.0], [1.0, 1.0]], 10**9)
+
+
+def test_waypoints_that_are_strings_or_beyond_any_joint_are_refused_not_coerced(robot, tmp_path):
+    """Strings were parsed, complex numbers lost their imaginary part with a warning, and 1e300 overflowed into a
+    "NaN configuration" error after two numpy warnings."""
+    import warnings
+
+    from tpee_ompl.viz.animation import animate_path, resample_path
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for bad, match in (([["0.87", "0.35", "0", "0"], ["0.87", "0.35", "0.1", "0"]], "real numbers"),
+                           ([[0.87 + 1j, 0.35, 0, 0], [0.87, 0.35, 0.1, 0]], "real numbers"),
+                           ([[1e300, 0, 0, 0], [0, 0, 0, 0]], "beyond")):
+            with pytest.raises(ValueError, match=match):
+                animate_path(robot, bad, tmp_path / "x.gif", frames=2)
+        with pytest.raises(ValueError, match="finite"):
+            resample_path([[float("nan"), 0.0], [1.0, 0.0]], 5)
+    assert not list(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize("dpi", [5, 201])
+def test_an_animation_resolution_that_breaks_matplotlib_or_memory_is_refused(robot, tmp_path, dpi):
+    """dpi 1-5 crashed in FreeType (IndexError from the GIF writer); dpi 2000 took 576 MB a frame."""
+    from tpee_ompl.viz.animation import animate_path
+
+    with pytest.raises(ValueError, match="dpi"):
+        animate_path(robot, [[0.87, 0.35, 0, 0], [0.87, 0.35, 0.1, 0]], tmp_path / "x.gif", frames=2, dpi=dpi)

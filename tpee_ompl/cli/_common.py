@@ -43,6 +43,7 @@ __all__ = [
     "default_of",
     "finite",
     "index",
+    "int_between",
     "load_robot",
     "nonempty",
     "numpy_seed",
@@ -127,6 +128,15 @@ def _int_in(text: str, low: int, high: int | None, message: str) -> int:
 def positive_int(text: str) -> int:
     """argparse type: an int in [1, :data:`MAX_COUNT`]."""
     return _int_in(text, 1, MAX_COUNT, f"must be a positive integer <= {MAX_COUNT:.0e}")
+
+
+def int_between(low: int, high: int) -> Callable[[str], int]:
+    """argparse type: an int in [low, high], the range said when refused."""
+    def parse(text: str) -> int:
+        return _int_in(text, low, high, f"must be an integer in [{low}, {high}]")
+
+    parse.__name__ = f"int_between_{low}_{high}"  # argparse names the type in some messages
+    return parse
 
 
 def count(text: str) -> int:

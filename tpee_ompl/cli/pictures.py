@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..viz.animation import MAX_FRAMES, animate_path
+from ..viz.workspace import MAX_WORKSPACE_SAMPLES
 from ._common import (
     CliError,
     add_force_arg,
@@ -19,10 +20,10 @@ from ._common import (
     check_output,
     default_of,
     finite,
+    int_between,
     load_robot,
     nonempty,
     numpy_seed,
-    positive_int,
 )
 from .plan import add_plan_args, check_plan_args, plan_motion
 
@@ -100,11 +101,11 @@ def cmd_animate(args: argparse.Namespace) -> int:
     check_output(args.output, "--output", args.force, ANIMATION_SUFFIXES)
     if args.output.lower().endswith(".mp4") and not animation.writers.is_available("ffmpeg"):
         raise CliError(f"--output {args.output}: writing .mp4 needs ffmpeg on PATH; write a .gif instead")
-    if args.frames > MAX_FRAMES:
-        raise CliError(f"--frames {args.frames}: at most {MAX_FRAMES} frames")
-    if args.frames < 2:
-        raise CliError(f"--frames {args.frames}: an animation needs at least 2 frames")
     if args.path:
+        given = [o for o, v in (("--planner", args.planner), ("--start", args.start), ("--goal", args.goal),
+                                ("--samples", args.samples), ("--library", args.library)) if v is not None]
+        if given:  # they plan a motion; --path animates the file's
+            raise CliError(f"--path animates the path in the file: {' '.join(given)} would be ignored")
         check_input_file(args.path, "--path", "path file")
         check_model_args(args)
         robot = load_robot(args)
@@ -172,7 +173,7 @@ def register(sub: argparse._SubParsersAction, fmt: type) -> None:
                                    "tpee-ompl animate --path p.json -o m.gif")
     add_plan_args(p)
     p.add_argument("--path", type=nonempty, help="JSON file with a 'path' list of waypoints (e.g. from plan --json)")
-    p.add_argument("--frames", type=positive_int, default=default_of(animate_path, "frames"),
+    p.add_argument("--frames", type=int_between(2, MAX_FRAMES), default=default_of(animate_path, "frames"),
                    help=f"frames, 2..{MAX_FRAMES} (default %(default)s)")
     p.add_argument("-o", "--output", type=nonempty, default="motion.gif", help="a .gif or .mp4 file (default motion.gif)")
     add_force_arg(p)
@@ -181,7 +182,8 @@ def register(sub: argparse._SubParsersAction, fmt: type) -> None:
     p = sub.add_parser("workspace", help="Monte-Carlo pointing workspace (Fig. 4)", formatter_class=fmt,
                        description="Sample collision-free configurations and draw where the barrel can point.\n\n"
                                    "example:\n  tpee-ompl workspace --samples 4000 -o workspace.png")
-    p.add_argument("--samples", type=positive_int, default=4000)
+    p.add_argument("--samples", type=int_between(1, MAX_WORKSPACE_SAMPLES), default=4000,
+                   help=f"configurations drawn, 1..{MAX_WORKSPACE_SAMPLES} (default %(default)s)")
     p.add_argument("--seed", type=numpy_seed, default=0, help="sampling seed, 0..2^32-1 (default 0)")
     p.add_argument("-o", "--output", type=nonempty, default="workspace.png", help="image file (default workspace.png)")
     add_force_arg(p)

@@ -12,6 +12,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..validation import MAX_JOINT_VALUE, as_float_array
+
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
@@ -30,15 +32,20 @@ def new_axes(figsize: tuple[float, float] = (7.0, 7.0), dpi: int = 110) -> Axes:
     return fig.add_subplot(projection="3d")
 
 
+MAX_DPI = 600
+"""Highest figure resolution (dots per inch): at 2000 a figure's canvas took 1.7 GB; below 10 matplotlib's text
+rendering fails (FreeType's "invalid ppem value")."""
+
+
 def check_view(elev: float, azim: float, dpi: int | None = None) -> None:
-    """The camera angles (degrees, finite) and the resolution (dots per inch, 1..2000; None: no file written);
-    ValueError naming the bad one (a NaN angle drew an empty picture)."""
+    """The camera angles (degrees, finite) and the resolution (dots per inch, 10..``MAX_DPI``; None: no file
+    written); ValueError naming the bad one (a NaN angle drew an empty picture)."""
     from ..validation import check_int, check_number
 
     check_number("elev (degrees)", elev)
     check_number("azim (degrees)", azim)
     if dpi is not None:
-        check_int("dpi", dpi, minimum=1, maximum=2000)
+        check_int("dpi", dpi, minimum=10, maximum=MAX_DPI)
 
 
 def set_view(ax: Axes, lo: np.ndarray, hi: np.ndarray, elev: float, azim: float) -> None:
@@ -84,12 +91,15 @@ def optional_target(target: Any) -> np.ndarray | None:
 
 
 def check_waypoints(robot: WearerArm, waypoints: Any) -> np.ndarray:
-    """The waypoints as a finite (K >= 1, robot.nq) float array; ValueError otherwise."""
-    W = np.asarray(waypoints, dtype=float)
+    """The waypoints as a finite (K >= 1, robot.nq) float array of joint values within +/-``MAX_JOINT_VALUE``;
+    ValueError otherwise (strings and complex numbers refused, not coerced: ``as_float_array``)."""
+    W = as_float_array(waypoints, "waypoints")
     if W.ndim != 2 or W.shape[1] != robot.nq or len(W) < 1:
         raise ValueError(f"waypoints must have shape (K, {robot.nq}) with K >= 1; got {W.shape}")
     if not np.all(np.isfinite(W)):
         raise ValueError("waypoints contain NaN or inf")
+    if np.abs(W).max() > MAX_JOINT_VALUE:  # no joint travels that far: 1e300 overflowed the drawing's arithmetic
+        raise ValueError(f"waypoints hold {np.abs(W).max():g}, beyond the +/-{MAX_JOINT_VALUE:g} rad any joint takes")
     return W
 
 
@@ -114,11 +124,12 @@ def _check_image_suffix(out: Path, suffixes: tuple[str, ...]) -> None:
 
 
 def image_suffixes() -> tuple[str, ...]:
-    """The file suffixes a figure can be written as (``.png``, ``.pdf``, ``.svg``, ...: matplotlib's)."""
+    """The file suffixes a figure can be written as (``.png``, ``.pdf``, ``.svg``, ...: matplotlib's but ``.pgf``)."""
     from matplotlib.backend_bases import FigureCanvasBase
 
     common = (".png", ".pdf", ".svg", ".jpg")
-    others = sorted("." + k for k in FigureCanvasBase.get_supported_filetypes() if "." + k not in common)
+    # not .pgf: matplotlib writes it through LaTeX (xelatex), failing after the drawing where LaTeX is missing
+    others = sorted("." + k for k in FigureCanvasBase.get_supported_filetypes() if "." + k not in (*common, ".pgf"))
     return (*common, *others)
 
 
