@@ -208,3 +208,8 @@ def test_table4_says_what_the_dimension_rrt_it_compares_is():
     table = ratio_table(runs, "DimensionRRT", "RRTstar")
     text = report._markdown(table, [], [], [], "DimensionRRT", "RRTstar", "batched")
     assert "`DimensionRRT`: the paper's dimension-RRT" in text and "DimensionRRTNoShortcuts" in text
+    assert "Table 3's DOF1/DOF2 rows are kept" in text
+    generic = [dict(r, from_sector=0) for r in runs]  # a problem without sectors: no Table 3, no radians promised
+    text = report._markdown(ratio_table(generic, "DimensionRRT", "RRTstar"), [], [], [], "DimensionRRT", "RRTstar",
+                            "batched")
+    assert "DimensionRRTNoShortcuts" in text and "Table 3" not in text and "joint space (rad)" not in text

@@ -82,7 +82,7 @@ def _make_plots(db_path: str | Path, directory: str | Path, planner: str | None,
             p = directory / f"fig15_ratios_{chk}.png"
             _save(fig, p)
             out.append(p)
-        for col, label, fname in (("time", "time (s)", "box_time.png"), ("solution_length", "raw path length (rad)", "box_length.png")):
+        for col, label, fname in (("time", "time (s)", "box_time.png"), ("solution_length", "raw path length", "box_length.png")):
             groups = defaultdict(list)
             for r in it:
                 if r["success"]:
@@ -113,7 +113,7 @@ def _make_plots(db_path: str | Path, directory: str | Path, planner: str | None,
                 ax2.step(t, c, where="post", color=f"C{k}", label=pl)
         ax1.set_xscale("log")
         ax1.set_xlabel("time budget (s)")
-        ax1.set_ylabel("median raw cost of successful runs (rad)")
+        ax1.set_ylabel("median raw cost of successful runs")
         ax1.legend(fontsize=7)
         ax2.set_xlabel("time (s)")
         ax2.set_ylabel("median best cost (progress rows, rad)")

@@ -329,9 +329,11 @@ def _ratio_markdown(ratios: list[dict], planner: str, reference: str, headline: 
     lines = [f"## Table 4: {planner} / {reference} at equal sample counts", ""]
     has_paper = any(not math.isnan(r["paper"]) for r in ratios)
     lines.append(f"Mean of per-query ratios{' (paper in brackets)' if has_paper else ''}, then median [Q1, Q3]; "
-                 "n = queries where both succeeded. Lengths are raw planner output in joint space (rad).")
-    if planner in OUR_PLANNER_NOTES:
-        lines += ["", f"`{planner}`: {OUR_PLANNER_NOTES[planner]}."]
+                 "n = queries where both succeeded. Lengths are raw planner output in the space's metric (rad for "
+                 "joint angles).")
+    if planner in OUR_PLANNER_NOTES:  # the wearer's notes (Table 3's rows) where the paper's figures apply
+        note = OUR_PLANNER_NOTES[planner] if has_paper else OUR_PLANNER_NOTES[planner].split("; on the wearer")[0]
+        lines += ["", f"`{planner}`: {note}."]
     labels = {r["metric"]: r["label"] for r in ratios}
     checkers = sorted({r["checker"] for r in ratios}, key=lambda c: (c != headline, c))
     for chk in checkers:
@@ -368,7 +370,7 @@ def _markdown(ratios: list[dict], succ: list[dict], quality: list[dict], anytime
                      f"| {_f(r['vs_straight_median'])} [{_f(r['vs_straight_q1'])}, {_f(r['vs_straight_q3'])}] "
                      f"| {_f(r['vs_best_median'])} [{_f(r['vs_best_q1'])}, {_f(r['vs_best_q3'])}] | {_f(r['time_median'])} |")
     if anytime:
-        lines += ["", "## Anytime comparison: median raw cost (rad) of successful runs", "",
+        lines += ["", "## Anytime comparison: median raw cost (path length in the space's metric) of successful runs", "",
                   "| budget (s) | planner | success / runs | cost median [Q1, Q3] |", "|---|---|---|---|"]
         for r in anytime:
             lines.append(f"| {r['budget']:g} | {r['planner']} | {r['success']}/{r['runs']} "

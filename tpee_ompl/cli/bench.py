@@ -101,7 +101,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--anytime-queries", type=count, default=_default("anytime_queries"),
                    help="anytime comparison on the first k queries only")
     p.add_argument("--max-queries", type=positive_int, default=_default("max_queries"),
-                   help="use N queries, round-robin over the ordered sector pairs")
+                   help="use N queries (the wearer's: round-robin over the ordered sector pairs; a problem's own: "
+                        "at most as many as it has)")
     p.add_argument("--runs", type=positive_int, default=_default("runs"), help="runs per planner per experiment (default: %(default)s)")
     p.add_argument("--workers", type=positive_int, default=None,
                    help=f"worker processes, one fresh process per query (default: {_default('workers')}; with "
