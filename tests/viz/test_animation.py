@@ -89,3 +89,12 @@ def test_an_animation_resolution_that_breaks_matplotlib_or_memory_is_refused(rob
 
     with pytest.raises(ValueError, match="dpi"):
         animate_path(robot, [[0.87, 0.35, 0, 0], [0.87, 0.35, 0.1, 0]], tmp_path / "x.gif", frames=2, dpi=dpi)
+
+
+@pytest.mark.parametrize("out", [None, 5, b"x.gif"])
+def test_an_output_that_is_no_file_name_is_a_value_error_naming_it(robot, out):
+    """animate_path raised a bare TypeError where save_scene says what is wrong."""
+    from tpee_ompl.viz.animation import animate_path
+
+    with pytest.raises(ValueError, match="out_path must be a file name"):
+        animate_path(robot, [[0.87, 0.35, 0, 0], [0.87, 0.35, 0.1, 0]], out, frames=2)

@@ -118,7 +118,7 @@ def animate_path(
     frames = check_int("frames", frames, minimum=2, maximum=MAX_FRAMES)
     fps = check_int("fps", fps, minimum=1, maximum=1000)
     check_view(elev, azim, dpi)
-    out = Path(out_path)
+    out = output_path(out_path, force=force)  # a file name that can be written (not None, a number, bytes)
     suffix = out.suffix.lower()
     if suffix == ".gif":
         writer: Any = animation.PillowWriter(fps=fps)
@@ -172,7 +172,6 @@ def animate_path(
         txt.set_text(f"{head}  frame {i + 1}/{frames}  {state}")
         txt.set_color("k" if valid[i] else LOS_BLOCKED)
 
-    output_path(out, force=force)
     with atomic_path(out, suffix_last=True, force=force) as tmp, writer.saving(fig, str(tmp), dpi):
         for i in range(frames):
             draw(i)
