@@ -79,6 +79,7 @@ USAGE = [
     ("show-output-exists", ["show", "-o", "existing.png"], "--output"),
     ("show-q-nan", ["show", "--q", "nan", "0", "0", "0", "-o", "s.png"], "--q"),
     ("show-q-three-values", ["show", "--q", "0", "0", "0", "-o", "s.png"], "--q"),
+    ("show-q-beyond-any-angle", ["show", "--q", "1e300", "0", "0", "0", "-o", "s.png"], "--q"),
     ("show-target-far", ["show", "--target", "1e300", "0", "0", "-o", "s.png"], "--target"),
     ("animate-path-missing", ["animate", "--path", "missing.json", "-o", "m.gif"], "--path"),
     ("animate-output-not-gif", ["animate", "--path", "missing.json", "-o", "m.txt"], "--output"),

@@ -14,6 +14,7 @@ from ._common import (
     CliError,
     add_force_arg,
     add_model_args,
+    angle,
     argument,
     check_input_file,
     check_model_args,
@@ -158,7 +159,7 @@ def register(sub: argparse._SubParsersAction, fmt: type) -> None:
                        description="Draw the wearer, the arm and the line of sight.\n\nexample:\n"
                                    "  tpee-ompl show -o scene.png\n"
                                    "  tpee-ompl show --q 0.87 0.35 0.3 -0.6 --target 4 1.5 1.9 --sectors -o s.png")
-    p.add_argument("--q", type=finite, nargs=4, metavar="Q", help="DOF1..DOF4 in radians (default: a sector-4 scene)")
+    p.add_argument("--q", type=angle, nargs=4, metavar="Q", help="DOF1..DOF4 in radians (default: a sector-4 scene)")
     p.add_argument("--target", type=finite, nargs=3, metavar=("X", "Y", "Z"), help="target point (m, world frame)")
     p.add_argument("--sectors", action="store_true", help="overlay the posture sectors")
     p.add_argument("-o", "--output", type=nonempty, default="scene.png", help="image file (.png, .pdf, .svg, ...; default scene.png)")
@@ -193,7 +194,7 @@ def register(sub: argparse._SubParsersAction, fmt: type) -> None:
     p = sub.add_parser("view", help="interactive meshcat view (pip install 'tpee_ompl[viewer]')", formatter_class=fmt,
                        description="Open the model in Pinocchio's MeshcatVisualizer.\n\n"
                                    "example:\n  tpee-ompl view --q 0.87 0.35 0 0")
-    p.add_argument("--q", type=finite, nargs=4, metavar="Q")
+    p.add_argument("--q", type=angle, nargs=4, metavar="Q")
     p.add_argument("--no-browser", action="store_true")
     add_model_args(p)
     p.set_defaults(func=cmd_view)
