@@ -73,3 +73,17 @@ def test_a_figure_name_without_an_image_suffix_is_refused_before_any_folder_is_m
         save_scene(robot, np.zeros(4), tmp_path / "s.png", elev=float("nan"))  # drew an empty picture
     with pytest.raises(ValueError, match="out_path"):
         save_scene(robot, np.zeros(4), None)
+
+
+def test_a_postscript_figure_is_written_without_matplotlibs_transparency_warning(robot, tmp_path, caplog):
+    """The scene's translucent faces made matplotlib log "The PostScript backend does not support transparency"."""
+    import logging
+
+    import numpy as np
+
+    from tpee_ompl.viz import save_scene
+
+    with caplog.at_level(logging.WARNING):
+        save_scene(robot, np.radians([50, 20, 17, -37]), tmp_path / "scene.eps", dpi=20)
+    assert (tmp_path / "scene.eps").stat().st_size > 0
+    assert not [r for r in caplog.records if "transparency" in r.getMessage()]

@@ -143,7 +143,13 @@ def write_figure(fig: Figure, out: Path, dpi: int, force: bool = True, **savefig
     from ..files import atomic_path
 
     _check_image_suffix(out, image_suffixes())
-    with atomic_path(out, force=force) as tmp:
-        fig.savefig(tmp, dpi=dpi, format=out.suffix[1:].lower(), **savefig_kwargs)
+    ps = logging.getLogger("matplotlib.backends.backend_ps")
+    level = ps.level
+    ps.setLevel(logging.ERROR)  # .eps/.ps: "does not support transparency" for the scene's translucent faces
+    try:
+        with atomic_path(out, force=force) as tmp:
+            fig.savefig(tmp, dpi=dpi, format=out.suffix[1:].lower(), **savefig_kwargs)
+    finally:
+        ps.setLevel(level)
     log.info("wrote %s", out)
     return out
