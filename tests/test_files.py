@@ -151,3 +151,10 @@ def test_a_file_written_by_someone_else_while_this_wrote_is_not_replaced_without
         with atomic_path(loop, force=False) as tmp:
             tmp.write_text("mine")
     assert loop.is_symlink()
+
+
+def test_a_name_near_the_file_systems_limit_can_be_written(tmp_path):
+    """The temporary name added ~19 bytes to the output's: a 245-byte name failed with 'File name too long'."""
+    out = tmp_path / ("b" * 245 + ".png")
+    atomic_write_text(out, "x")
+    assert out.read_text() == "x" and len(list(tmp_path.iterdir())) == 1

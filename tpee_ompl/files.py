@@ -102,9 +102,10 @@ def atomic_path(path: str | os.PathLike, *, force: bool = True, suffix_last: boo
         target = Path(os.path.realpath(target))
     target.parent.mkdir(parents=True, exist_ok=True)
     suffix = ".part" + target.suffix if suffix_last else target.suffix + ".part"
+    prefix = f".{target.name[:100]}."  # a name near the 255-byte limit still leaves room for the temporary's
     tmp: Path | None = None
     try:
-        fd, tmp_name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=suffix, dir=target.parent)
+        fd, tmp_name = tempfile.mkstemp(prefix=prefix, suffix=suffix, dir=target.parent)
         os.close(fd)
         tmp = Path(tmp_name)
         os.chmod(tmp, 0o666 & ~_umask())
@@ -119,7 +120,7 @@ def atomic_path(path: str | os.PathLike, *, force: bool = True, suffix_last: boo
             except FileExistsError:
                 raise OutputExistsError(f"{target} exists (written while this ran); pass --force to replace it") from None
     except OSError as exc:
-        if exc.filename is not None and Path(exc.filename).name.startswith(f".{target.name}."):
+        if exc.filename is not None and Path(exc.filename).name.startswith(prefix):
             # the error names the temporary file: name the file the caller asked for
             raise type(exc)(exc.errno, exc.strerror, str(target)) from exc
         raise
