@@ -205,3 +205,16 @@ def test_config_numbers_become_plain_python_values_and_duplicates_are_refused():
         with pytest.raises(ValueError, match=match):
             CampaignConfig(**kw)
     assert "PRMstar" not in KNOWN_PLANNERS  # deadlocks with a Python termination condition
+
+
+def test_asking_for_more_queries_than_a_set_has_says_so(query_file, tmp_path, caplog):
+    """narrow3 --max-queries 25 ran its 10 queries without a word."""
+    import logging
+
+    from helpers.bench_standins import tiny_config
+
+    from tpee_ompl.bench.campaign import prepare_campaign
+
+    with caplog.at_level(logging.WARNING):
+        plan = prepare_campaign(tiny_config(query_file, tmp_path, max_queries=500))
+    assert any(f"has {len(plan.queries)} queries: all of them run" in r.getMessage() for r in caplog.records)

@@ -164,6 +164,9 @@ def prepare_campaign(config: CampaignConfig) -> CampaignPlan:
     queries = stratified_subset(queries, config.max_queries)
     if not queries:
         raise ValueError(f"query set {what!r} has no queries")
+    if config.max_queries is not None and len(queries) < config.max_queries:
+        log.warning("query set %s has %d queries: all of them run (max_queries %d)", what, len(queries),
+                    config.max_queries)
     if config.seed + len(queries) - 1 > MAX_SEED:
         raise ValueError(f"seed {config.seed}: query k uses seed + k, which must stay <= {MAX_SEED} "
                          f"for {len(queries)} queries")
