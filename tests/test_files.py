@@ -158,3 +158,23 @@ def test_a_name_near_the_file_systems_limit_can_be_written(tmp_path):
     out = tmp_path / ("b" * 245 + ".png")
     atomic_write_text(out, "x")
     assert out.read_text() == "x" and len(list(tmp_path.iterdir())) == 1
+
+
+def test_a_file_system_without_hard_links_still_gets_new_files_without_force(tmp_path, monkeypatch):
+    """os.link fails with EPERM on vfat and some network mounts: every write without --force failed after the work."""
+    import errno
+
+    from tpee_ompl.files import OutputExistsError
+
+    def no_links(src, dst):
+        raise OSError(errno.EPERM, "Operation not permitted", str(dst))
+
+    monkeypatch.setattr(os, "link", no_links)
+    out = tmp_path / "new.png"
+    atomic_write_text(out, "mine", force=False)
+    assert out.read_text() == "mine"
+    with pytest.raises(OutputExistsError):
+        with atomic_path(tmp_path / "other.png", force=False) as tmp:
+            tmp.write_text("mine")
+            (tmp_path / "other.png").write_text("precious")
+    assert (tmp_path / "other.png").read_text() == "precious"

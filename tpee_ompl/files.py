@@ -10,6 +10,7 @@ starts, so a refused target costs nothing and leaves nothing behind.
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
 import tempfile
 import time
@@ -102,7 +103,8 @@ def atomic_path(path: str | os.PathLike, *, force: bool = True, suffix_last: boo
         target = Path(os.path.realpath(target))
     target.parent.mkdir(parents=True, exist_ok=True)
     suffix = ".part" + target.suffix if suffix_last else target.suffix + ".part"
-    prefix = f".{target.name[:100]}."  # a name near the 255-byte limit still leaves room for the temporary's
+    # at most 100 bytes of the name: one near the 255-byte limit still leaves room for the temporary's
+    prefix = "." + os.fsencode(target.name)[:100].decode(errors="ignore") + "."
     tmp: Path | None = None
     try:
         fd, tmp_name = tempfile.mkstemp(prefix=prefix, suffix=suffix, dir=target.parent)
@@ -114,11 +116,8 @@ def atomic_path(path: str | os.PathLike, *, force: bool = True, suffix_last: boo
             os.fsync(f.fileno())
         if force:
             os.replace(tmp, target)
-        else:  # a hard link is created only where no name is: a file written meanwhile stays
-            try:
-                os.link(tmp, target)
-            except FileExistsError:
-                raise OutputExistsError(f"{target} exists (written while this ran); pass --force to replace it") from None
+        else:
+            _place_new(tmp, target)
     except OSError as exc:
         if exc.filename is not None and Path(exc.filename).name.startswith(prefix):
             # the error names the temporary file: name the file the caller asked for
@@ -128,6 +127,33 @@ def atomic_path(path: str | os.PathLike, *, force: bool = True, suffix_last: boo
         if tmp is not None:
             with contextlib.suppress(FileNotFoundError):
                 tmp.unlink()
+
+
+_NO_HARD_LINKS = {errno.EPERM, errno.EOPNOTSUPP, errno.ENOTSUP, errno.ENOSYS, errno.EMLINK, errno.EXDEV}
+"""What ``link()`` answers on a file system without hard links (vfat, exFAT, some network and FUSE mounts)."""
+
+
+def _place_new(tmp: Path, target: Path) -> None:
+    """Put the written ``tmp`` at ``target`` only where no name is yet (a file written meanwhile by another process
+    stays): a hard link, created only at a free name; where the file system has none, the name is reserved with an
+    exclusive create first, then replaced."""
+    try:
+        os.link(tmp, target)
+        return
+    except FileExistsError:
+        pass
+    except OSError as exc:
+        if exc.errno not in _NO_HARD_LINKS:
+            raise
+        try:
+            os.close(os.open(target, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o666))
+        except FileExistsError:
+            pass
+        else:
+            os.replace(tmp, target)
+            return
+    what = "a link to itself" if target.is_symlink() else "written while this ran"
+    raise OutputExistsError(f"{target} exists ({what}); pass --force to replace it")
 
 
 def atomic_write(path: str | os.PathLike, write: Callable[[Path], object], *, force: bool = True) -> Path:
