@@ -203,3 +203,33 @@ def test_another_model_gets_clear_errors_and_a_default_tracker_planner_without_t
 
     path = plan(np.r_[posture_preset(1), 0.0, 0.0], np.r_[posture_preset(4), 0.0, 0.0], 1, 4)
     assert robot.are_valid(path).all()
+
+
+def test_a_damaged_packaged_library_is_said_not_taken_for_another_models(tmp_path, monkeypatch, capsys):
+    """An unreadable packaged library read as 'built for another model': plan quietly used dimension-rrt, track
+    planned without it, and --planner library said it was built for another --urdf that nobody gave."""
+    import tpee_ompl.cli.plan as plan_cli
+
+    broken = tmp_path / "default.npz"
+    broken.write_bytes(b"")
+    monkeypatch.setattr(plan_cli, "default_library_path", lambda: broken)
+    from helpers.cli_queries import start_goal_args
+
+    assert main(["plan", "--from", "1", "--to", "4", *start_goal_args(), "--time", "0.05"]) == 1
+    assert "unreadable" in capsys.readouterr().err
+    assert main(["track", "--duration", "1"]) == 1
+    assert "unreadable" in capsys.readouterr().err
+
+
+def test_plan_and_track_with_another_models_library_say_it_as_library_stats_does(other_model, tmp_path, capsys):
+    from helpers.cli_queries import start_goal_args
+
+    urdf, srdf = other_model
+    lib = tmp_path / "mine.npz"
+    assert main(["library", "build", "--pairs", "1-4", "--per-pair", "1", "--max-samples", "200", "--workers", "1",
+                 "--library", str(lib), "--urdf", urdf, "--srdf", srdf]) == 0
+    capsys.readouterr()
+    for argv in (["plan", "--from", "1", "--to", "4", *start_goal_args(), "--library", str(lib)],
+                 ["track", "--duration", "1", "--library", str(lib)], ["library", "stats", "--library", str(lib)]):
+        assert main(argv) == 2, argv
+        assert "give the --urdf/--srdf it was built for" in capsys.readouterr().err

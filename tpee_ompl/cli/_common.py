@@ -38,6 +38,7 @@ __all__ = [
     "add_model_args",
     "argument",
     "check_input_file",
+    "check_library_model",
     "check_model_args",
     "check_output",
     "default_of",
@@ -218,6 +219,18 @@ def check_input_file(path: str | Path, option: str, what: str = "file", hint: st
     if not p.is_file():
         raise CliError(f"{option} {p}: {what} not found{hint}")
     return p
+
+
+def check_library_model(path: str | Path, robot: WearerArm, option: str = "--library") -> None:
+    """A usage error (exit 2) when the library file at ``path`` was built for another model than ``robot``'s; a
+    missing or damaged file raises its own error (a runtime one)."""
+    from ..library.storage import library_model_hash
+
+    built_for = library_model_hash(path)
+    if built_for != robot.model_hash:
+        raise CliError(f"{option} {path}: built for model {built_for!r}, not the loaded model {robot.model_hash!r}: "
+                       "give the --urdf/--srdf it was built for, or build one for this model ('tpee-ompl library "
+                       "build --urdf U --srdf S --library FILE')")
 
 
 def add_force_arg(p: argparse.ArgumentParser) -> None:

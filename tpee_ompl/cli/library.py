@@ -30,6 +30,7 @@ from ._common import (
     add_model_args,
     argument,
     check_input_file,
+    check_library_model,
     check_output,
     finite,
     index,
@@ -84,13 +85,8 @@ def _check_library_file(path: Path) -> Path:
 
 def _load(path: Path, robot: WearerArm, fallback: bool = True,
           max_samples: int = _BUILD_DEFAULTS.max_samples) -> PathLibrary:
-    from ..library.storage import library_model_hash
-
     _check_library_file(path)
-    built_for = library_model_hash(path)
-    if built_for is not None and built_for != robot.model_hash:
-        raise CliError(f"--library {path}: built for model {built_for!r}, not the loaded model {robot.model_hash!r}: "
-                       "give the --urdf/--srdf it was built for")
+    check_library_model(path, robot)
     plan = dimension_rrt_planner(robot, max_samples=max_samples) if fallback else None
     return PathLibrary.load(path, robot, plan=plan)
 

@@ -19,6 +19,7 @@ from ._common import (
     angle,
     argument,
     check_input_file,
+    check_library_model,
     check_model_args,
     check_output,
     count,
@@ -93,11 +94,14 @@ def check_plan_args(args: argparse.Namespace) -> None:
 def _default_planner(args: argparse.Namespace, robot: WearerArm) -> str:
     """--planner, or by default ``library`` when a library for the model is at hand (--library, or the packaged one
     for its model), else ``dimension-rrt``; --planner library without one for the model is a usage error."""
-    if args.library is not None or args.planner not in (None, "library"):
+    if args.library is not None:
+        check_library_model(args.library, robot)
+        return "library"
+    if args.planner not in (None, "library"):
         return args.planner
     from ..library.storage import library_model_hash
 
-    if library_model_hash(default_library_path()) == robot.model_hash:
+    if library_model_hash(default_library_path()) == robot.model_hash:  # a damaged packaged library raises
         return "library"
     if args.planner == "library":
         raise CliError("--planner library: the packaged path library was built for the packaged model, not this "
@@ -294,11 +298,13 @@ def cmd_track(args: argparse.Namespace) -> int:
             raise CliError(f"--library is read by --planner default and library, not {args.planner}")
         check_input_file(args.library, "--library", "path library")
     robot = load_robot(args)
+    if args.library is not None and args.planner in ("default", "library"):
+        check_library_model(args.library, robot)
     if args.library is None:  # the packaged library, when it was built for this model
         from ..library.storage import library_model_hash
 
         packaged = default_library_path()
-        if library_model_hash(packaged) == robot.model_hash:
+        if library_model_hash(packaged) == robot.model_hash:  # a damaged packaged library raises
             args.library = str(packaged)
         elif args.planner == "library":
             raise CliError("--planner library: the packaged path library was built for the packaged model, not this "

@@ -258,14 +258,24 @@ def _beyond_limit(name: str, x: np.ndarray) -> str | None:
     return f"holds {m:g}, beyond +/-{_MAX_ABS[name]:g} ({'joint angles, rad' if name in _ANGLES else 'DMP weights'})"
 
 
-def library_model_hash(path: str | Path) -> str | None:
-    """The model hash a library file was built for, read from its metadata alone (None when the file does not say)."""
+def library_model_hash(path: str | Path) -> str:
+    """The model hash a library file was built for, read from its metadata alone.
+
+    Raises FileNotFoundError (no such file) or LibraryFileError (not a regular file, unreadable, no model hash):
+    a damaged library is said as such, never taken for one of another model."""
+    path = Path(path)
+    if path.exists() and not path.is_file():
+        raise LibraryFileError(f"path library {path} is not a regular file")
     try:
-        with np.load(Path(path), allow_pickle=False) as z:
-            meta = json.loads(str(_Archive(z, Path(path)).read("meta")))
-    except (*_READ_ERRORS, LibraryFileError, json.JSONDecodeError):
-        return None
-    return meta.get("model_hash") if isinstance(meta, dict) else None
+        with np.load(path, allow_pickle=False) as z:
+            meta = json.loads(str(_Archive(z, path).read("meta")))
+    except FileNotFoundError:
+        raise
+    except (*_READ_ERRORS, json.JSONDecodeError, RecursionError) as exc:
+        raise _unreadable(path, exc) from exc
+    if not isinstance(meta, dict) or not isinstance(meta.get("model_hash"), str):
+        raise LibraryFileError(f"path library {path} has no valid metadata: no model hash")
+    return meta["model_hash"]
 
 
 def read_library(path: str | Path, robot: WearerArm) -> tuple[dict[tuple[int, int], PairDemos], dict[str, Any]]:
