@@ -98,3 +98,11 @@ def test_an_output_that_is_no_file_name_is_a_value_error_naming_it(robot, out):
 
     with pytest.raises(ValueError, match="out_path must be a file name"):
         animate_path(robot, [[0.87, 0.35, 0, 0], [0.87, 0.35, 0.1, 0]], out, frames=2)
+
+
+def test_an_animation_whose_frames_and_resolution_together_would_take_gigabytes_is_refused(robot, tmp_path):
+    """Each limit alone allowed 500 frames at dpi 200: about 3.6 GB."""
+    from tpee_ompl.viz.animation import animate_path
+
+    with pytest.raises(ValueError, match="frames x dpi"):
+        animate_path(robot, [[0.87, 0.35, 0, 0], [0.87, 0.35, 0.1, 0]], tmp_path / "x.gif", frames=500, dpi=200)

@@ -34,6 +34,9 @@ MAX_FRAMES = 500
 17 s and 390 MB)."""
 MAX_ANIMATION_DPI = 200
 """Highest resolution of an animation's frames (dots per inch; a frame at 2000 took 576 MB)."""
+MAX_FRAME_DPI2 = MAX_FRAMES * 80**2
+"""Most ``frames * dpi**2`` an animation may ask for (the memory grows with both: 150 frames at dpi 200 took 1.2
+GB): 500 frames at the default dpi 80, 80 at dpi 200."""
 
 
 def resample_path(waypoints: np.ndarray, n: int) -> np.ndarray:
@@ -116,6 +119,10 @@ def animate_path(
     W = check_waypoints(robot, waypoints)
     check_int("dpi", dpi, minimum=10, maximum=MAX_ANIMATION_DPI)
     frames = check_int("frames", frames, minimum=2, maximum=MAX_FRAMES)
+    if frames * dpi**2 > MAX_FRAME_DPI2:
+        raise ValueError(f"frames {frames} at dpi {dpi}: frames x dpi^2 must be at most {MAX_FRAME_DPI2:g} (every "
+                         f"frame is held in memory until the file is written): at dpi {dpi} at most "
+                         f"{MAX_FRAME_DPI2 // dpi**2} frames")
     fps = check_int("fps", fps, minimum=1, maximum=1000)
     check_view(elev, azim, dpi)
     out = output_path(out_path, force=force)  # a file name that can be written (not None, a number, bytes)
