@@ -329,9 +329,12 @@ def test_settings_fixed_at_construction_refuse_assignment_instead_of_being_ignor
     """p.h = 4 changed settings() (what a benchmark records) while the search went on with h = 7."""
     ss = make_planar_arm_setup()
     planner = DimensionRRT(ss.getSpaceInformation(), seed=3)
-    for name, value in (("h", 4), ("seed", 5), ("groups", [[0, 1, 2, 3]]), ("prescribed", {})):
+    for name, value in (("h", 4), ("seed", 5), ("groups", [[0, 1, 2, 3]]), ("prescribed", {}),
+                        ("options", planner.options)):
         with pytest.raises(AttributeError, match=f"pass {name}="):
             setattr(planner, name, value)
+    with pytest.raises(ValueError, match="max_samples"):
+        planner.max_samples = -5  # was a silent TIMEOUT with 0 samples
     assert planner.h == 7 and planner.seed == 3 and planner.settings()["h"] == "7"
     planner.max_samples = 50  # read at every solve: honoured
     ss.setPlanner(planner)

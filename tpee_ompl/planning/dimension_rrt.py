@@ -195,7 +195,7 @@ class DimensionRRT(PythonPlanner):
         rng_full = self._full_range(opts, grouped)
         initial = grouped.check_initial(initial_waypoints)
         super().__init__(si, opts.name)
-        self.options = opts
+        self._options = opts
         self.grouped = grouped
         self.max_samples = opts.max_samples
         self.narrow_after = opts.narrow_after
@@ -216,6 +216,16 @@ class DimensionRRT(PythonPlanner):
     groups = _fixed("groups", lambda self: self.grouped.groups, "The DOF groups (``DimensionRRTOptions.groups``).")
     prescribed = _fixed("prescribed", lambda self: self.grouped.prescribed, "Groups with a prescribed trajectory.")
     seed = _fixed("seed", lambda self: self.options.seed, "The seed of the planner's random generator.")
+    options = _fixed("options", lambda self: self._options, "The settings it was built with (``DimensionRRTOptions``).")
+
+    @property
+    def max_samples(self) -> int | None:
+        """Sample cap of a solve (None: none); read at every solve, so it may be changed between solves."""
+        return self._max_samples
+
+    @max_samples.setter
+    def max_samples(self, value: int | None) -> None:
+        self._max_samples = check_int("max_samples", value, minimum=1, optional=True)
 
     @staticmethod
     def _full_range(opts: DimensionRRTOptions, grouped: GroupedSpace) -> np.ndarray:
