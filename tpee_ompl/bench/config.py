@@ -55,15 +55,18 @@ thread waits for it holding Python's lock, so with the benchmark's Python condit
 (and ignored SIGTERM); ``module:function`` can still name a factory for it."""
 OUR_PLANNER_NOTES: dict[str, str] = {
     "DimensionRRT": "the paper's dimension-RRT with shortcut sweeps between fake-time waypoints after each "
-                    "improvement (the paper's rule alone: DimensionRRTNoShortcuts); on the wearer Table 3's DOF1/DOF2 "
-                    "rows are kept",
+                    "improvement (the paper's rule alone: DimensionRRTNoShortcuts)",
     "DimensionRRTNoShortcuts": "the paper's dimension-RRT, improved by the paper's rule alone",
     "DimensionRRTReleased": "DimensionRRT whose rows are planned too once its path converged on them",
     "LibraryDimensionRRT": "the DMP path library's validated path, refined by dimension-RRT (rows released)",
     "RRTConnectSimplify": "OMPL's RRTConnect, then OMPL's PathSimplifier in the time left",
 }
-"""What this package's benchmark planners are, one line each (a report says it beside their names; the part from
-"; on the wearer" only where the paper's figures apply)."""
+"""What this package's benchmark planners are, one line each (a report says it beside their names)."""
+WEARER_PLANNER_NOTES: dict[str, str] = {
+    "DimensionRRT": "on the wearer Table 3's DOF1/DOF2 rows are kept",
+    "DimensionRRTNoShortcuts": "on the wearer Table 3's DOF1/DOF2 rows are kept",
+}
+"""What a report adds to :data:`OUR_PLANNER_NOTES` for the wearer's cross-sector queries."""
 NOT_ITERATION_CAPPED: tuple[str, ...] = ("RRTConnect", "RRTConnectSimplify", "AORRTC", "RRT")
 """Planners that cannot be stopped at a sample count (their ompl 2.0.1 bindings have no ``numIterations()``), so they
 never join the iteration-matched comparison; refused there before a campaign starts."""

@@ -116,7 +116,7 @@ def _make_plots(db_path: str | Path, directory: str | Path, planner: str | None,
         ax1.set_ylabel("median raw cost of successful runs")
         ax1.legend(fontsize=7)
         ax2.set_xlabel("time (s)")
-        ax2.set_ylabel("median best cost (progress rows, rad)")
+        ax2.set_ylabel("median best cost (progress rows)")
         ax2.set_title("longest budget", fontsize=9)
         ax2.legend(fontsize=7)
         fig.tight_layout()

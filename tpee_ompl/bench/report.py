@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from ..files import atomic_path, atomic_write_text
-from .config import OUR_PLANNER_NOTES
+from .config import OUR_PLANNER_NOTES, WEARER_PLANNER_NOTES
 from .results import planner_name
 
 __all__ = [
@@ -166,7 +166,7 @@ def ratio_table(runs: list[dict], planner: str, reference: str, checker: str | N
                 ratios = [pa[q] / pb[q] for q in queries if q in pa and q in pb and pb[q] > 0]
                 s = summarize(ratios)
                 paper = PAPER_TABLE4.get(cap, {}).get(key, math.nan) if tpee else math.nan
-                out.append({"checker": chk, "sample_cap": cap, "metric": key,
+                out.append({"checker": chk, "sample_cap": cap, "metric": key, "tpee": tpee,
                             "label": label if tpee else GENERIC_LABELS[key], **s, "queries": len(queries), "paper": paper})
     return out
 
@@ -331,9 +331,9 @@ def _ratio_markdown(ratios: list[dict], planner: str, reference: str, headline: 
     lines.append(f"Mean of per-query ratios{' (paper in brackets)' if has_paper else ''}, then median [Q1, Q3]; "
                  "n = queries where both succeeded. Lengths are raw planner output in the space's metric (rad for "
                  "joint angles).")
-    if planner in OUR_PLANNER_NOTES:  # the wearer's notes (Table 3's rows) where the paper's figures apply
-        note = OUR_PLANNER_NOTES[planner] if has_paper else OUR_PLANNER_NOTES[planner].split("; on the wearer")[0]
-        lines += ["", f"`{planner}`: {note}."]
+    if planner in OUR_PLANNER_NOTES:
+        wearer = WEARER_PLANNER_NOTES.get(planner) if any(r.get("tpee") for r in ratios) else None
+        lines += ["", f"`{planner}`: {OUR_PLANNER_NOTES[planner]}{'; ' + wearer if wearer else ''}."]
     labels = {r["metric"]: r["label"] for r in ratios}
     checkers = sorted({r["checker"] for r in ratios}, key=lambda c: (c != headline, c))
     for chk in checkers:

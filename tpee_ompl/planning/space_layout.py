@@ -87,12 +87,13 @@ class RealVectorLayout:
             where = f" (subspace {list(path)})" if path else ""
             if bad:
                 locked = [i for i in bad if math.isfinite(lo[i]) and lo[i] == hi[i]]
-                why = (f"bounds of width 0 for dimension(s) {locked} (a joint locked this way): dimension-RRT samples "
+                other = [i for i in bad if i not in locked]
+                why = [f"bounds of width 0 for dimension(s) {locked} (a joint locked this way): dimension-RRT samples "
                        "every dimension of the space; leave a locked joint out of the space (RobotChecker(..., "
-                       "locked={joint: value}) does) or give it a width" if locked else
-                       f"no valid bounds for dimension(s) {bad} (low must be < high, both finite): call "
-                       "space.setBounds(low, high) first")
-                raise ValueError(f"RealVectorStateSpace{where} has {why}")
+                       "locked={joint: value}) does) or give it a width"] if locked else []
+                why += [f"no valid bounds for dimension(s) {other} (low must be < high, both finite): call "
+                        "space.setBounds(low, high) first"] if other else []
+                raise ValueError(f"RealVectorStateSpace{where} has {'; and '.join(why)}")
             huge = [i for i in range(len(lo)) if max(abs(lo[i]), abs(hi[i])) > MAX_BOUND]
             if huge:
                 raise ValueError(f"RealVectorStateSpace{where} has bounds beyond +/-{MAX_BOUND:g} for dimension(s) {huge}: "
