@@ -93,6 +93,8 @@ USAGE = [
     ("animate-path-with-a-planner", ["animate", "--path", "{in}/path_ok.json", "--planner", "rrtconnect", "-o", "m.gif"],
      "--planner would be ignored"),
     ("show-output-pgf-needs-latex", ["show", "-o", "scene.pgf"], "--output"),
+    ("animate-path-with-a-time-and-a-seed", ["animate", "--path", "{in}/path_ok.json", "--time", "3", "--seed", "7",
+                                             "-o", "m.gif"], "--time --seed would be ignored"),
     ("workspace-samples-beyond-memory", ["workspace", "--samples", "10000000", "-o", "w.png"], "--samples"),
     ("workspace-samples-zero", ["workspace", "--samples", "0", "-o", "w.png"], "--samples"),
     ("workspace-seed-negative", ["workspace", "--seed", "-1", "-o", "w.png"], "--seed"),

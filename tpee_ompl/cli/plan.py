@@ -232,6 +232,9 @@ def add_plan_args(p: argparse.ArgumentParser, required: bool = False) -> None:
     p.add_argument("--query-index", type=index, default=0, help="which query of that pair, from 0 (default 0)")
     p.add_argument("--start", type=finite, nargs=4, default=None, metavar="Q", help="start DOF1..DOF4 (rad)")
     p.add_argument("--goal", type=finite, nargs=4, default=None, metavar="Q", help="goal DOF1..DOF4 (rad)")
+    # what planning was asked for beyond the defaults (``animate --path`` plans nothing: it refuses these)
+    p.set_defaults(plan_options={a.dest: (a.default, a.option_strings[0]) for a in p._actions  # noqa: SLF001
+                                 if a.option_strings and a.dest not in ("help", "json")})
     add_model_args(p)
 
 
