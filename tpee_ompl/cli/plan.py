@@ -301,9 +301,9 @@ def cmd_track(args: argparse.Namespace) -> int:
             raise CliError(f"--library is read by --planner default and library, not {args.planner}")
         check_input_file(args.library, "--library", "path library")
     robot = load_robot(args)
-    if args.library is not None and args.planner in ("default", "library"):
+    if args.library is not None:  # (read by the default and library planners only: refused above for the others)
         check_library_model(args.library, robot)
-    if args.library is None:  # the packaged library, when it was built for this model
+    else:  # the packaged library, when it was built for this model
         from ..library.storage import library_model_hash
 
         packaged = default_library_path()
