@@ -208,11 +208,11 @@ def test_another_model_gets_clear_errors_and_a_default_tracker_planner_without_t
 def test_a_damaged_packaged_library_is_said_not_taken_for_another_models(tmp_path, monkeypatch, capsys):
     """An unreadable packaged library read as 'built for another model': plan quietly used dimension-rrt, track
     planned without it, and --planner library said it was built for another --urdf that nobody gave."""
-    import tpee_ompl.cli.plan as plan_cli
+    import tpee_ompl.resources as resources
 
     broken = tmp_path / "default.npz"
     broken.write_bytes(b"")
-    monkeypatch.setattr(plan_cli, "default_library_path", lambda: broken)
+    monkeypatch.setattr(resources, "default_library_path", lambda: broken)  # read by storage.packaged_library_for
     from helpers.cli_queries import start_goal_args
 
     assert main(["plan", "--from", "1", "--to", "4", *start_goal_args(), "--time", "0.05"]) == 1

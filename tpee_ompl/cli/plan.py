@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -11,7 +12,6 @@ import numpy as np
 from ..bench.config import CLI_PLANNER_NAMES
 from ..library import dimension_rrt_planner
 from ..model.pointing import aim
-from ..resources import default_library_path
 from ._common import (
     CliError,
     add_force_arg,
@@ -99,15 +99,20 @@ def _default_planner(args: argparse.Namespace, robot: WearerArm) -> str:
         return "library"
     if args.planner not in (None, "library"):
         return args.planner
-    from ..library.storage import library_model_hash
+    return "library" if _packaged_library(robot, required=args.planner == "library") else "dimension-rrt"
 
-    if library_model_hash(default_library_path()) == robot.model_hash:  # a damaged packaged library raises
-        return "library"
-    if args.planner == "library":
+
+def _packaged_library(robot: WearerArm, required: bool) -> Path | None:
+    """The packaged library when it was built for the model (a damaged one raises); with ``required``
+    (``--planner library``) a usage error when it was not."""
+    from ..library.storage import packaged_library_for
+
+    path = packaged_library_for(robot)
+    if path is None and required:
         raise CliError("--planner library: the packaged path library was built for the packaged model, not this "
                        "--urdf/--srdf; give --library FILE built for it ('tpee-ompl library build --urdf U --srdf S "
                        "--library FILE')")
-    return "dimension-rrt"
+    return path
 
 
 def _start_and_goal(args: argparse.Namespace, robot: WearerArm) -> tuple[np.ndarray, np.ndarray, str | None]:
@@ -304,15 +309,8 @@ def cmd_track(args: argparse.Namespace) -> int:
     if args.library is not None:  # (read by the default and library planners only: refused above for the others)
         check_library_model(args.library, robot)
     else:  # the packaged library, when it was built for this model
-        from ..library.storage import library_model_hash
-
-        packaged = default_library_path()
-        if library_model_hash(packaged) == robot.model_hash:  # a damaged packaged library raises
-            args.library = str(packaged)
-        elif args.planner == "library":
-            raise CliError("--planner library: the packaged path library was built for the packaged model, not this "
-                           "--urdf/--srdf; give --library FILE built for it ('tpee-ompl library build --urdf U "
-                           "--srdf S --library FILE')")
+        packaged = _packaged_library(robot, required=args.planner == "library")
+        args.library = None if packaged is None else str(packaged)
     if args.planner == "dimension-rrt":
         plan = dimension_rrt_planner(robot, max_samples=args.samples, seed=args.seed)
 

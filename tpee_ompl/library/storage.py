@@ -9,12 +9,14 @@ The DMPs' response profiles are recomputed on reading (:meth:`tpee_ompl.library.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import json
 import zipfile
 import zlib
 from dataclasses import asdict
 from pathlib import Path
+from collections.abc import Iterator
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -29,8 +31,8 @@ from .dmp import DMP, DMPOptions
 if TYPE_CHECKING:
     from .path_library import PathLibrary
 
-__all__ = ["FORMAT_VERSION", "MAX_CANDIDATES", "MAX_PER_STEP", "LibraryFileError", "library_model_hash", "read_library",
-           "write_library"]
+__all__ = ["FORMAT_VERSION", "MAX_CANDIDATES", "MAX_PER_STEP", "LibraryFileError", "library_model_hash",
+           "packaged_library_for", "read_library", "write_library"]
 
 FORMAT_VERSION = 2
 """Version of the ``.npz`` layout written by :func:`write_library` (2: per-demo planning margins)."""
@@ -258,24 +260,59 @@ def _beyond_limit(name: str, x: np.ndarray) -> str | None:
     return f"holds {m:g}, beyond +/-{_MAX_ABS[name]:g} ({'joint angles, rad' if name in _ANGLES else 'DMP weights'})"
 
 
+@contextlib.contextmanager
+def _open_archive(path: Path) -> Iterator[_Archive]:
+    """The library file at ``path`` open for reading: FileNotFoundError, or LibraryFileError for what is not a
+    regular file (a folder, a pipe: np.load would wait on it forever) or not an ``.npz`` archive."""
+    if path.exists() and not path.is_file():
+        raise LibraryFileError(f"path library {path} is not a regular file")
+    if path.is_file() and not zipfile.is_zipfile(path):  # numpy's own message would advise loading it with pickle
+        raise _unreadable(path, "not an .npz archive")
+    try:
+        z = np.load(path, allow_pickle=False)
+    except FileNotFoundError:
+        raise
+    except _READ_ERRORS as exc:
+        raise _unreadable(path, exc) from exc
+    with z:
+        yield _Archive(z, path)
+
+
+def _read_meta(archive: _Archive) -> Any:
+    """The file's ``meta`` record, parsed (one JSON text of at most ``_MAX_META_BYTES``); LibraryFileError if not."""
+    path = archive.path
+    if "meta" not in archive.keys:
+        raise LibraryFileError(f"path library {path} has no valid metadata: no 'meta' record")
+    shape, dtype = archive.header("meta")
+    if shape != () or dtype.kind != "U" or dtype.itemsize > _MAX_META_BYTES:
+        raise LibraryFileError(f"path library {path} has no valid metadata: 'meta' must be one JSON text of at "
+                               f"most {_MAX_META_BYTES} bytes, got {dtype} of shape {shape}")
+    try:
+        return json.loads(str(archive.read("meta")))
+    except (json.JSONDecodeError, RecursionError) as exc:
+        raise LibraryFileError(f"path library {path} has no valid metadata: {exc}") from exc
+
+
 def library_model_hash(path: str | Path) -> str:
     """The model hash a library file was built for, read from its metadata alone.
 
     Raises FileNotFoundError (no such file) or LibraryFileError (not a regular file, unreadable, no model hash):
     a damaged library is said as such, never taken for one of another model."""
     path = Path(path)
-    if path.exists() and not path.is_file():
-        raise LibraryFileError(f"path library {path} is not a regular file")
-    try:
-        with np.load(path, allow_pickle=False) as z:
-            meta = json.loads(str(_Archive(z, path).read("meta")))
-    except FileNotFoundError:
-        raise
-    except (*_READ_ERRORS, json.JSONDecodeError, RecursionError) as exc:
-        raise _unreadable(path, exc) from exc
+    with _open_archive(path) as archive:
+        meta = _read_meta(archive)
     if not isinstance(meta, dict) or not isinstance(meta.get("model_hash"), str):
         raise LibraryFileError(f"path library {path} has no valid metadata: no model hash")
     return meta["model_hash"]
+
+
+def packaged_library_for(robot: WearerArm) -> Path | None:
+    """The packaged path library when it was built for ``robot``'s model (it was for the packaged one), else None;
+    a damaged packaged library raises (:func:`library_model_hash`)."""
+    from ..resources import default_library_path
+
+    path = default_library_path()
+    return path if library_model_hash(path) == robot.model_hash else None
 
 
 def read_library(path: str | Path, robot: WearerArm) -> tuple[dict[tuple[int, int], PairDemos], dict[str, Any]]:
@@ -291,34 +328,14 @@ def read_library(path: str | Path, robot: WearerArm) -> tuple[dict[tuple[int, in
         If the file is damaged, has another format version, was built for another model, or a field
         or array is malformed (the message names it).
     """
-    path = Path(path)
-    if path.exists() and not path.is_file():  # a folder, a pipe (np.load would wait on it forever), a device
-        raise LibraryFileError(f"path library {path} is not a regular file")
-    if path.is_file() and not zipfile.is_zipfile(path):  # numpy's own message would advise loading it with pickle
-        raise _unreadable(path, "not an .npz archive")
-    try:
-        z = np.load(path, allow_pickle=False)
-    except FileNotFoundError:
-        raise
-    except _READ_ERRORS as exc:
-        raise _unreadable(path, exc) from exc
-    with z:
-        return _read_archive(_Archive(z, path), robot)
+    with _open_archive(Path(path)) as archive:
+        return _read_archive(archive, robot)
 
 
 def _read_archive(archive: _Archive, robot: WearerArm) -> tuple[dict[tuple[int, int], PairDemos], dict[str, Any]]:
     """:func:`read_library` on the open file."""
     path = archive.path
-    if "meta" not in archive.keys:
-        raise LibraryFileError(f"path library {path} has no valid metadata: no 'meta' record")
-    shape, dtype = archive.header("meta")
-    if shape != () or dtype.kind != "U" or dtype.itemsize > _MAX_META_BYTES:
-        raise LibraryFileError(f"path library {path} has no valid metadata: 'meta' must be one JSON text of at "
-                               f"most {_MAX_META_BYTES} bytes, got {dtype} of shape {shape}")
-    try:
-        meta = json.loads(str(archive.read("meta")))
-    except (json.JSONDecodeError, RecursionError) as exc:
-        raise LibraryFileError(f"path library {path} has no valid metadata: {exc}") from exc
+    meta = _read_meta(archive)
     version = meta.get("format_version") if isinstance(meta, dict) else None
     if isinstance(meta, dict) and (type(version) is not int or version != FORMAT_VERSION):
         raise LibraryFileError(

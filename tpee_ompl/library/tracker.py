@@ -363,11 +363,11 @@ def make_default_planner(
     if isinstance(library, PathLibrary):
         lib = library
     elif library == "default":  # the packaged library, when it was built for this model (else none, as track does)
-        from ..resources import default_library_path
-        from .storage import library_model_hash
+        from .storage import packaged_library_for
 
-        if library_model_hash(default_library_path()) == robot.model_hash:
-            lib = PathLibrary.load(default_library_path(), robot)
+        packaged = packaged_library_for(robot)
+        if packaged is not None:
+            lib = PathLibrary.load(packaged, robot)
         else:
             log.info("the packaged path library was built for another model: cross-sector motions are planned "
                      "without it")
