@@ -3,7 +3,7 @@ DOF1/DOF2 row can have, against the best path any planner found.
 
     PYTHONPATH=. .venv/bin/python experiments/table3_bound.py results/<stamp>_pn_anytime/benchmark.db
     PYTHONPATH=. .venv/bin/python experiments/table3_bound.py DB --planner DimensionRRT --reference RRTConnectSimplify
-    PYTHONPATH=. .venv/bin/python experiments/table3_bound.py DB --end-motions   # + the end-motion bound (~1 min)
+    PYTHONPATH=. .venv/bin/python experiments/table3_bound.py DB --end-motions   # + the end-motion bound (20 s)
 
 Dimension-RRT's TPEE case keeps DOF1/DOF2 on the paper's Table 3 row (unless ``release_after`` is set;
 the library pipeline sets it, and its DMP and direct-motion paths leave the row anyway); AORRTC,
