@@ -3,7 +3,7 @@ DOF1/DOF2 row can have, against the best path any planner found.
 
     PYTHONPATH=. .venv/bin/python experiments/table3_bound.py results/<stamp>_pn_anytime/benchmark.db
     PYTHONPATH=. .venv/bin/python experiments/table3_bound.py DB --planner DimensionRRT --reference RRTConnectSimplify
-    PYTHONPATH=. .venv/bin/python experiments/table3_bound.py DB --end-motions   # + the end-motion bound (20 s)
+    PYTHONPATH=. .venv/bin/python experiments/table3_bound.py DB --end-motions   # + the end-motion bound (13 s)
 
 Dimension-RRT's TPEE case keeps DOF1/DOF2 on the paper's Table 3 row (unless ``release_after`` is set;
 the library pipeline sets it, and its DMP and direct-motion paths leave the row anyway); AORRTC,
@@ -63,11 +63,14 @@ def end_motion_bound(robot: WearerArm, q, limit: float, grid: float) -> float:
         lb = np.hypot(steps.sum() - a, np.linalg.norm(X - other[2:], axis=1)) + np.hypot(a, np.linalg.norm(X - end[2:], axis=1))
         near = np.flatnonzero(lb <= limit)
         W = np.column_stack([np.broadcast_to(row[k], (len(near), 2)), X[near]])
+        if len(near):  # the motions only from the valid waypoints
+            valid = robot.are_valid(W)
+            near, W = near[valid], W[valid]
         E = np.broadcast_to(end, W.shape)
-        ok = robot.are_valid(W) if len(near) else np.zeros(0, dtype=bool)
+        ok = np.zeros(len(near), dtype=bool)
         for i in range(0, len(near), 20000):  # the motion as the path runs it: start -> waypoint 1, waypoint 5 -> goal
             A, B = (W[i : i + 20000], E[i : i + 20000]) if k > 1 else (E[i : i + 20000], W[i : i + 20000])
-            ok[i : i + 20000] &= mv.check_motions(A, B)
+            ok[i : i + 20000] = mv.check_motions(A, B)
         bounds.append(float(lb[near[ok]].min()) if ok.any() else math.inf)
     return max(bounds)
 
@@ -88,6 +91,7 @@ def main(argv: list[str] | None = None) -> int:
     if not args.db.is_file():
         print(f"table3_bound.py: no such database: {args.db}", file=sys.stderr)
         return 2
+    ou.setLogLevel(ou.LOG_WARN)
     runs = [r for r in load_runs(args.db) if r["comparison"] == "anytime" and r["motion_validator"] in (None, "batched")]
     if not runs:
         print(f"table3_bound.py: {args.db} has no anytime runs", file=sys.stderr)
@@ -114,7 +118,6 @@ def main(argv: list[str] | None = None) -> int:
         bound = cross_sector_length_bound(q.start, q.goal, q.from_sector, q.to_sector)
         x = length.get((args.planner, budgets[-1], qid))
         if args.end_motions and bound <= WITHIN_BEST * best[qid] and (x is None or x > WITHIN_BEST * best[qid]):
-            ou.setLogLevel(ou.LOG_WARN)
             bound = max(bound, end_motion_bound(robot, q, _END_LIMIT * best[qid], args.grid))
         rows.append((qid, q.from_sector, q.to_sector, bound, best[qid]))
     cols = "".join(f"  {p[:6]:>6s}@{b:g}" for p in (args.planner, args.reference) for b in budgets)
