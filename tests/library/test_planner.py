@@ -143,6 +143,52 @@ def test_bad_settings_raise_value_error_naming_them(robot, library, kwargs, matc
         LibraryDimensionRRT(ss.getSpaceInformation(), library, **kwargs)
 
 
+@pytest.mark.parametrize(("kwargs", "match"), [
+    ({"groups": [[0, 1], [2]]}, "DOF"),  # DOF 3 in no group
+    ({"range_": [0.1, 0.1]}, "range_"),
+])
+def test_settings_the_refining_planner_would_refuse_are_refused_when_the_pipeline_is_made(robot, library, kwargs,
+                                                                                          match):
+    """They used to pass here and turn every solve into CRASH (the refining dimension-RRT is built at solve time)."""
+    ss = make_simple_setup(robot)
+    with pytest.raises(ValueError, match=match):
+        LibraryDimensionRRT(ss.getSpaceInformation(), library, **kwargs)
+
+
+def test_a_joint_space_with_a_dimension_of_width_zero_is_refused_when_the_pipeline_is_made(library):
+    space = ob.RealVectorStateSpace(4)
+    bounds = ob.RealVectorBounds(4)
+    bounds.setLow(-3.0)
+    bounds.setHigh(3.0)
+    bounds.setLow(2, 0.5)
+    bounds.setHigh(2, 0.5)
+    space.setBounds(bounds)
+    with pytest.raises(ValueError, match="width 0"):
+        LibraryDimensionRRT(ob.SpaceInformation(space), library)
+
+
+def test_several_goal_states_are_planned_by_dimension_rrt_on_the_row_without_the_library(robot, library, caplog):
+    start, goal = _query(robot, 1, 2, 0)
+    ss = make_simple_setup(robot, start, goal)
+    si = ss.getSpaceInformation()
+    far = goal.copy()
+    far[3] = goal[3] + 0.3 if goal[3] + 0.3 <= robot.upper[3] else goal[3] - 0.3
+    goals = ob.GoalStates(si)
+    for q in (goal, far):
+        goals.addState(set_state(si.allocState(), q))
+    ss.setGoal(goals)
+    planner = LibraryDimensionRRT(si, library, from_sector=1, to_sector=2, max_samples=300, seed=0)
+    ss.setPlanner(planner)
+    with caplog.at_level("INFO"):
+        status = ss.solve(10.0)
+    stats = planner.last_run_stats()
+    assert status == ob.PlannerStatus.EXACT_SOLUTION and "GoalStates" in caplog.text
+    assert stats["library_outcome"] == "planned" and stats["candidates_tried"] == 0 and stats["samples"] > 0
+    W = path_to_array(ss.getSolutionPath(), 4)
+    assert any(np.allclose(W[-1], q) for q in (goal, far))
+    assert path_passes_motion_checks(si, ss.getSolutionPath(), in_bounds=True)
+
+
 def test_not_a_library_is_refused(robot):
     ss = make_simple_setup(robot)
     with pytest.raises(ValueError, match="PathLibrary"):

@@ -99,6 +99,36 @@ def test_of_more_goal_states_than_max_goals_the_nearest_are_kept_on_every_solve(
         assert planner.last_run_stats()["samples"] == 400  # the cap counts the samples of all goals
 
 
+def test_goal_states_beyond_max_goals_are_named_in_a_warning(caplog) -> None:
+    ss = _point_setup()
+    ss.setGoal(_goal_states(ss, [(0.9, 0.5), (0.85, 0.15), (0.9, 0.9), (0.95, 0.1)]))
+    planner = DimensionRRT(ss.getSpaceInformation(), groups=[[0, 1]], seed=3, max_samples=50, max_goals=2)
+    ss.setPlanner(planner)
+    with caplog.at_level("WARNING"):
+        ss.solve(10.0)
+    assert "the 2 goal states nearest the start, of 4 (max_goals)" in caplog.text
+
+
+def test_of_several_start_states_the_first_valid_is_planned_from_and_a_warning_says_so(caplog) -> None:
+    ss = _point_setup()  # start (0.1, 0.1)
+    ss.addStartState(set_state(ss.getSpaceInformation().allocState(), (0.2, 0.9)))
+    status, _ = _solve(ss, _goal_states(ss, [(0.3, 0.6)]), max_samples=50)
+    assert status == ob.PlannerStatus.EXACT_SOLUTION
+    np.testing.assert_allclose(_proven(ss)[0], (0.1, 0.1))
+    assert "the first valid of the 2 given" in caplog.text
+
+
+@pytest.mark.parametrize(("point", "why"), [((0.5, 0.1), "invalid"), ((1.5, 0.5), "outside the space's bounds")])
+def test_a_goal_state_that_cannot_be_reached_gives_invalid_goal_and_an_error_saying_why(point, why, caplog) -> None:
+    ss = _point_setup()
+    goal = ob.GoalState(ss.getSpaceInformation())
+    goal.setState(set_state(ss.getSpaceInformation().allocState(), point))
+    with caplog.at_level("ERROR"):
+        status, _ = _solve(ss, goal, max_samples=10)
+    assert status == ob.PlannerStatus.INVALID_GOAL
+    assert f"the goal state is {why}" in caplog.text
+
+
 def test_one_goal_state_as_goal_states_gives_the_goal_state_path() -> None:
     paths = []
     for several in (False, True):

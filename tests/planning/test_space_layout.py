@@ -70,6 +70,13 @@ def test_real_vector_space_without_bounds_is_refused() -> None:
         RealVectorLayout(ob.RealVectorStateSpace(3))
 
 
+def test_a_space_whose_bounds_were_never_set_is_told_to_set_them() -> None:
+    """OMPL's bounds start at 0 and 0: that is not a locked joint (the error used to say so)."""
+    with pytest.raises(ValueError, match=r"no bounds \(every low and high is 0\): call space.setBounds") as e:
+        RealVectorLayout(ob.RealVectorStateSpace(3))
+    assert "locked" not in str(e.value)
+
+
 def test_a_dimension_locked_by_bounds_of_width_zero_is_refused_saying_so() -> None:
     """OMPL users lock a joint with low == high; the error said "no valid bounds: call space.setBounds" (they were set)."""
     space = ob.RealVectorStateSpace(3)

@@ -63,7 +63,10 @@ class LibraryDimensionRRT(PythonPlanner):
         Fields of :class:`DimensionRRTOptions` replacing those of ``options``.
 
     Every exact path passed ``si.checkMotion`` over the whole path (the library path here, the
-    dimension-RRT path in :class:`DimensionRRT`); the problem definition keeps the cheaper.
+    dimension-RRT path in :class:`DimensionRRT`); the problem definition keeps the cheaper.  A goal that
+    is not one state (``GoalStates``, a sampleable region) is planned by :class:`DimensionRRT` alone (on the
+    given pair's Table 3 row): the library's paths end at one state.  Bad ``options`` (groups, ``h``,
+    ``range_``) and a space without usable bounds raise ValueError here, not at the first solve.
     """
 
     def __init__(
@@ -94,6 +97,7 @@ class LibraryDimensionRRT(PythonPlanner):
         if not isinstance(opts, DimensionRRTOptions):
             raise ValueError(f"options must be a DimensionRRTOptions, got {type(opts).__name__}")
         opts = dataclasses.replace(opts, name=name, **overrides)
+        DimensionRRT.checked_setup(si, opts)  # the refining planner is built at solve time: its settings are checked now
         super().__init__(si, name)
         self.library = library
         self.pair = pair
@@ -146,6 +150,12 @@ class LibraryDimensionRRT(PythonPlanner):
     def _solve(self, ptc: ob.PlannerTerminationCondition) -> ob.PlannerStatus:
         t0 = time.perf_counter()
         si, pdef = self.getSpaceInformation(), self.getProblemDefinition()
+        goal = pdef.getGoal()
+        if goal is not None and not isinstance(goal, ob.GoalState):  # the library's paths end at one state
+            log.info("LibraryDimensionRRT: the goal is a %s, not one state: planned by dimension-RRT without the "
+                     "library", type(goal).__name__)
+            self._stats["library_outcome"] = "planned"
+            return self._refine(ptc, t0, self.pair, None, False)
         ends = self._endpoints()
         if isinstance(ends, ob.PlannerStatus):
             return ends
@@ -214,11 +224,19 @@ class LibraryDimensionRRT(PythonPlanner):
             return planner_status(ob.PlannerStatus.EXACT_SOLUTION)
         if stats["library_outcome"] is None:
             stats["library_outcome"] = "planned"
+        return self._refine(ptc, t0, (i, j) if cross else None, seed, have_exact)
+
+    def _refine(self, ptc: ob.PlannerTerminationCondition, t0: float, pair: tuple[int, int] | None,
+                seed: np.ndarray | None, have_exact: bool) -> ob.PlannerStatus:
+        """Dimension-RRT on the same problem definition until ``ptc`` (on the pair's Table 3 row, from the DMP
+        ``seed`` when given), its progress merged into this run's statistics."""
+        si, pdef = self.getSpaceInformation(), self.getProblemDefinition()
+        stats, progress = self._stats, self._stats["progress"]
         opts = dataclasses.replace(self.options, seed=self._run_seed())
         inner = None
-        if cross:
+        if pair is not None:
             try:
-                inner = tpee_dimension_rrt(si, i, j, opts, initial_waypoints=seed if seed is not None
+                inner = tpee_dimension_rrt(si, *pair, opts, initial_waypoints=seed if seed is not None
                                            and seed.shape[0] == self.options.h else None)
             except ValueError as e:  # e.g. a space whose bounds the Table 3 row leaves
                 log.warning("LibraryDimensionRRT: planned over every DOF, without Table 3's row: %s", e)

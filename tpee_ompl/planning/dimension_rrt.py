@@ -190,9 +190,7 @@ class DimensionRRT(PythonPlanner):
         # Validate everything BEFORE super().__init__: an exception raised after it leaves a
         # half-constructed nanobind trampoline whose collection crashed the interpreter.
         opts = resolve_options(options, overrides)
-        check_space_information(si)
-        grouped = GroupedSpace(si, opts.groups, opts.h, prescribed)
-        rng_full = self._full_range(opts, grouped)
+        grouped, rng_full = self.checked_setup(si, opts, prescribed)
         initial = grouped.check_initial(initial_waypoints)
         super().__init__(si, opts.name)
         self._options = opts
@@ -226,6 +224,16 @@ class DimensionRRT(PythonPlanner):
     @max_samples.setter
     def max_samples(self, value: int | None) -> None:
         self._max_samples = check_int("max_samples", value, minimum=1, optional=True)
+
+    @classmethod
+    def checked_setup(cls, si: ob.SpaceInformation, opts: DimensionRRTOptions,
+                      prescribed: Mapping[int, np.ndarray] | None = None) -> tuple[GroupedSpace, np.ndarray]:
+        """The grouped space and the per-DOF ``range_`` these options give on ``si``; ValueError (naming the
+        setting or the space) where the constructor would raise one.  For planners that build a DimensionRRT
+        only at solve time (the library pipeline), to refuse bad settings when they are made."""
+        check_space_information(si)
+        grouped = GroupedSpace(si, opts.groups, opts.h, prescribed)
+        return grouped, cls._full_range(opts, grouped)
 
     @staticmethod
     def _full_range(opts: DimensionRRTOptions, grouped: GroupedSpace) -> np.ndarray:
@@ -392,6 +400,9 @@ class DimensionRRT(PythonPlanner):
             log.info("DimensionRRT: %d of %d goal states are off the prescribed trajectory", len(Q1) - len(fits), len(Q1))
         if len(fits) > 1:
             fits.sort(key=lambda q1: float(layout.distance(q0, q1)))  # nearest first (stable)
+        if len(fits) > self.options.max_goals:
+            log.warning("%s plans to the %d goal states nearest the start, of %d (max_goals)", self.getName(),
+                        self.options.max_goals, len(fits))
         return q0, fits
 
     def _solve(self, ptc: ob.PlannerTerminationCondition) -> ob.PlannerStatus:

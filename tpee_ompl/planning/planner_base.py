@@ -104,6 +104,9 @@ class PythonPlanner(ob.Planner):
         start = pis.nextStart()
         if start is None:  # nextStart() skips start states out of bounds or invalid (OMPL checks them itself)
             return planner_status(ob.PlannerStatus.INVALID_START)
+        count = self.getProblemDefinition().getStartStateCount()
+        if count > 1:  # RRTConnect grows a tree from each; these planners search from one start
+            log.warning("%s plans from one start state: the first valid of the %d given", self.getName(), count)
         if not finite_state(self.getSpaceInformation(), start):  # OMPL's bounds check lets NaN through
             log.error("%s: the start state has NaN or inf values", self.getName())
             return planner_status(ob.PlannerStatus.INVALID_START)
@@ -120,7 +123,11 @@ class PythonPlanner(ob.Planner):
         if not finite_state(si, gstate):
             log.error("%s: the goal state has NaN or inf values", self.getName())
             return planner_status(ob.PlannerStatus.INVALID_GOAL)
-        if not (si.satisfiesBounds(gstate) and si.isValid(gstate)):
+        if not si.satisfiesBounds(gstate):
+            log.error("%s: the goal state is outside the space's bounds", self.getName())
+            return planner_status(ob.PlannerStatus.INVALID_GOAL)
+        if not si.isValid(gstate):
+            log.error("%s: the goal state is invalid (the state validity checker rejects it)", self.getName())
             return planner_status(ob.PlannerStatus.INVALID_GOAL)
         return gstate
 

@@ -85,6 +85,9 @@ class RealVectorLayout:
             lo, hi = [float(v) for v in b.low], [float(v) for v in b.high]
             bad = [i for i in range(len(lo)) if not (math.isfinite(lo[i]) and math.isfinite(hi[i]) and lo[i] < hi[i])]
             where = f" (subspace {list(path)})" if path else ""
+            if bad and not any(lo + hi):  # OMPL's RealVectorBounds start at 0 and 0: none were set
+                raise ValueError(f"RealVectorStateSpace{where} has no bounds (every low and high is 0): call "
+                                 "space.setBounds(low, high) first")
             if bad:
                 locked = [i for i in bad if math.isfinite(lo[i]) and lo[i] == hi[i]]
                 other = [i for i in bad if i not in locked]
