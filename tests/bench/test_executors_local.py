@@ -91,6 +91,32 @@ def test_a_query_whose_worker_always_dies_is_listed_exit_1_and_resume_runs_it(qu
     assert len(names) == len(set(names)) == 6
 
 
+def _rrtstar_rows(db: Path) -> list[tuple]:
+    con = sqlite3.connect(db)
+    try:
+        return con.execute("SELECT experiments.query_id, experiments.sample_cap, runs.status, runs.iterations, "
+                           "runs.best_cost, runs.solution_length FROM runs JOIN experiments ON runs.experimentid = "
+                           "experiments.id JOIN plannerConfigs ON runs.plannerid = plannerConfigs.id WHERE "
+                           "plannerConfigs.name LIKE '%RRTstar' ORDER BY 1, 2, runs.id").fetchall()
+    finally:
+        con.close()
+
+
+def test_the_experiments_a_retried_task_runs_give_the_rows_of_an_uninterrupted_run(query_file, tmp_path, monkeypatch):
+    """The retry skips the experiments its dead predecessor logged; OMPL's planners used to draw, in the ones it ran,
+    the random numbers the skipped ones had drawn (RRT*'s rows changed without a word)."""
+    rows = []
+    for times in (0, 1):
+        kills = _arm_killer(monkeypatch, tmp_path / f"kills{times}", times=times, cap=60)
+        cfg = tiny_config(query_file, tmp_path / f"out{times}", sample_caps=(30, 60), anytime_budgets=(), workers=1,
+                          iteration_planners=(KILLER, "RRTstar"))
+        executor = ProcessPoolExecutor(1)
+        res = run_campaign(cfg, executor=executor, report=False, progress_bar=False)
+        assert len(list(kills.iterdir())) == times and len(executor.lost) == times and not res.failed_tasks
+        rows.append(_rrtstar_rows(res.database))
+    assert len(rows[0]) == 3 * 2 and rows[1] == rows[0]
+
+
 def test_a_hung_task_is_killed_at_its_time_limit_retried_once_then_reported():
     ex = ProcessPoolExecutor(2, poll=0.2)
     tasks = [{"qpos": 0, "time_limit_s": 0.5}, {"qpos": 1, "time_limit_s": 60}]

@@ -1,8 +1,10 @@
 """One query's experiments, in a worker process: seeding, the experiment list, one ``ompl.tools.Benchmark`` each.
 
 Each (query, comparison, cap/budget, motion validator) is one OMPL experiment, on one
-``SimpleSetup`` per experiment (same validity checker, motion-check resolution, objective and OMPL
-seed for every planner):
+``SimpleSetup`` per experiment (same validity checker, motion-check resolution and objective for every
+planner; each planner's seed, and OMPL's seed generator when it is made, from the campaign seed, the query,
+its position in the list and the cap or budget, so the validators' experiments of one cap draw the same
+samples, and a retried or resumed experiment the samples of an uninterrupted run):
 
 * **iterations** (paper Table 4): every planner is capped at N samples/iterations.  dimension-RRT
   gets ``max_samples=N``; OMPL's planners (default settings) are stopped after exactly N
@@ -80,6 +82,19 @@ def _seed_process(seed: int) -> None:
         _SEEDED.append(int(seed))
     elif _SEEDED[0] != int(seed):
         log.warning("OMPL was seeded with %d in this process, not %d: runs are not reproducible", _SEEDED[0], seed)
+
+
+def _seed_planner(seed: int) -> None:
+    """Reseed OMPL's seed generator just before a planner is made, so that an OMPL planner's random numbers depend
+    on its own seed (campaign seed, query, position, cap or budget) and not on how many planners the process made
+    before it: a task retried after its worker died, or a resumed campaign, runs only the experiments not yet
+    logged, and they must give the rows an uninterrupted run gives."""
+    level = ou.getLogLevel()
+    ou.setLogLevel(ou.LOG_NONE)  # a later setSeed in a process logs an error, and reseeds all the same
+    try:
+        ou.RNG.setSeed(int(seed) or 1)
+    finally:
+        ou.setLogLevel(level)
 
 
 def experiment_specs(cfg: dict, qpos: int) -> list[dict]:
@@ -317,7 +332,8 @@ def _add_planners(cfg: dict, task: dict, spec: dict, setup: _Setup, bench: ot.Be
                   only: list[str] | None) -> dict:
     """Add the comparison's planners (only those in ``only``, if given) to ``bench``; returns their wrappers by name.
 
-    A planner's seed depends on its position in the comparison's full list, so it is the same with ``only``.
+    A planner's seed depends on its position in the comparison's full list, so it is the same with ``only``; OMPL's
+    seed generator is set to it before the planner is made (:func:`_seed_planner`).
     """
     cap, budget = spec["cap"], spec["budget"]
     planners = cfg["iteration_planners"] if spec["comparison"] == "iterations" else cfg["anytime_planners"]
@@ -341,6 +357,7 @@ def _wrap_planner(pname: str, ctx: PlannerContext, spec: dict, setup: _Setup, la
     Raises ValueError when its factory returns no ``ob.Planner`` or one named like a planner in ``earlier``.
     """
     factory = planner_factory(pname)
+    _seed_planner(ctx.seed)
     inner = factory(setup.si, ctx)
     if not isinstance(inner, ob.Planner):
         raise ValueError(f"planner factory {pname!r} returned {type(inner).__name__}, not an ompl.base.Planner")
