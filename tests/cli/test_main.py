@@ -190,6 +190,37 @@ def test_ctrl_c_while_the_command_line_loads_ends_it_with_130_and_one_line():
     assert proc.returncode == 130 and proc.stderr == "tpee-ompl: interrupted\n" and proc.stdout == ""
 
 
+def test_sigterm_while_the_command_line_loads_ends_it_with_130_and_one_line():
+    """SIGTERM in the first 0.4 s ended the process without a word (exit 143): the command's own handler was not
+    on yet.  The signal is sent at the import of pinocchio, which the command line's modules load."""
+    import subprocess
+    import sys
+
+    code = ("import builtins, os, signal, sys\n"
+            "real = builtins.__import__\n"
+            "def killed(name, *a, **k):\n"
+            "    if name == 'pinocchio':\n"
+            "        os.kill(os.getpid(), signal.SIGTERM)\n"
+            "    return real(name, *a, **k)\n"
+            "builtins.__import__ = killed\n"
+            "from tpee_ompl._launch import main\n"
+            "sys.exit(main())\n")
+    proc = subprocess.run([sys.executable, "-c", code, "plan", "--from", "1", "--to", "4"], capture_output=True,
+                          text=True, timeout=120)
+    assert proc.returncode == 130 and proc.stderr == "tpee-ompl: interrupted\n" and proc.stdout == ""
+
+
+def test_python_dash_m_tpee_ompl_is_the_command_line():
+    import subprocess
+    import sys
+
+    proc = subprocess.run([sys.executable, "-m", "tpee_ompl", "aim", "--target", "5", "2", "1.5"], capture_output=True,
+                          text=True, timeout=120)
+    assert proc.returncode == 0 and proc.stdout.strip() and proc.stderr == ""
+    bad = subprocess.run([sys.executable, "-m", "tpee_ompl", "aim"], capture_output=True, text=True, timeout=120)
+    assert bad.returncode == 2 and bad.stderr.startswith("tpee-ompl aim: error:")
+
+
 def test_an_interrupt_while_the_command_cleans_up_after_its_work_ends_with_130(monkeypatch, capsys):
     """The last clean-up (a garbage collection) ran after the interrupt handling: Ctrl-C there printed a traceback
     or was lost (exit 0)."""
