@@ -25,3 +25,16 @@ def test_results_dirs_are_always_new(tmp_path):
 def test_values_are_formatted_as_ompl_log_text():
     assert [format_value(v) for v in (None, True, 3, 0.5, float("nan"), float("inf"), "s")] == [
         "", "1", "3", "0.5", "nan", "inf", "s"]
+
+
+def test_a_json_line_is_never_glued_to_a_last_line_cut_short(tmp_path):
+    import json
+
+    from tpee_ompl.bench.results import append_json_line
+
+    path = tmp_path / "tasks.jsonl"
+    append_json_line(path, {"qpos": 0})
+    path.write_text(path.read_text() + '{"qpos": 1, "lo')  # cut short by something else
+    append_json_line(path, {"qpos": 2})
+    lines = path.read_text().splitlines()
+    assert len(lines) == 3 and json.loads(lines[0]) == {"qpos": 0} and json.loads(lines[2]) == {"qpos": 2}

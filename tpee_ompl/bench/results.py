@@ -89,6 +89,8 @@ def append_json_line(path: Path, data: dict) -> None:
     from ..files import atomic_write_text
 
     old = Path(path).read_text() if Path(path).is_file() else ""
+    if old and not old.endswith("\n"):  # a last line cut short elsewhere (an editor, a full disk): not glued to it
+        old += "\n"
     atomic_write_text(path, old + json.dumps(data, allow_nan=False) + "\n")
 
 
