@@ -217,3 +217,26 @@ def test_table4_says_what_the_dimension_rrt_it_compares_is():
     text = report._markdown(ratio_table(at300, "DimensionRRT", "RRTstar"), [], [], [], "DimensionRRT", "RRTstar",
                             "batched")
     assert "Table 3's DOF1/DOF2 rows are kept" in text
+
+
+def test_runs_cut_by_the_time_limit_before_their_cap_are_said_under_the_success_counts():
+    base = {"comparison": "iterations", "sample_cap": 5000, "timelimit": 0.05, "solved": 1, "status": 6,
+            "reaches_goal": 1, "approximate_solution": 0, "correct_solution": 1, "path_valid_dense": 1,
+            "solution_length": 2.0, "planner": "R", "query_id": "0", "motion_validator": "batched", "time_budget": None}
+    runs = [{**base, "iterations": 976, "time": 0.11}, {**base, "iterations": 5000, "time": 0.03, "query_id": "1"}]
+    runs = [{**r, "success": report._success(r)} for r in runs]
+    text = report._markdown([], success_table(runs), [], [], "D", "R", "batched")
+    assert "1 sample-capped run(s) stopped at the time limit (`--max-time`) before their cap" in text
+
+
+def test_a_campaign_without_the_reference_at_sample_caps_says_why_it_has_no_table4(tmp_path, monkeypatch):
+    """With only dimension-RRT at sample caps the report was headed "Table 4: DimensionRRT / RRTstar" over n = 0
+    and table4.csv was all NaN; a campaign without budgets wrote empty anytime CSVs."""
+    runs = [run("DimensionRRT", q, 500, 1.0, 2.0, 1.0, 1.0) for q in (0, 1)]
+    monkeypatch.setattr(report, "load_runs", lambda db: runs)
+    out = report.write_report(tmp_path / "unused.db", tmp_path)
+    assert out["markdown_text"].startswith("No Table 4: it compares DimensionRRT with RRTstar at equal sample counts, "
+                                           "and the campaign ran RRTstar at no sample cap.")
+    assert "## Table 4" not in out["markdown_text"] and not (tmp_path / "table4.csv").exists()
+    assert not (tmp_path / "anytime.csv").exists() and not (tmp_path / "anytime_quality.csv").exists()
+    assert (tmp_path / "success.csv").read_text().startswith("comparison,")

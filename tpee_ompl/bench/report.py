@@ -189,6 +189,7 @@ def success_table(runs: list[dict], expected: dict | None = None) -> list[dict]:
                "success": sum(r["success"] for r in rs),
                "invalid_path": sum(1 for r in rs if r["solved"] == 1 and not r["success"] and not _hit_max_time(r)),
                "unsolved": sum(1 for r in rs if r["solved"] != 1 or _hit_max_time(r)),  # max_time: not at the cap
+               "cut_by_max_time": sum(1 for r in rs if _hit_max_time(r)),
                "queries": len(ids), "missing_queries": None}
         if wanted is not None:
             row["missing_queries"] = wanted.get((comp, chk, setting), 0) - len(ids)
@@ -197,7 +198,8 @@ def success_table(runs: list[dict], expected: dict | None = None) -> list[dict]:
     for (comp, chk, setting), n in sorted((wanted or {}).items()):
         if (comp, chk, setting) not in present:  # not one run of it finished
             out.append({"comparison": comp, "checker": chk, "setting": setting, "planner": "(every planner)",
-                        "runs": 0, "success": 0, "invalid_path": 0, "unsolved": 0, "queries": 0, "missing_queries": n})
+                        "runs": 0, "success": 0, "invalid_path": 0, "unsolved": 0, "cut_by_max_time": 0, "queries": 0,
+                        "missing_queries": n})
     return out
 
 
@@ -362,6 +364,10 @@ def _markdown(ratios: list[dict], succ: list[dict], quality: list[dict], anytime
         miss = "" if r["missing_queries"] is None else str(r["missing_queries"])
         lines.append(f"| {r['comparison']} | {r['checker']} | {r['setting']} | {r['planner']} | {r['success']} / {r['runs']} "
                      f"| {r['invalid_path']} | {r['unsolved']} | {miss} |")
+    cut = sum(r["cut_by_max_time"] for r in succ)
+    if cut:
+        lines += ["", f"{cut} sample-capped run(s) stopped at the time limit (`--max-time`) before their cap: counted as "
+                      "unsolved, since their paths came from fewer samples (a longer `--max-time` lets them reach it)."]
     lines += ["", "## Path length relative to the straight start-goal segment (lower bound) and to the best path found",
               "", "| comparison | validator | setting | planner | success | length / straight, median [Q1, Q3] "
               "| length / best found, median [Q1, Q3] | median time (s) |", "|---|---|---|---|---|---|---|---|"]
@@ -433,8 +439,8 @@ def _lost_queries(expected: dict | None) -> str:
 
 def write_report(db_path: str | Path, directory: str | Path, expected: dict | None = None,
                  planner: str | None = None, reference: str | None = None) -> dict:
-    """Write ``report.md``, ``table4.csv`` (when the campaign had sample caps), ``success.csv``,
-    ``length_quality.csv``, ``anytime.csv``, ``anytime_quality.csv``.
+    """Write ``report.md``, ``table4.csv`` (when the campaign ran both planners of the ratio at sample caps), and
+    those of ``success.csv``, ``length_quality.csv``, ``anytime.csv``, ``anytime_quality.csv`` that have rows.
 
     ``planner``/``reference`` default to the campaign's first two iteration planners (or
     DimensionRRT / RRTstar).  Returns the paths and the Markdown text.
@@ -447,12 +453,17 @@ def write_report(db_path: str | Path, directory: str | Path, expected: dict | No
     planner = planner or resolve_planner_name(names[0], seen)
     reference = reference or resolve_planner_name(names[1] if len(names) > 1 else "RRTstar", seen)
     headline = (cfg.get("checkers") or ["batched"])[0]
-    ratios = ratio_table(runs, planner, reference)
+    absent = [p for p in dict.fromkeys((planner, reference)) if p not in seen]
+    ratios = ratio_table(runs, planner, reference) if seen and not absent and planner != reference else []
+    note = ""
+    if seen and not ratios:  # sample caps were run, but not both planners of the ratio
+        note = (f"No Table 4: it compares {planner} with {reference} at equal sample counts, and the campaign ran "
+                f"{' and '.join(absent) if absent else 'one planner'} at no sample cap.\n\n")
     succ = success_table(runs, expected)
     quality = length_quality_table(runs)
     anytime = anytime_table(runs)
     anytime_quality = anytime_quality_table(runs)
-    text = (_markdown(ratios, succ, quality, anytime, planner, reference, headline)
+    text = (note + _markdown(ratios, succ, quality, anytime, planner, reference, headline)
             + _anytime_quality_markdown(anytime_quality) + _lost_queries(expected))
     paths = {"markdown": directory / "report.md"}
     atomic_write_text(paths["markdown"], text)
@@ -461,8 +472,9 @@ def write_report(db_path: str | Path, directory: str | Path, expected: dict | No
         _write_csv(paths["csv"], ratios)
     for name, rows in (("success", succ), ("length_quality", quality), ("anytime", anytime),
                        ("anytime_quality", anytime_quality)):
-        paths[name] = directory / f"{name}.csv"
-        _write_csv(paths[name], rows)
+        if rows:  # a table the campaign has no runs for (no budgets: no anytime rows) is not written empty
+            paths[name] = directory / f"{name}.csv"
+            _write_csv(paths[name], rows)
     return {**paths, "markdown_text": text, "planner": planner, "reference": reference}
 
 
