@@ -3,8 +3,8 @@
 Each (query, comparison, cap/budget, motion validator) is one OMPL experiment, on one
 ``SimpleSetup`` per experiment (same validity checker, motion-check resolution and objective for every
 planner; each planner's seed, and OMPL's seed generator when it is made, from the campaign seed, the query,
-its position in the list and the cap or budget, so the validators' experiments of one cap draw the same
-samples, and a retried or resumed experiment the samples of an uninterrupted run):
+its position in the list and the cap or budget (a ladder's one run: its largest cap's), so a retried or
+resumed experiment draws the samples of an uninterrupted run):
 
 * **iterations** (paper Table 4): every planner is capped at N samples/iterations.  dimension-RRT
   gets ``max_samples=N``; OMPL's planners (default settings) are stopped after exactly N
