@@ -161,6 +161,7 @@ def test_a_runtime_failure_is_exit_1_in_one_line_and_keeps_what_ran(inputs, tmp_
     args = _args(["--planners", "helpers.bench_standins:make_broken_factory", "RRTstar"], inputs, tmp_path)
     proc = run_cli(args, cwd=TESTS)
     assert_refused(proc, 1, "2 query(ies) lost", "this planner factory always fails", "--resume")
+    assert proc.stderr.count("this planner factory always fails") == 1  # said once for the queries it lost
     (directory,) = tmp_path.iterdir()  # the campaign had started: its folder stays, with the reasons
     meta = json.loads((directory / "campaign.json").read_text())
     assert [f["qpos"] for f in meta["failed_tasks"]] == [0, 1] and meta["interrupted"] is False

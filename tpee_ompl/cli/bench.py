@@ -238,14 +238,28 @@ def run(args: argparse.Namespace) -> int:
               f"finish it with --resume {result.directory}")
         return 130
     if result.failed_tasks or result.skipped_logs:
-        lost = "; ".join(f"query {f['query_id']} ({' '.join(str(f['reason']).split())}, "
-                         f"{len(f['missing_logs'])} experiment(s))" for f in result.failed_tasks)  # one line
+        lost = _lost_line(result.failed_tasks)
         bad = ", ".join(p.name for p in result.skipped_logs)
         print(f"{prog}: error: campaign finished incomplete: {len(result.failed_tasks)} query(ies) lost"
               + (f": {lost}" if lost else "") + (f"; unreadable logs: {bad}" if bad else "")
               + f"; run them again with --resume {result.directory}", file=sys.stderr)
         return 1
     return 0
+
+
+def _lost_line(failed: list[dict], shown: int = 5) -> str:
+    """The lost queries in one line, one entry per reason (a planner factory that fails fails every query: its
+    error was repeated once per query, 18 kB for 120)."""
+    by_reason: dict[str, list[dict]] = {}
+    for f in failed:
+        by_reason.setdefault(" ".join(str(f["reason"]).split()), []).append(f)
+    parts = []
+    for reason, fs in by_reason.items():
+        ids = [str(f["query_id"]) for f in fs]
+        which = (f"query {ids[0]}" if len(ids) == 1 else f"queries {', '.join(ids[:shown])}"
+                 + (f" and {len(ids) - shown} more" if len(ids) > shown else ""))
+        parts.append(f"{which} ({reason}, {sum(len(f['missing_logs']) for f in fs)} experiment(s))")
+    return "; ".join(parts)
 
 
 def _interrupted(prog: str, where: object) -> int:
