@@ -157,3 +157,23 @@ def test_a_task_run_in_a_subprocess_is_killed_at_its_time_limit_run_once_more_th
     assert out["failed"] == "no result within its time limit (5 s): killed" and out["attempts"] == 2
     assert out["qpos"] == 3 and starts.read_text().splitlines() == ["start", "start"]  # two fresh processes
     assert run_task_in_subprocess({**task, "seconds": 0}, "helpers.bench_tasks:sleep")["seconds"] == 0
+
+
+def test_task_folders_of_processes_that_are_gone_are_swept_and_the_others_kept(tmp_path, monkeypatch):
+    """A Dask worker killed or interrupted mid-task left its ``tpee_task_*`` folder in /tmp for good."""
+    import os
+    import subprocess
+    import sys
+    import tempfile
+
+    from tpee_ompl.bench.executors import sweep_task_dirs
+
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+    gone = subprocess.Popen([sys.executable, "-c", "pass"])
+    gone.wait()
+    (tmp_path / f"tpee_task_{gone.pid}_x1").mkdir()
+    (tmp_path / f"tpee_task_{gone.pid}_x1" / "task.json").write_text("{}")
+    (tmp_path / f"tpee_task_{os.getpid()}_x2").mkdir()  # a task running in this process
+    (tmp_path / "tpee_task_x3").mkdir()  # no pid in its name: not this module's to judge
+    assert sweep_task_dirs() == 1
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted([f"tpee_task_{os.getpid()}_x2", "tpee_task_x3"])

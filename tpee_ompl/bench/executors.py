@@ -26,6 +26,7 @@ import json
 import logging
 import multiprocessing as mp
 import os
+import shutil
 import signal
 import subprocess
 import sys
@@ -271,9 +272,37 @@ def run_task_in_subprocess(task: dict, fn_path: str = "tpee_ompl.bench.experimen
     return task_failure(task, f"no result within its time limit ({float(limit):g} s): killed", 2)
 
 
+_TASK_DIR = "tpee_task_"
+"""Prefix of a task's folder in the temporary folder, followed by the pid of the process that made it."""
+
+
+def sweep_task_dirs() -> int:
+    """Remove the task folders (``tpee_task_<pid>_*`` in the temporary folder) whose process is gone: a Dask worker
+    killed or interrupted mid-task cannot remove its own.  Called before each task and when a Dask executor shuts
+    down; returns how many were removed."""
+    removed = 0
+    for folder in Path(tempfile.gettempdir()).glob(f"{_TASK_DIR}*_*"):
+        pid = folder.name[len(_TASK_DIR):].split("_", 1)[0]
+        if pid.isdigit() and not _alive(int(pid)):
+            shutil.rmtree(folder, ignore_errors=True)
+            removed += 1
+    return removed
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:  # another user's process: alive
+        return True
+    return True
+
+
 def _run_child(task: dict, fn_path: str) -> dict:
     """One fresh Python process running ``fn(task)``; raises ``subprocess.TimeoutExpired`` at the time limit."""
-    with tempfile.TemporaryDirectory(prefix="tpee_task_") as tmp:
+    sweep_task_dirs()
+    with tempfile.TemporaryDirectory(prefix=f"{_TASK_DIR}{os.getpid()}_") as tmp:
         src, dst = Path(tmp) / "task.json", Path(tmp) / "result.json"
         src.write_text(json.dumps(task))
         env = dict(os.environ)
@@ -408,6 +437,7 @@ class DaskExecutor:
             with contextlib.suppress(Exception):
                 self._cluster.close()
             logging.getLogger("distributed").setLevel(self._log_level)
+            sweep_task_dirs()  # what its workers, stopped mid-task, left in this host's temporary folder
 
 
 def make_executor(workers: int = 1, dask: str | None = None, dask_workers: int = 2,
