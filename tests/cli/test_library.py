@@ -33,6 +33,16 @@ def test_build_writes_a_loadable_library_with_its_parameters(robot, small_file: 
     assert "max_samples=200" in lib.build_params["planner"]
 
 
+@pytest.mark.parametrize("quiet", [False, True])
+def test_build_shows_the_pairs_done_on_stderr_unless_no_progress(tmp_path, capsys, quiet) -> None:
+    """A default build runs for minutes: it used to print nothing until the end."""
+    argv = ["library", "build", "--pairs", "1-2", "2-3", "--per-pair", "1", "--max-samples", "200", "--seed", "2",
+            "--library", str(tmp_path / "p.npz")] + (["--no-progress"] if quiet else [])
+    assert _run(argv) == 0
+    err = capsys.readouterr().err
+    assert ("library pairs" in err and "2/2" in err) != quiet
+
+
 def test_stats_describes_the_file(small_file: str, capsys) -> None:
     assert _run(["library", "stats", "--library", small_file]) == 0
     out = capsys.readouterr().out

@@ -96,7 +96,7 @@ def _build_options(args: argparse.Namespace) -> LibraryBuildOptions:
     given = {"per_pair": args.per_pair, "seed": args.seed, "min_difference": args.min_difference,
              "max_attempts": args.max_attempts, "max_samples": args.max_samples, "timeout": args.timeout,
              "demo_margins": tuple(args.demo_margins), "workers": args.workers,
-             "dmp_options": DMPOptions(scaling=args.dmp_scaling)}
+             "dmp_options": DMPOptions(scaling=args.dmp_scaling), "progress": not args.no_progress}
     if args.pairs:
         given["pairs"] = tuple(args.pairs)
     try:
@@ -229,6 +229,7 @@ def register(subparsers: argparse._SubParsersAction, formatter_class: type = arg
     b.add_argument("--dmp-scaling", choices=("none", "amplitude"), default=d.dmp_options.scaling,
                    help="DMP forcing: 'amplitude' = eq. 13's x(g - y0), 'none' = absolute "
                         f"(default {d.dmp_options.scaling}; docs/dmp.md says why)")
+    b.add_argument("--no-progress", action="store_true", help="no progress bar (pairs done, time left)")
     add_force_arg(b)
     b.set_defaults(func=run_build)
 

@@ -16,7 +16,7 @@ import logging
 import signal
 from collections import Counter
 from collections.abc import Mapping, Sequence
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import asdict, dataclass
 from multiprocessing import get_context
 from typing import Any
@@ -86,6 +86,10 @@ class LibraryBuildOptions:
         Processes building the pairs in parallel (default sampler and planner only). Default 1.
     dmp_options : DMPOptions
         The DMPs' settings (default :data:`LIBRARY_DMP_OPTIONS`).
+    progress : bool
+        A progress bar on stderr (pairs done, with an estimate of the time left; default sampler and planner
+        only; ``tpee-ompl library build`` shows it unless ``--no-progress``).  Not a build parameter: the library
+        is the same either way.  Default False.
     """
 
     per_pair: int = 20
@@ -100,6 +104,7 @@ class LibraryBuildOptions:
     demo_margins: Sequence[float] = DEMO_MARGINS
     workers: int = 1
     dmp_options: DMPOptions = LIBRARY_DMP_OPTIONS
+    progress: bool = False
 
     def __post_init__(self) -> None:
         set_ = lambda field_, value: object.__setattr__(self, field_, value)  # noqa: E731 (frozen dataclass)
@@ -114,6 +119,7 @@ class LibraryBuildOptions:
         set_("require_planning", check_bool("require_planning", self.require_planning))
         set_("demo_margins", check_demo_margins(self.demo_margins))
         set_("workers", check_int("workers", self.workers, minimum=1))
+        set_("progress", check_bool("progress", self.progress))
         if not isinstance(self.dmp_options, DMPOptions):
             raise ValueError(f"dmp_options must be a DMPOptions, got {self.dmp_options!r}")
 
@@ -167,22 +173,31 @@ def collect_default_demos(
     children = np.random.SeedSequence(opts.seed).spawn(len(opts.pairs))
     model = (robot.files.urdf, robot.files.srdf, robot.security_margin, dict(robot.link_margins), robot.n_threads)
     jobs = [(model, i, j, child, opts) for (i, j), child in zip(opts.pairs, children)]
-    if opts.workers > 1 and len(jobs) > 1:
-        # the workers ignore Ctrl-C: the parent ends them (a worker that dies breaks the pool: an error, not a hang)
-        ex = ProcessPoolExecutor(min(opts.workers, len(jobs)), mp_context=get_context("spawn"),
-                                 initializer=child_sigint, initargs=(signal.SIG_IGN,))
-        try:
-            with sigint_blocked_for_children():  # the workers start on submit
-                futures = [ex.submit(_collect_default_pair, job) for job in jobs]
-            results = [f.result() for f in futures]
-        except BaseException:
-            for proc in list((getattr(ex, "_processes", None) or {}).values()):  # no public way before 3.14
-                proc.terminate()
-            ex.shutdown(wait=False, cancel_futures=True)
-            raise
-        ex.shutdown()
-    else:
-        results = [_collect_default_pair(job, robot) for job in jobs]
+    from tqdm import tqdm
+
+    with tqdm(total=len(jobs), desc="library pairs", unit="pair", disable=not opts.progress) as bar:
+        if opts.workers > 1 and len(jobs) > 1:
+            # the workers ignore Ctrl-C: the parent ends them (a worker that dies breaks the pool: an error, not a hang)
+            ex = ProcessPoolExecutor(min(opts.workers, len(jobs)), mp_context=get_context("spawn"),
+                                     initializer=child_sigint, initargs=(signal.SIG_IGN,))
+            try:
+                with sigint_blocked_for_children():  # the workers start on submit
+                    futures = [ex.submit(_collect_default_pair, job) for job in jobs]
+                for done in as_completed(futures):
+                    done.result()  # a failed pair raises now, not after the others
+                    bar.update()
+                results = [f.result() for f in futures]
+            except BaseException:
+                for proc in list((getattr(ex, "_processes", None) or {}).values()):  # no public way before 3.14
+                    proc.terminate()
+                ex.shutdown(wait=False, cancel_futures=True)
+                raise
+            ex.shutdown()
+        else:
+            results = []
+            for job in jobs:
+                results.append(_collect_default_pair(job, robot))
+                bar.update()
     stats: Counter[str] = Counter()
     for r in results:
         stats.update(r[4])
