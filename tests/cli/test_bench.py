@@ -61,6 +61,16 @@ def test_resume_of_a_folder_without_campaign_is_a_clear_error(capsys, tmp_path):
     assert "campaign.json" in capsys.readouterr().err
 
 
+def test_resume_of_a_folder_it_may_not_write_in_is_a_usage_error_naming_it(capsys, tmp_path, monkeypatch):
+    """It was exit 1 with "PermissionError: ... .lock" (root may write anywhere: the check is simulated)."""
+    import tpee_ompl.cli.bench as cli_bench
+
+    monkeypatch.setattr(cli_bench.os, "access", lambda path, mode: False)
+    assert main(["--resume", str(tmp_path), "--workers", "1", "--no-progress"]) == 2
+    assert capsys.readouterr().err.strip().endswith(f"--resume {tmp_path}: the folder is not writable (the "
+                                                    "campaign's logs, lock and database are written there)")
+
+
 def test_list_problems_prints_every_problem_and_runs_nothing(capsys, tmp_path):
     from tpee_ompl.bench.problems import PROBLEM_NAMES
 

@@ -138,3 +138,15 @@ def test_track_output_writes_the_sector_as_an_integer_and_times_exactly(tmp_path
     assert rows and all(r[5] in {"0", "1", "2", "3", "4"} for r in rows)  # was 3.000000000000000000e+00 (0: in a motion)
     written = np.array([[float(v) for v in r[:5]] for r in rows])
     np.testing.assert_array_equal(written, np.c_[results[0].times, results[0].configurations])  # to the last bit
+
+
+def test_queries_given_a_folder_or_a_pipe_says_what_it_is(capsys, tmp_path):
+    """Both used to be "not found"."""
+    import os
+
+    fifo = tmp_path / "q.json"
+    os.mkfifo(fifo)
+    for given, said in ((tmp_path, "is a folder, not a query file"), (fifo, "is not a regular file")):
+        assert main(["plan", "--from", "1", "--to", "4", "--queries", str(given)]) == 2
+        err = capsys.readouterr().err.strip()
+        assert err.startswith("tpee-ompl plan: error: --queries: ") and said in err and "\n" not in err

@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import logging
+import os
 import re
 import sys
 import traceback
@@ -204,6 +205,9 @@ def run(args: argparse.Namespace) -> int:
     prog = getattr(args, "bench_prog", "bench")
     try:
         if args.resume:  # its own worker count (the checker's threads follow it) unless --workers is given
+            if Path(args.resume).is_dir() and not os.access(args.resume, os.W_OK | os.X_OK):
+                raise ValueError(f"--resume {args.resume}: the folder is not writable (the campaign's logs, lock and "
+                                 "database are written there)")
             saved = load_campaign(args.resume)["config"].get("workers", _default("workers"))
             workers = saved if args.workers is None else args.workers
             config = plan = None
@@ -230,7 +234,8 @@ def run(args: argparse.Namespace) -> int:
             return _interrupted(prog, args.resume)
         if getattr(args, "verbose", False):
             traceback.print_exc()
-        print(f"{prog}: error: {type(exc).__name__}: {_user_message(exc)}", file=sys.stderr)
+        kind = "" if isinstance(exc, (ValueError, OSError, RuntimeError)) else f"{type(exc).__name__}: "  # as cli.main
+        print(f"{prog}: error: {kind}{_user_message(exc)}", file=sys.stderr)
         return 1
     _print_result(result)
     if result.interrupted:

@@ -138,7 +138,7 @@ def run_query(args: argparse.Namespace) -> int:
             raise CliError(f"give --query-set NAME --index K, or --from --to --start --goal, not both ({' '.join(given)})")
         try:
             queries = load_queries(args.query_set, robot)
-        except FileNotFoundError as exc:
+        except OSError as exc:  # missing, a folder, a pipe, not readable
             raise CliError(f"--query-set: {exc}") from None
         k = 0 if args.index is None else args.index
         if k >= len(queries):

@@ -126,7 +126,7 @@ def _start_and_goal(args: argparse.Namespace, robot: WearerArm) -> tuple[np.ndar
 
     try:
         queries = load_queries(args.queries, robot)
-    except FileNotFoundError as exc:
+    except OSError as exc:  # missing, a folder, a pipe, not readable
         raise CliError(f"--queries: {exc}") from None
     except QuerySetError as exc:
         if getattr(args, "urdf", None) and "made for model_hash" in str(exc):  # the packaged sets are the packaged model's

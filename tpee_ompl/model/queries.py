@@ -172,18 +172,24 @@ def save_queries(
 def read_query_document(name_or_path: str | os.PathLike) -> tuple[Path, object]:
     """The file of a named query set (packaged) or a JSON path, and its parsed JSON (any type).
 
-    Raises ValueError (not a name or path), FileNotFoundError (no such set or file) or
-    :class:`QuerySetError` (not JSON).  Shared by the sector sets and the joint sets
+    Raises ValueError (not a name or path), FileNotFoundError (no such set or file), another OSError (a folder,
+    a pipe, a file it may not read) or :class:`QuerySetError` (not JSON).  Shared by the sector sets and the joint sets
     (:mod:`tpee_ompl.model.joint_queries`)."""
     if isinstance(name_or_path, bool) or not isinstance(name_or_path, (str, os.PathLike)):
         raise ValueError(f"query set must be a name or a path, got {name_or_path!r}")
     p = Path(name_or_path)
     if not p.suffix and not p.exists():
         p = query_set_path(str(name_or_path))
-    if not p.is_file():
+    if p.is_dir():
+        raise IsADirectoryError(f"query set {str(name_or_path)!r}: {p} is a folder, not a query file")
+    if not p.exists():
         raise FileNotFoundError(f"query set {str(name_or_path)!r} not found (looked at {p})")
+    if not p.is_file():
+        raise OSError(f"query set {str(name_or_path)!r}: {p} is not a regular file (a pipe or a device)")
     try:
         return p, json.loads(p.read_text(encoding="utf-8"))
+    except PermissionError as exc:
+        raise PermissionError(f"query set {str(name_or_path)!r}: {p} cannot be read ({exc.strerror})") from None
     except (UnicodeDecodeError, json.JSONDecodeError, RecursionError) as exc:
         raise QuerySetError(f"{p}: not a JSON query set (truncated or corrupt?): {exc}") from exc
 
