@@ -7,6 +7,7 @@ import json
 from pathlib import Path
 
 import numpy as np
+import pytest
 from helpers.cli_queries import GOAL, START, start_goal_args
 
 from tpee_ompl.cli.main import main
@@ -150,3 +151,28 @@ def test_queries_given_a_folder_or_a_pipe_says_what_it_is(capsys, tmp_path):
         assert main(["plan", "--from", "1", "--to", "4", "--queries", str(given)]) == 2
         err = capsys.readouterr().err.strip()
         assert err.startswith("tpee-ompl plan: error: --queries: ") and said in err and "\n" not in err
+
+
+@pytest.mark.parametrize("quiet", [False, True])
+def test_a_track_that_lasts_more_than_two_seconds_shows_its_progress_unless_no_progress(capsys, monkeypatch, quiet):
+    """A long --duration x --rate ran a minute without a word; a short one stays silent (the bar waits 2 s)."""
+    import time
+
+    from tpee_ompl.library.tracker import Tracker
+
+    real = Tracker.step
+
+    def slow(self, *a):
+        time.sleep(0.12)
+        return real(self, *a)
+
+    monkeypatch.setattr(Tracker, "step", slow)
+    argv = ["track", "--script", "jitter", "--duration", "3", "--rate", "10", "--json"] + (["--no-progress"] if quiet else [])
+    assert main(argv) == 0
+    err = capsys.readouterr().err
+    assert ("track" in err and "30/30" in err) != quiet
+
+
+def test_a_short_track_prints_nothing_on_stderr(capsys):
+    assert main(["track", "--script", "jitter", "--duration", "2", "--json"]) == 0
+    assert capsys.readouterr().err == ""

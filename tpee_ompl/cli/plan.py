@@ -291,6 +291,8 @@ def _scripted_targets(name: str, duration: float, rate: float) -> list[tuple]:
 
 def cmd_track(args: argparse.Namespace) -> int:
     """Run the Fig. 10 tracking strategy on a scripted target stream and report its events."""
+    from tqdm import tqdm
+
     from ..library.tracker import MAX_TIME, Tracker, make_default_planner
 
     if not args.duration <= MAX_TIME:  # the tracker takes sample times within +/- MAX_TIME
@@ -329,7 +331,9 @@ def cmd_track(args: argparse.Namespace) -> int:
     else:
         planner = make_default_planner(robot, seed=args.seed, library=args.library)
     stream = _scripted_targets(args.script, args.duration, args.rate)
-    result = Tracker(robot, planner).run(stream)
+    # on stderr, only when the run lasts more than 2 s (a long --duration x --rate ran a minute without a word)
+    result = Tracker(robot, planner).run(tqdm(stream, desc="track", unit="sample", delay=2.0,
+                                              disable=args.no_progress))
     kinds = ("aim", "cross-sector", "blind-area", "unreachable")
     summary = {k: result.count(k) for k in kinds}
     if args.output:
@@ -393,6 +397,8 @@ def register(sub: argparse._SubParsersAction, fmt: type) -> None:
     p.add_argument("--rate", type=positive_float, default=10.0, help="target samples per second")
     p.add_argument("--seed", type=seed, default=1, help="OMPL / planner seed, 1..2^32-1 (default 1)")
     p.add_argument("--json", action="store_true")
+    p.add_argument("--no-progress", action="store_true",
+                   help="no progress bar (shown on stderr when the run lasts more than 2 s)")
     p.add_argument("-o", "--output", type=nonempty, help="write the trajectory as CSV (a new file; --force to replace one)")
     add_force_arg(p)
     add_model_args(p)
