@@ -325,3 +325,23 @@ def test_quieter_ompl_raises_the_level_for_its_block_only_and_never_lowers_it():
             assert ou.getLogLevel() == level
     finally:
         ou.setLogLevel(before)
+
+
+def test_seed_ompl_makes_the_next_planners_draw_the_same_numbers_after_numbers_were_drawn(capfd):
+    from ompl import base as ob
+    from ompl import util as ou
+
+    from tpee_ompl.planning.setup import seed_ompl
+
+    def draws() -> list[float]:  # a new RNG takes its seed from the generator, as a planner's or sampler's does
+        rngs = [ou.RNG() for _ in range(2)]
+        return [r.uniform01() for r in rngs for _ in range(3)]
+
+    ou.RNG()  # numbers drawn before: OMPL logs an error at a later setSeed
+    seed_ompl(17)
+    first = draws()
+    seed_ompl(17)
+    assert draws() == first
+    seed_ompl(18)
+    assert draws() != first
+    assert "already started" not in capfd.readouterr().err

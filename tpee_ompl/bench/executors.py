@@ -1,10 +1,11 @@
 """Where the tasks of a benchmark campaign run: this process, a local process pool, or Dask.
 
 A campaign is a list of plain-data tasks (one per query, see :func:`tpee_ompl.bench.experiment.run_query_task`), each run
-in a **fresh process** so that ``ompl.util.RNG.setSeed`` (which works once per process) gives every
-task the same seed whichever machine runs it.  The executors differ only in who starts that process:
+in a **fresh process** (a worker that dies or hangs takes nothing else with it; OMPL's seed generator is set before
+each planner is made, so a task draws the same numbers whichever process or machine runs it).  The executors differ
+only in who starts that process:
 
-* :class:`InProcessExecutor`: this process, one task after the other (tests; OMPL seeded once).
+* :class:`InProcessExecutor`: this process, one task after the other (tests).
 * :class:`ProcessPoolExecutor` (default): one fresh spawned process per task, ``workers`` at a time;
   a task whose process dies (SIGKILL, segfault, OOM killer) or outlives its time limit is run
   once more in a fresh process, then yielded as a failure (:func:`task_failure`): nothing hangs.

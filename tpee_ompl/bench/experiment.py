@@ -39,6 +39,7 @@ from .._version import __version__
 from ..files import write_new_file
 from ..planning.paths import path_length, path_passes_motion_checks
 from ..planning.space_layout import RealVectorLayout
+from ..planning.setup import seed_ompl
 from ..validation import sub_seed
 from .database import NO_PATH_COLUMNS, failed_run_properties, log_text, pad_aborted_runs, patch_recorded_data
 from .ladder import DeriveContext
@@ -73,28 +74,12 @@ def group_lengths(waypoints: np.ndarray, first: Sequence[int] = (0, 1),
 
 
 # --------------------------------------------------------------------------- seeds, experiment list
-_SEEDED: list[int] = []
-
-
-def _seed_process(seed: int) -> None:
-    if not _SEEDED:  # a second setSeed in one process only prints an error
-        ou.RNG.setSeed(int(seed))
-        _SEEDED.append(int(seed))
-    elif _SEEDED[0] != int(seed):
-        log.warning("OMPL was seeded with %d in this process, not %d: runs are not reproducible", _SEEDED[0], seed)
-
-
 def _seed_planner(seed: int) -> None:
-    """Reseed OMPL's seed generator just before a planner is made, so that an OMPL planner's random numbers depend
+    """Set OMPL's seed generator just before a planner is made, so that an OMPL planner's random numbers depend
     on its own seed (campaign seed, query, position, cap or budget) and not on how many planners the process made
     before it: a task retried after its worker died, or a resumed campaign, runs only the experiments not yet
     logged, and they must give the rows an uninterrupted run gives."""
-    level = ou.getLogLevel()
-    ou.setLogLevel(ou.LOG_NONE)  # a later setSeed in a process logs an error, and reseeds all the same
-    try:
-        ou.RNG.setSeed(int(seed) or 1)
-    finally:
-        ou.setLogLevel(level)
+    seed_ompl(int(seed) or 1)  # (sub_seed can give 0, which OMPL refuses)
 
 
 def experiment_specs(cfg: dict, qpos: int) -> list[dict]:
@@ -140,7 +125,7 @@ def run_query_task(task: dict) -> dict:
     """
     t0 = time.perf_counter()
     cfg, query, qpos = task["config"], task["query"], int(task["qpos"])
-    _seed_process(task["seed"])
+    seed_ompl(task["seed"])  # (each planner is seeded again before it is made)
     ou.setLogLevel(ou.LOG_WARN)
     log_dir = Path(task["log_dir"]) if task.get("log_dir") else None
     specs = task.get("specs") or experiment_specs(cfg, qpos)

@@ -150,11 +150,11 @@ def plan_motion(args: argparse.Namespace) -> tuple[dict, WearerArm]:
     from ompl import util as ou
 
     from ..planning.paths import path_passes_motion_checks, path_to_array
-    from ..planning.setup import make_simple_setup
+    from ..planning.setup import make_simple_setup, seed_ompl
 
     check_plan_args(args)
     ou.setLogLevel(ou.LOG_WARN)
-    ou.RNG.setSeed(args.seed)
+    seed_ompl(args.seed)
     robot = load_robot(args)
     args.planner = _default_planner(args, robot)
     start, goal, qid = _start_and_goal(args, robot)

@@ -26,7 +26,7 @@ from ..model.pointing import AimingError, BlindAreaError, PointingGeometry, aim_
 from ..model.sectors import SECTORS, check_sector, in_pointing_sector, infer_sector, posture_preset, posture_sector
 from ..model.wearer_arm import WearerArm
 from ..planning.paths import MIN_JOINT_STEP, motion_is_valid, motion_states, motion_step, planned_waypoints
-from ..validation import MAX_SECONDS, as_float_array, check_number, check_seed
+from ..validation import MAX_SECONDS, as_float_array, check_number
 from .path_library import CHECK_STEP, PathLibrary
 
 __all__ = [
@@ -306,23 +306,6 @@ class Tracker:
         )
 
 
-_OMPL_SEED: list[int] = []
-"""The seed OMPL's random generator was given here: it takes one per process (later ones change nothing but make OMPL
-print an error)."""
-
-
-def _seed_ompl(seed: int) -> None:
-    """Seed OMPL's global random generator, once per process (:data:`_OMPL_SEED`); a later, other seed is logged."""
-    from ompl import util as ou
-
-    if not _OMPL_SEED:
-        ou.RNG.setSeed(seed)
-        _OMPL_SEED.append(seed)
-    elif seed != _OMPL_SEED[0]:
-        log.warning("OMPL's random generator takes one seed per process (%d here): seed %d changes nothing",
-                    _OMPL_SEED[0], seed)
-
-
 def make_default_planner(
     robot: WearerArm,
     *,
@@ -342,7 +325,7 @@ def make_default_planner(
     at most ``timeout`` seconds, simplified.  Every path is checked at the tracker's default step
     (:data:`~tpee_ompl.library.path_library.CHECK_STEP`, or the robot's motion step if smaller); raises
     RuntimeError if none is found.  OMPL's log level is left as the caller set it (its "Info:" lines are off
-    while a motion is planned), and OMPL's generator is seeded once per process.  ``seed`` fixes the samples,
+    while a motion is planned), and OMPL's seed generator is set to ``seed`` here (:func:`seed_ompl`).  ``seed`` fixes the samples,
     not the time: the library step stops after ``library_time`` seconds of wall-clock time, so how far it
     refined a path, and so the tracker's trajectory, can differ between runs (``library=None``, or a planner
     capped by samples, repeats exactly).
@@ -351,13 +334,13 @@ def make_default_planner(
 
     from ..model.queries import straight_motion
     from ..planning.paths import path_to_array
-    from ..planning.setup import make_simple_setup, quieter_ompl
+    from ..planning.setup import make_simple_setup, quieter_ompl, seed_ompl
     from .planner import LibraryDimensionRRT
 
     timeout = check_number("timeout (seconds)", timeout, low=0.0, low_open=True, high=MAX_SECONDS)
     library_time = check_number("library_time (seconds)", library_time, low=0.0, low_open=True, high=MAX_SECONDS)
     if seed is not None:
-        _seed_ompl(check_seed("seed", seed))
+        seed_ompl(seed)
     step = motion_step(robot, CHECK_STEP)
     lib: PathLibrary | None = None
     if isinstance(library, PathLibrary):

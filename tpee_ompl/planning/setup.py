@@ -32,7 +32,7 @@ from ompl import util as ou
 
 from ..model.clearance_balls import SCREEN_COST_LIMIT, SCREEN_LEVELS, screened_all_valid, screened_lines_valid
 from ..model.robot_checker import RobotChecker
-from ..validation import MOTION_VALIDATORS, check_bool, check_number
+from ..validation import MOTION_VALIDATORS, check_bool, check_number, check_seed
 from .paths import (MIN_JOINT_STEP, batched_motion_states, bisection_order, counted_motion_states, state_to_array,
                     unchecked_motion_states)
 from .space_layout import RealVectorLayout
@@ -49,6 +49,7 @@ __all__ = [
     "motion_check_step",
     "motion_counts",
     "quieter_ompl",
+    "seed_ompl",
     "valid_motion_fraction",
     "MOTION_VALIDATORS",
 ]
@@ -66,6 +67,17 @@ def quieter_ompl(level: ou.LogLevel = ou.LOG_WARN) -> Iterator[None]:
         yield
     finally:
         ou.setLogLevel(before)
+
+
+def seed_ompl(seed: int) -> None:
+    """Set OMPL's seed generator to ``seed``: the planners and samplers made after it draw reproducible numbers.
+
+    Once random numbers were drawn in a process, OMPL logs an error ("Random number generation already started")
+    and reseeds all the same (``RandomNumbers.cpp``), so a later seed does take effect; the error is silenced.
+    ValueError for a seed OMPL cannot take (:func:`~tpee_ompl.validation.check_seed`: 0 makes it run unseeded)."""
+    seed = check_seed("seed", seed)
+    with quieter_ompl(ou.LOG_NONE):
+        ou.RNG.setSeed(seed)
 
 
 
