@@ -56,6 +56,14 @@ def test_missing_dask_gives_a_clear_error(monkeypatch, capsys, tmp_path):
     assert not list(tmp_path.iterdir())  # nothing started
 
 
+def test_a_malformed_dask_address_is_a_usage_error_naming_dask(capsys, tmp_path):
+    pytest.importorskip("distributed")
+    code = main(["--dask", "foo", "--samples", "10", "--anytime", "--out", str(tmp_path), "--no-progress"])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and "error: --dask 'foo': missing port" in err and "tcp://host:port" in err
+    assert not list(tmp_path.iterdir())
+
+
 def test_resume_of_a_folder_without_campaign_is_a_clear_error(capsys, tmp_path):
     assert main(["--resume", str(tmp_path), "--workers", "1", "--no-progress"]) == 2
     assert "campaign.json" in capsys.readouterr().err

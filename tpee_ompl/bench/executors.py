@@ -401,7 +401,11 @@ class DaskExecutor:
             self.client = distributed.Client(self._cluster)
             self.description = f"Dask LocalCluster ({n_workers} workers)"
         else:
-            self.client = distributed.Client(scheduler)
+            try:
+                self.client = distributed.Client(scheduler)
+            except ValueError as exc:  # a malformed address ("missing port number in address 'foo'")
+                raise ValueError(f"scheduler {scheduler!r}: {exc} (give local, or tcp://host:port of a running Dask "
+                                 "scheduler)") from None
             self.description = f"Dask scheduler {scheduler}"
         self._futures: list = []
 

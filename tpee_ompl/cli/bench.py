@@ -59,7 +59,8 @@ _OPTION_OF = {"sample_caps": "--samples", "anytime_budgets": "--anytime", "itera
               "alt_checker_caps": "--alt-checker-samples", "anytime_queries": "--anytime-queries",
               "max_queries": "--max-queries", "max_time": "--max-time", "queries": "--queries", "name": "--name",
               "problem": "--problem", "checkers": "--checkers",
-              "runs": "--runs", "workers": "--workers", "seed": "--seed", "out": "--out", "resume": "--resume"}
+              "runs": "--runs", "workers": "--workers", "seed": "--seed", "out": "--out", "resume": "--resume",
+              "scheduler": "--dask"}
 """:class:`CampaignConfig` field -> option, to name the option in a refusal."""
 
 
