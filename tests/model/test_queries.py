@@ -96,3 +96,14 @@ def test_query_from_dict_takes_only_json_numbers(value):
     d["start"] = value
     with pytest.raises(QuerySetError, match="'start'"):
         Query.from_dict(d)
+
+
+def test_another_robots_joint_query_set_is_named_as_such_not_as_an_unknown_format(robot):
+    """It said "unsupported format_version None"."""
+    with pytest.raises(QuerySetError, match=r"a joint-space query set for robot 'kinova_posts', not the wearer's"):
+        load_queries("kinova_posts", robot)
+
+
+def test_a_query_set_given_as_a_folder_says_so(robot, tmp_path):
+    with pytest.raises(IsADirectoryError, match="is a folder, not a query file"):
+        load_queries(tmp_path, robot)

@@ -226,6 +226,11 @@ def load_query_set(name_or_path: str | os.PathLike, robot: WearerArm | None = No
     if not isinstance(doc, dict):
         raise QuerySetError(f"{p}: expected a JSON object at the top level, got {type(doc).__name__}")
     version = doc.get("format_version")
+    if str(doc.get("format", "")).startswith("joint_queries/"):  # another robot's set (tpee_ompl.model.joint_queries)
+        robot = doc.get("robot")
+        raise QuerySetError(f"{p}: a joint-space query set for {'robot ' + repr(robot) if robot else 'another robot'}, "
+                            "not the wearer's sector queries (its campaigns: tpee-ompl bench --problem NAME, "
+                            "--list-problems)")
     if isinstance(version, bool) or version != FORMAT_VERSION:
         raise QuerySetError(f"{p}: unsupported format_version {version!r} (expected {FORMAT_VERSION})")
     queries = query_entries(p, doc, Query.from_dict)
