@@ -158,3 +158,23 @@ def test_a_python_planners_settings_are_one_line_each_in_the_log():
             return {"note": "line one\nline two", "multi  word\tkey": 3}
 
     assert planner_settings(P()) == {"note": "line one line two", "multi word key": "3"}
+
+
+@pytest.mark.parametrize("name", ["os:system", "math:hypot", "json:dumps"])
+def test_a_callable_that_cannot_take_si_and_ctx_is_refused_when_named(name):
+    """`--planners os:system` ran every query of a campaign, each failing with the same TypeError."""
+    from tpee_ompl.bench.planners import planner_factory
+
+    if name == "math:hypot":  # takes any number of arguments: only its result can tell, when it is called
+        assert planner_factory(name) is __import__("math").hypot
+        return
+    with pytest.raises(ValueError, match=r"cannot be called as factory\(si, ctx\)"):
+        planner_factory(name)
+
+
+def test_a_factory_with_two_parameters_is_taken():
+    from helpers.bench_standins import make_standin
+
+    from tpee_ompl.bench.planners import planner_factory
+
+    assert planner_factory("helpers.bench_standins:make_standin") is make_standin

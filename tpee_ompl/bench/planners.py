@@ -17,6 +17,7 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import importlib
+import inspect
 import logging
 import math
 import time
@@ -153,6 +154,13 @@ def planner_factory(name: str) -> PlannerFactory:
             raise ValueError(f"planner {name!r}: cannot import {attr} from {mod} ({exc})") from None
         if not callable(fn):
             raise ValueError(f"planner {name!r}: {attr} is not a factory function")
+        try:  # checked here, before any work: a wrong callable failed every query of a campaign, one by one
+            inspect.signature(fn).bind(None, None)
+        except TypeError:
+            raise ValueError(f"planner {name!r}: {attr} cannot be called as factory(si, ctx) (a planner factory takes "
+                             "the SpaceInformation and a PlannerContext and returns an ob.Planner)") from None
+        except ValueError:  # no signature to read (some builtins): what it returns is checked when it is called
+            pass
         return fn
     raise ValueError(f"unknown planner {name!r}: choose from {sorted(PLANNER_FACTORIES)} or give module:function")
 
