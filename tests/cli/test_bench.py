@@ -64,6 +64,25 @@ def test_a_malformed_dask_address_is_a_usage_error_naming_dask(capsys, tmp_path)
     assert not list(tmp_path.iterdir())
 
 
+def test_more_workers_than_cores_are_warned_about(caplog, monkeypatch, tmp_path):
+    """Timed runs sharing cores are slower than alone: `--workers 100000` was accepted without a word."""
+    import tpee_ompl.bench.executors as executors
+    import tpee_ompl.cli.bench as cli_bench
+
+    def stop(*a, **k):
+        raise ValueError("stopped before any work (test)")
+
+    monkeypatch.setattr(cli_bench.os, "cpu_count", lambda: 2)
+    monkeypatch.setattr(executors, "make_executor", stop)
+    with caplog.at_level("WARNING"):
+        assert main(["--workers", "3", "--samples", "10", "--anytime", "--out", str(tmp_path), "--no-progress"]) == 2
+    assert "--workers 3 on a machine with 2 cores" in caplog.text
+    caplog.clear()
+    with caplog.at_level("WARNING"):
+        main(["--workers", "2", "--samples", "10", "--anytime", "--out", str(tmp_path), "--no-progress"])
+    assert "cores" not in caplog.text
+
+
 def test_resume_of_a_folder_without_campaign_is_a_clear_error(capsys, tmp_path):
     assert main(["--resume", str(tmp_path), "--workers", "1", "--no-progress"]) == 2
     assert "campaign.json" in capsys.readouterr().err
