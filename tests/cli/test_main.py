@@ -170,39 +170,21 @@ def test_output_into_a_closed_pipe_ends_quietly_with_sigpipes_code():
     assert proc.returncode == 141 and proc.stderr == ""
 
 
-def test_ctrl_c_while_the_command_line_loads_ends_it_with_130_and_one_line():
-    """Ctrl-C in the first 0.3 s (OMPL, Pinocchio and Coal loading) used to print the import's traceback; the
-    interrupt is simulated at the import of pinocchio, which the command line's modules load."""
-    import subprocess
-    import sys
-
-    code = ("import builtins, sys\n"
-            "real = builtins.__import__\n"
-            "def interrupted(name, *a, **k):\n"
-            "    if name == 'pinocchio':\n"
-            "        raise KeyboardInterrupt\n"
-            "    return real(name, *a, **k)\n"
-            "builtins.__import__ = interrupted\n"
-            "from tpee_ompl._launch import main\n"
-            "sys.exit(main())\n")
-    proc = subprocess.run([sys.executable, "-c", code, "plan", "--from", "1", "--to", "4"], capture_output=True,
-                          text=True, timeout=120)
-    assert proc.returncode == 130 and proc.stderr == "tpee-ompl: interrupted\n" and proc.stdout == ""
-
-
-def test_sigterm_while_the_command_line_loads_ends_it_with_130_and_one_line():
-    """SIGTERM in the first 0.4 s ended the process without a word (exit 143): the command's own handler was not
-    on yet.  The signal is sent at the import of pinocchio, which the command line's modules load."""
+@pytest.mark.parametrize("signal_at_import", ["raise KeyboardInterrupt", "os.kill(os.getpid(), signal.SIGTERM)"])
+def test_an_interrupt_while_the_command_line_loads_ends_it_with_130_and_one_line(signal_at_import):
+    """Ctrl-C in the first 0.3 s (OMPL, Pinocchio and Coal loading) used to print the import's traceback, and SIGTERM
+    ended the process without a word (exit 143: the command's own handler was not on yet).  Both are simulated at
+    the import of pinocchio, which the command line's modules load."""
     import subprocess
     import sys
 
     code = ("import builtins, os, signal, sys\n"
             "real = builtins.__import__\n"
-            "def killed(name, *a, **k):\n"
+            "def interrupted(name, *a, **k):\n"
             "    if name == 'pinocchio':\n"
-            "        os.kill(os.getpid(), signal.SIGTERM)\n"
+            f"        {signal_at_import}\n"
             "    return real(name, *a, **k)\n"
-            "builtins.__import__ = killed\n"
+            "builtins.__import__ = interrupted\n"
             "from tpee_ompl._launch import main\n"
             "sys.exit(main())\n")
     proc = subprocess.run([sys.executable, "-c", code, "plan", "--from", "1", "--to", "4"], capture_output=True,

@@ -61,3 +61,15 @@ class LengthTimes100(ob.OptimizationObjective):
     def motionCost(self, a: ob.State, b: ob.State) -> ob.Cost:
         return ob.Cost(100.0 * self._si.distance(a, b))
 
+
+def locked_dimension_space(n: int, locked: int, value: float = 0.5, bound: float = 1.0) -> ob.RealVectorStateSpace:
+    """A RealVector(n) space over [-bound, bound] whose dimension ``locked`` has bounds of width 0 (at ``value``),
+    as OMPL users lock a joint."""
+    space = ob.RealVectorStateSpace(n)
+    bounds = ob.RealVectorBounds(n)
+    bounds.setLow(-bound)
+    bounds.setHigh(bound)
+    bounds.setLow(locked, value)
+    bounds.setHigh(locked, value)
+    space.setBounds(bounds)
+    return space

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from helpers.library_standins import sampler
-from helpers.planning_spaces import LengthTimes100
+from helpers.planning_spaces import LengthTimes100, locked_dimension_space
 from ompl import base as ob
 from ompl import geometric as og
 
@@ -156,15 +156,8 @@ def test_settings_the_refining_planner_would_refuse_are_refused_when_the_pipelin
 
 
 def test_a_joint_space_with_a_dimension_of_width_zero_is_refused_when_the_pipeline_is_made(library):
-    space = ob.RealVectorStateSpace(4)
-    bounds = ob.RealVectorBounds(4)
-    bounds.setLow(-3.0)
-    bounds.setHigh(3.0)
-    bounds.setLow(2, 0.5)
-    bounds.setHigh(2, 0.5)
-    space.setBounds(bounds)
     with pytest.raises(ValueError, match="width 0"):
-        LibraryDimensionRRT(ob.SpaceInformation(space), library)
+        LibraryDimensionRRT(ob.SpaceInformation(locked_dimension_space(4, 2, bound=3.0)), library)
 
 
 def test_several_goal_states_are_planned_by_dimension_rrt_on_the_row_without_the_library(robot, library, caplog):

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from helpers.planning_spaces import locked_dimension_space
 from ompl import base as ob
 
 from tpee_ompl.planning.space_layout import RealVectorLayout
@@ -79,15 +80,8 @@ def test_a_space_whose_bounds_were_never_set_is_told_to_set_them() -> None:
 
 def test_a_dimension_locked_by_bounds_of_width_zero_is_refused_saying_so() -> None:
     """OMPL users lock a joint with low == high; the error said "no valid bounds: call space.setBounds" (they were set)."""
-    space = ob.RealVectorStateSpace(3)
-    bounds = ob.RealVectorBounds(3)
-    bounds.setLow(-1.0)
-    bounds.setHigh(1.0)
-    bounds.setLow(1, 0.5)
-    bounds.setHigh(1, 0.5)
-    space.setBounds(bounds)
     with pytest.raises(ValueError, match=r"bounds of width 0 for dimension\(s\) \[1\].*locked"):
-        RealVectorLayout(space)
+        RealVectorLayout(locked_dimension_space(3, 1))
 
 
 def test_so2_leaves_wrap_around_like_the_space() -> None:
