@@ -79,6 +79,7 @@ def test_installed_cli_plans_and_reads_the_packaged_library(installed):
     stats = _run([cli, "library", "stats"], cwd=work)
     assert "240 demonstrations" in stats.stdout
     assert str(py.parent.parent.resolve()) in stats.stdout.splitlines()[0]
+    assert _run([str(py), "-m", "tpee_ompl", "--version"], cwd=work).stdout.startswith("tpee-ompl ")
 
 
 def test_installed_wheel_lists_the_problems_and_benchmarks_a_generic_one(installed):
