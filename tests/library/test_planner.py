@@ -351,3 +351,16 @@ def test_a_space_whose_bounds_the_library_path_and_table3_row_leave_gets_a_path_
     W = path_to_array(ss.getSolutionPath(), 4)
     assert np.all(W >= lo - 1e-12) and np.all(W <= hi + 1e-12)
     assert path_passes_motion_checks(si, ss.getSolutionPath(), in_bounds=True)
+
+
+def test_of_several_start_states_the_pipeline_says_once_which_it_plans_from(robot, library, caplog):
+    q = _stored("planning_necessary", 1, 2)  # its direct motion collides, so the pipeline's dimension-RRT runs
+    ss = make_simple_setup(robot, q.start, q.goal)
+    si = ss.getSpaceInformation()
+    ss.addStartState(set_state(si.allocState(), q.start))  # a second start: the pipeline and its dimension-RRT read both
+    planner = LibraryDimensionRRT(si, library, max_samples=100, seed=0)
+    ss.setPlanner(planner)
+    with caplog.at_level("WARNING"):
+        assert ss.solve(5.0) == ob.PlannerStatus.EXACT_SOLUTION
+    assert planner.last_run_stats()["samples"] > 0
+    assert caplog.text.count("the first valid of the 2 given") == 1

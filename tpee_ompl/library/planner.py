@@ -155,7 +155,7 @@ class LibraryDimensionRRT(PythonPlanner):
             log.info("LibraryDimensionRRT: the goal is a %s, not one state: planned by dimension-RRT without the "
                      "library", type(goal).__name__)
             self._stats["library_outcome"] = "planned"
-            return self._refine(ptc, t0, self.pair, None, False)
+            return self._refine(ptc, t0, self.pair, None, False, read_ends=False)
         ends = self._endpoints()
         if isinstance(ends, ob.PlannerStatus):
             return ends
@@ -227,9 +227,10 @@ class LibraryDimensionRRT(PythonPlanner):
         return self._refine(ptc, t0, (i, j) if cross else None, seed, have_exact)
 
     def _refine(self, ptc: ob.PlannerTerminationCondition, t0: float, pair: tuple[int, int] | None,
-                seed: np.ndarray | None, have_exact: bool) -> ob.PlannerStatus:
+                seed: np.ndarray | None, have_exact: bool, read_ends: bool = True) -> ob.PlannerStatus:
         """Dimension-RRT on the same problem definition until ``ptc`` (on the pair's Table 3 row, from the DMP
-        ``seed`` when given), its progress merged into this run's statistics."""
+        ``seed`` when given), its progress merged into this run's statistics; ``read_ends``: this planner read the
+        start already (and said which of several it takes)."""
         si, pdef = self.getSpaceInformation(), self.getProblemDefinition()
         stats, progress = self._stats, self._stats["progress"]
         opts = dataclasses.replace(self.options, seed=self._run_seed())
@@ -241,6 +242,7 @@ class LibraryDimensionRRT(PythonPlanner):
             except ValueError as e:  # e.g. a space whose bounds the Table 3 row leaves
                 log.warning("LibraryDimensionRRT: planned over every DOF, without Table 3's row: %s", e)
         inner = DimensionRRT(si, opts) if inner is None else inner
+        inner._say_start_choice = not read_ends  # noqa: SLF001 (the pipeline said which start it took)
         inner.setProblemDefinition(pdef)
         self._inner = inner
         t_inner = time.perf_counter() - t0

@@ -55,6 +55,7 @@ class PythonPlanner(ob.Planner):
     def __init__(self, si: ob.SpaceInformation, name: str) -> None:
         super().__init__(si, name)
         self._stats: dict[str, Any] = self._empty_stats()
+        self._say_start_choice = True  # off for a planner run inside another that said it already
 
     @staticmethod
     def _empty_stats() -> dict[str, Any]:
@@ -105,7 +106,7 @@ class PythonPlanner(ob.Planner):
         if start is None:  # nextStart() skips start states out of bounds or invalid (OMPL checks them itself)
             return planner_status(ob.PlannerStatus.INVALID_START)
         count = self.getProblemDefinition().getStartStateCount()
-        if count > 1:  # RRTConnect grows a tree from each; these planners search from one start
+        if count > 1 and self._say_start_choice:  # RRTConnect grows a tree from each; these search from one start
             log.warning("%s plans from one start state: the first valid of the %d given", self.getName(), count)
         if not finite_state(self.getSpaceInformation(), start):  # OMPL's bounds check lets NaN through
             log.error("%s: the start state has NaN or inf values", self.getName())
