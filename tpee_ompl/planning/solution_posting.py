@@ -14,12 +14,22 @@ from ompl import geometric as og
 from .paths import path_passes_motion_checks
 from .planner_base import problem_objective
 
-__all__ = ["SolutionPoster"]
+__all__ = ["SolutionPoster", "without_repeats"]
 
 log = logging.getLogger("tpee_ompl.planning.dimension_rrt")
 
 _POST_SHARE = 0.1
 """After the first, improvements are posted as found while posting costs at most this share of the run time."""
+
+
+def without_repeats(W: np.ndarray) -> np.ndarray:
+    """The waypoints W without one equal to the waypoint before it (start == goal, or waypoints the released search
+    collapsed): OMPL's planners post no zero-length segment, and time parametrisations downstream divide by the
+    segment's length.  The first and the last are always kept."""
+    keep = np.r_[True, np.any(W[1:] != W[:-1], axis=1)]
+    if keep.all():
+        return W
+    return W[keep] if keep.sum() >= 2 else W[[0, -1]]
 
 
 class SolutionPoster:
@@ -69,6 +79,7 @@ class SolutionPoster:
             return
         t = time.perf_counter()
         W, cost = self._pending
+        W = without_repeats(W)
         self._pending = None
         planner = self.planner
         path = self.to_path(self.si, W)
