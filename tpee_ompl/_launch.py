@@ -1,10 +1,12 @@
 """The ``tpee-ompl`` console script (and ``python -m tpee_ompl``).
 
-The command line's modules load OMPL, Pinocchio and Coal (about 0.3 s).  They are imported here, inside the
-script's function, so that Ctrl-C in that time ends the command as it does later (exit 130 and one line, see
-:mod:`tpee_ompl.cli.main`) instead of with a traceback of the interrupted import; SIGTERM does the same from
-the first moment (the command's own handler, :func:`tpee_ompl.signals.sigterm_as_keyboard_interrupt`, takes
-over once its work starts).
+The command line's modules load OMPL, Pinocchio and Coal (about 0.3 s).  A KeyboardInterrupt raised while a
+compiled module initialises aborts the process (nanobind: ``terminate called after throwing an instance of
+'nanobind::python_error'``), and one raised in a finaliser there is dropped.  So SIGINT and SIGTERM are held
+(blocked) while those modules load and delivered when the imports end: the command then ends as it does later
+(exit 130 and one line, see :mod:`tpee_ompl.cli.main`).  SIGTERM is handled as Ctrl-C from the first moment
+(the command's own handler, :func:`tpee_ompl.signals.sigterm_as_keyboard_interrupt`, takes over once its work
+starts).
 """
 
 from __future__ import annotations
@@ -20,9 +22,15 @@ def _interrupt(signum: int, frame: object) -> None:
 def main() -> int:
     """Run ``tpee-ompl`` with the process's arguments; returns the exit code."""
     signal.signal(signal.SIGTERM, _interrupt)  # it used to end the process without a word while the modules loaded
+    held = {signal.SIGINT, signal.SIGTERM}
+    block = hasattr(signal, "pthread_sigmask")
     try:
-        from .cli.main import main as run
-
+        previous = signal.pthread_sigmask(signal.SIG_BLOCK, held) if block else None
+        try:
+            from .cli.main import main as run
+        finally:
+            if block:
+                signal.pthread_sigmask(signal.SIG_SETMASK, previous)  # a held signal is delivered here, in Python
         return run()
     except KeyboardInterrupt:  # during the imports or the argument parsing: the command's handler is not on yet
         print("tpee-ompl: interrupted", file=sys.stderr)
