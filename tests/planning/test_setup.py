@@ -83,6 +83,37 @@ def test_batched_and_discrete_motion_validators_agree(robot, rng, batched):
         assert sb.checkMotion(a, b) == sd.checkMotion(a, b)
 
 
+@pytest.mark.parametrize("screened", [True, False])
+def test_a_motion_that_ends_exactly_at_a_joint_limit_is_judged_by_its_end_state_as_ompl_does(robot, rng, screened):
+    """The last state checked was a + 1.0 * (b - a), which can be an ulp past the limit b sits on: such valid motions
+    were refused where OMPL's DiscreteMotionValidator accepts them (a helper's probe on the Panda: 173 of 300)."""
+    from tpee_ompl.planning.paths import batched_motion_states
+
+    ss_b = make_simple_setup(robot, batched_motion_validator=True)
+    ss_d = make_simple_setup(robot, batched_motion_validator=False)
+    sb, sd = ss_b.getSpaceInformation(), ss_d.getSpaceInformation()
+    mv = sb.getMotionValidator()
+    mv.screen_levels = mv.screen_levels if screened else ()
+    found = 0
+    for _ in range(20000):
+        k = int(rng.integers(4))
+        q0 = rng.uniform(robot.lower, robot.upper)
+        q1 = q0 + rng.normal(scale=0.05, size=4)
+        q1[k] = robot.upper[k]
+        if not (robot.within_limits(q1) and (q0 + 1.0 * (q1 - q0))[k] > robot.upper[k]):
+            continue  # only the ends the old arithmetic pushed past the limit
+        if not (robot.is_valid(q0) and robot.is_valid(q1)):
+            continue
+        a, b = set_state(sb.allocState(), q0), set_state(sb.allocState(), q1)
+        assert motion_states(q0, q1, 0.01)[-1].tolist() == q1.tolist()
+        assert batched_motion_states(q0[None], q1[None], 0.01)[0][-1].tolist() == q1.tolist()
+        assert sb.checkMotion(a, b) == sd.checkMotion(a, b)
+        found += 1
+        if found == 20:
+            break
+    assert found == 20
+
+
 def test_rrtstar_between_two_presets_returns_an_exact_path_whose_every_segment_passes_check_motion(robot):
     ou.RNG.setSeed(7) if ou.RNG.getSeed() == 0 else None
     ss = make_simple_setup(robot, preset(1), preset(4))

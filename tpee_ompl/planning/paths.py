@@ -216,7 +216,9 @@ def unchecked_motion_states(a: np.ndarray, b: np.ndarray, step: float, include_s
     ``validSegmentCountFactor`` f, so ``f * ceil(|b - a| / step)`` segments, as OMPL counts them."""
     d = b - a
     n = factor * max(1, math.ceil(math.sqrt(float(d @ d)) / step))
-    return a + (np.arange(0 if include_start else 1, n + 1) / n)[:, None] * d
+    S = a + (np.arange(0 if include_start else 1, n + 1) / n)[:, None] * d
+    S[-1] = b  # b itself, as OMPL checks s2 (a + 1.0 * (b - a) can be an ulp past a joint limit b sits on)
+    return S
 
 
 def batched_motion_states(A: np.ndarray, B: np.ndarray, step: float, factor: int = 1) -> tuple[np.ndarray, np.ndarray]:
@@ -238,13 +240,16 @@ def batched_motion_states(A: np.ndarray, B: np.ndarray, step: float, factor: int
     D = B - A
     # the segment counts as motion_states computes them (one dot product per motion: the same rounding)
     n = np.array([factor * max(1, math.ceil(math.sqrt(float(d @ d)) / step)) for d in D], dtype=np.int64)
-    return counted_motion_states(A, D, n), n
+    S = counted_motion_states(A, D, n)
+    S[np.cumsum(n) - 1] = B  # each motion's end is B[k] itself (see unchecked_motion_states)
+    return S, n
 
 
 def counted_motion_states(A: np.ndarray, D: np.ndarray, counts: np.ndarray) -> np.ndarray:
     """The states ``A[k] + (j / counts[k]) D[k]``, j = 1 .. counts[k], of every motion k in motion order (its
-    start excluded, its end ``A[k] + D[k]`` included): :func:`batched_motion_states` once the counts are known.
-    Not validated (inner loops)."""
+    start excluded, its end ``A[k] + D[k]`` included; callers that have the end B[k] put it in that row, as OMPL
+    checks the end state itself): :func:`batched_motion_states` once the counts are known.  Not validated (inner
+    loops)."""
     idx = np.repeat(np.arange(len(A)), counts)
     j = np.arange(int(counts.sum())) - np.repeat(np.cumsum(counts) - counts, counts) + 1
     return A[idx] + (j / counts[idx])[:, None] * D[idx]

@@ -231,6 +231,7 @@ class BatchedMotionValidator(ob.MotionValidator):
         D = lay.delta(A, B)
         counts = self.segment_counts(A, B)
         S = lay.wrap(counted_motion_states(A, D, counts))
+        S[np.cumsum(counts) - 1] = B  # each end is the state itself, as OMPL checks s2
         self.motions_checked += len(counts)
         if self.screen_levels:  # the states are evenly spaced along each motion's joint-space line (unwrapped)
             spacing = np.linalg.norm(D, axis=1) / counts
