@@ -333,9 +333,13 @@ _J2 = '<parent link="base"/><child link="b"/><origin xyz="0 0 -0.5"/><axis xyz="
 def test_joints_it_cannot_plan_are_refused_with_what_to_do_and_locking_them_works(tmp_path):
     limits = '<limit lower="-1" upper="1" effort="1" velocity="1"/>'
     mimic = _two_joint_urdf(tmp_path / "mimic.urdf", f'type="revolute">{_J2}{limits}<mimic joint="j1" multiplier="-1"/>')
-    with pytest.raises(ValueError, match="joint 'j2' mimics 'j1'.*lock it"):  # it used to be planned on its own
-        RobotChecker(mimic)
-    assert RobotChecker(mimic, locked={"j2": 0.0}).nq == 1
+    with pytest.raises(ValueError, match="joint 'j2' mimics 'j1'.*lock 'j1' and the joints that mimic it"):
+        RobotChecker(mimic)  # it used to be planned on its own
+    # the mimic locked alone (the advice this error used to give) leaves its master planned: the two would part
+    with pytest.raises(ValueError, match="joint 'j1' is planned while 'j2', which mimics it, is locked"):
+        RobotChecker(mimic, locked={"j2": 0.0})
+    with pytest.raises(ValueError, match="no joint left to plan"):  # both locked: the mimics pass (nothing else here)
+        RobotChecker(mimic, locked={"j1": 0.5, "j2": -0.5})
     continuous = _two_joint_urdf(tmp_path / "continuous.urdf", f'type="continuous">{_J2}')
     assert RobotChecker(continuous, locked={"j2": 7.0}).nq == 1  # a locked continuous joint takes any angle
     floating = _two_joint_urdf(tmp_path / "floating.urdf", 'type="floating"><parent link="base"/><child link="b"/>')

@@ -380,11 +380,21 @@ def _check_mimics(root: ET.Element, model: pin.Model, urdf: Path) -> None:
     """No planned joint is a URDF mimic joint: Pinocchio's parser loads one as an independent joint, so the
     planner would give it values the robot cannot take."""
     planned = set(model.names[1:])
+    followers: dict[str, list[str]] = {}
     for joint in root.iter("joint"):
         mimic = joint.find("mimic")
-        if mimic is not None and joint.get("name") in planned:
-            raise ValueError(f"URDF {urdf}: joint {joint.get('name')!r} mimics {mimic.get('joint')!r}, which would be "
-                             f"planned as an independent joint: lock it (locked={{{joint.get('name')!r}: value}})")
+        if mimic is not None:
+            followers.setdefault(str(mimic.get("joint")), []).append(str(joint.get("name")))
+    for master, names in followers.items():
+        free = [n for n in names if n in planned]
+        locks = ", ".join(f"{n!r}: value" for n in [master, *names])
+        advice = f"lock {master!r} and the joints that mimic it (locked={{{locks}}}, each mimic at multiplier x value + offset)"
+        if free:
+            raise ValueError(f"URDF {urdf}: joint {free[0]!r} mimics {master!r}, which would be planned as an "
+                             f"independent joint: {advice}")
+        if master in planned:  # its mimics locked, it free: the two would part (a gripper's two fingers)
+            raise ValueError(f"URDF {urdf}: joint {master!r} is planned while {names[0]!r}, which mimics it, is locked: "
+                             f"{advice}")
 
 
 def is_continuous(joint: pin.JointModel) -> bool:
