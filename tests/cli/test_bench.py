@@ -76,7 +76,7 @@ def test_more_workers_than_cores_are_warned_about(caplog, monkeypatch, tmp_path)
     monkeypatch.setattr(executors, "make_executor", stop)
     with caplog.at_level("WARNING"):
         assert main(["--workers", "3", "--samples", "10", "--anytime", "--out", str(tmp_path), "--no-progress"]) == 2
-    assert "--workers 3 on a machine with 2 cores" in caplog.text
+    assert "--workers 3 on a machine with 2 core(s)" in caplog.text
     caplog.clear()
     with caplog.at_level("WARNING"):
         main(["--workers", "2", "--samples", "10", "--anytime", "--out", str(tmp_path), "--no-progress"])

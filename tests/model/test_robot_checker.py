@@ -497,3 +497,13 @@ def test_convex_meshes_keep_a_flat_mesh_and_leave_a_robot_without_meshes_as_it_w
     wearer = WearerArm()
     assert RobotChecker(wearer.files.urdf, wearer.files.srdf, convex_meshes=True).model_hash == \
         RobotChecker(wearer.files.urdf, wearer.files.srdf).model_hash
+
+
+def test_more_threads_than_cores_are_warned_about(monkeypatch, caplog):
+    """n_threads up to 1024 was taken without a word: on a mesh robot 1000 threads held 3.2 GB (a helper's probe)."""
+    import tpee_ompl.model.robot_checker as robot_checker
+
+    monkeypatch.setattr(robot_checker.os, "cpu_count", lambda: 1)
+    with caplog.at_level("WARNING"):
+        WearerArm(n_threads=2)
+    assert "n_threads=2 on a machine with 1 core(s)" in caplog.text

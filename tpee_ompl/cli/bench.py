@@ -218,7 +218,7 @@ def run(args: argparse.Namespace) -> int:
             plan = prepare_campaign(config)
         cores = os.cpu_count() or 1
         if not (args.scheduler or args.dask) and workers > cores:  # timed runs then share cores: their figures suffer
-            logging.getLogger(__name__).warning("--workers %d on a machine with %d cores: runs compete for the CPU, "
+            logging.getLogger(__name__).warning("--workers %d on a machine with %d core(s): runs compete for the CPU, "
                                                 "so times and time-budgeted results are not those of one run alone",
                                                 workers, cores)
         executor = make_executor(workers, dask=args.scheduler or args.dask, dask_workers=args.dask_workers,

@@ -134,6 +134,9 @@ class RobotChecker:
         self.files = files
         self.link_margins = self._check_link_margins(link_margins, self.security_margin)
         self.n_threads = int(n_threads) if n_threads is not None else min(2, os.cpu_count() or 1)
+        if self.n_threads > (os.cpu_count() or 1):  # each thread has its own copy of the collision data (meshes)
+            log.warning("n_threads=%d on a machine with %d core(s): each thread holds a copy of the collision data, and "
+                        "threads beyond the cores only wait", self.n_threads, os.cpu_count() or 1)
         self._lever_arms: np.ndarray | None = None
         self._pair_lever_arms: np.ndarray | None = None
         self.collision_checks = 0
