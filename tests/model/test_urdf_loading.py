@@ -28,3 +28,17 @@ def test_a_joint_to_a_missing_link_is_named_before_urdfdom_fails_vaguely(tmp_pat
     (tmp_path / "broken.urdf").write_text(broken, encoding="utf-8")
     with pytest.raises(ValueError, match="child link 'nowhere', which is not a <link>"):
         RobotChecker(tmp_path / "broken.urdf")
+
+
+def test_a_urdf_of_another_robot_given_as_the_wearer_says_where_such_robots_are_planned(tmp_path):
+    """`tpee-ompl plan --urdf ur5.urdf` said only that joint 'j1' was missing."""
+    import pytest
+
+    from tpee_ompl.model.urdf_loading import load_wearer_model
+
+    urdf = tmp_path / "other.urdf"
+    urdf.write_text('<robot name="o"><link name="base"/><link name="a"/><joint name="shoulder" type="revolute">'
+                    '<parent link="base"/><child link="a"/><axis xyz="0 0 1"/>'
+                    '<limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>')
+    with pytest.raises(ValueError, match=r"lacks revolute joint 'j1'.*another robot is planned with RobotChecker"):
+        load_wearer_model(urdf, None)

@@ -114,7 +114,10 @@ def load_wearer_model(urdf: Path, srdf: Path | None) -> LoadedModel:
     joints = {j.get("name"): j.get("type") for j in root.iter("joint")}
     for name in ARM_JOINTS:
         if joints.get(name) != "revolute":
-            raise ValueError(f"URDF {urdf} lacks revolute joint {name!r} (found: {sorted(k for k in joints if k)})")
+            raise ValueError(f"URDF {urdf} lacks revolute joint {name!r} (found: {sorted(k for k in joints if k)}): a "
+                             f"wearer arm has the revolute joints {list(ARM_JOINTS)} and the link {MUZZLE_FRAME!r}; "
+                             "another robot is planned with RobotChecker(urdf, srdf) and make_simple_setup, or "
+                             "benchmarked as a problem (tpee-ompl bench --list-problems)")
     if MUZZLE_FRAME not in {link.get("name") for link in root.iter("link")}:
         raise ValueError(f"URDF {urdf} lacks the {MUZZLE_FRAME!r} link")
     loaded = load_urdf_model(urdf, srdf)
