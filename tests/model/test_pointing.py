@@ -178,3 +178,17 @@ def test_targets_inside_the_body_or_at_the_pivot_are_refused(robot):
 def test_aim_batch_refuses_a_flag_or_geometry_of_the_wrong_type(kw, match):
     with pytest.raises(ValueError, match=match):
         aim_batch(np.array([[5.0, 2.0, 1.5]]), 3, **kw)
+
+
+def test_aiming_another_robot_is_a_value_error_naming_what_it_lacks(tmp_path):
+    """It was a bare IndexError ("Index out of range") from inside the geometry's reading (a helper's README run)."""
+    from tpee_ompl.model.pointing import PointingGeometry
+    from tpee_ompl.model.robot_checker import RobotChecker
+
+    urdf = tmp_path / "other.urdf"
+    urdf.write_text('<robot name="o"><link name="base"/><link name="a"><collision><geometry><sphere radius="0.05"/>'
+                    '</geometry></collision></link><joint name="shoulder" type="revolute"><parent link="base"/>'
+                    '<child link="a"/><origin xyz="0 0 0.5"/><axis xyz="0 0 1"/>'
+                    '<limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>')
+    with pytest.raises(ValueError, match=r"aiming needs the wearer arm .* this robot has the joints \['shoulder'\]"):
+        PointingGeometry.from_robot(RobotChecker(urdf))

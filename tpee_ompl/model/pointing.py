@@ -44,6 +44,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..validation import as_float_array, check_bool
+from .urdf_loading import ARM_JOINTS
 from .wearer_arm import MAX_TARGET_DISTANCE, MUZZLE_FRAME, WearerArm, check_target_point, default_robot
 from .sectors import posture_preset
 
@@ -132,6 +133,10 @@ class PointingGeometry:
     def from_robot(cls, robot: WearerArm) -> PointingGeometry:
         """Read the constants from a loaded model; raise ValueError if its pointing system is not pan-offset-tilt."""
         m = robot.model
+        names = tuple(m.names[1:])
+        if names != ARM_JOINTS or not m.existFrame(MUZZLE_FRAME):  # another robot (an IndexError further down)
+            raise ValueError(f"aiming needs the wearer arm (joints {list(ARM_JOINTS)} and the {MUZZLE_FRAME!r} link); "
+                             f"this robot has the joints {list(names)}")
         jp = m.jointPlacements
         data = m.createData()
 
