@@ -42,3 +42,19 @@ def test_a_urdf_of_another_robot_given_as_the_wearer_says_where_such_robots_are_
                     '<limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>')
     with pytest.raises(ValueError, match=r"lacks revolute joint 'j1'.*another robot is planned with RobotChecker"):
         load_wearer_model(urdf, None)
+
+
+def test_an_srdf_floating_base_is_said_to_be_fixed_here(tmp_path, caplog):
+    """go1's and the Bravo7's SRDFs declare a floating root joint; the model loaded with its base welded to the
+    world without a word (a helper's probe)."""
+    from tpee_ompl.model.wearer_arm import WearerArm
+    from tpee_ompl.resources import model_file
+
+    urdf, srdf = model_file("wearer_arm.urdf"), model_file("wearer_arm.srdf")
+    text = srdf.read_text().replace("</robot>", '<virtual_joint name="root_joint" type="floating" '
+                                                'parent_frame="world" child_link="base_link"/></robot>')
+    floating = tmp_path / "floating.srdf"
+    floating.write_text(text)
+    with caplog.at_level("WARNING"):
+        WearerArm(urdf, floating)
+    assert "declares the floating virtual joint 'root_joint': its base is fixed to the world here" in caplog.text

@@ -414,6 +414,10 @@ def _apply_srdf(model: pin.Model, gmodel: pin.GeometryModel, srdf: Path, unknown
     """Remove the SRDF's disabled pairs, after checking that it names only links of the model (``unknown_links``
     "error"), or passing over the pairs that name other links ("skip"; Pinocchio applies the rest)."""
     root = _read_robot_xml(srdf, "SRDF")
+    for vj in root.iter("virtual_joint"):  # a mobile or legged robot's base: the URDF's root stays fixed here
+        if vj.get("type") in ("floating", "planar"):
+            log.warning("SRDF %s declares the %s virtual joint %r: its base is fixed to the world here (only the "
+                        "URDF's joints are planned)", srdf, vj.get("type"), vj.get("name"))
     links = {f.name for f in model.frames}
     pairs = [(dc.get("link1"), dc.get("link2")) for dc in root.iter("disable_collisions")]
     foreign = [p for p in pairs if p[0] not in links or p[1] not in links]
