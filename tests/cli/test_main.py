@@ -177,8 +177,8 @@ def test_output_into_a_closed_pipe_ends_quietly_with_sigpipes_code():
 def test_an_interrupt_while_the_command_line_loads_ends_it_with_130_and_one_line(signal_at_import):
     """Ctrl-C in the first 0.3 s (OMPL, Pinocchio and Coal loading) used to print the import's traceback, and SIGTERM
     ended the process without a word (exit 143: the command's own handler was not on yet).  Both signals are now held
-    while the modules load (one raised inside a compiled module's initialisation aborted the process: a helper's
-    probe, 4 of 80 real signals at 0.22-0.28 s) and delivered after.  Simulated at the import of pinocchio, which the
+    while the modules load (one raised inside a compiled module's initialisation aborted the process: SIGINT
+    and SIGTERM sent to `tpee-ompl track` at 0.20-0.35 s by a scratch probe: 4 aborts in 80) and delivered after.  Simulated at the import of pinocchio, which the
     command line's modules load; the last case checks that both signals are held there."""
     import subprocess
     import sys

@@ -359,7 +359,6 @@ def test_quieter_ompl_raises_the_level_for_its_block_only_and_never_lowers_it():
 
 
 def test_seed_ompl_makes_the_next_planners_draw_the_same_numbers_after_numbers_were_drawn(capfd):
-    from ompl import base as ob
     from ompl import util as ou
 
     from tpee_ompl.planning.setup import seed_ompl
