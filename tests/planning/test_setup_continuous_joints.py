@@ -127,6 +127,31 @@ def test_start_and_goal_angles_of_continuous_joints_are_wrapped_into_so2(tmp_pat
         make_simple_setup(robot, [0.0, 3.0, 0.0, 0.0], [0.0, 0.0, 0.0, 0.0])
 
 
+def test_unwrapped_angles_of_continuous_joints_get_the_verdict_of_their_wrapped_angle(tmp_path):
+    """ROS's joint_states report continuous joints unwrapped (7.0 rad): every validity check takes such an angle
+    as the same position; a bounded joint outside its limits and a non-finite angle stay invalid."""
+    robot = RobotChecker(_chain(tmp_path, MIXED), obstacles=_post(-0.7, 0.3))
+    rng = np.random.default_rng(11)
+    Q = rng.uniform(robot.lower, robot.upper, (200, robot.nq))
+    turns = rng.integers(-3, 4, (200, 2)) * 2 * math.pi
+    U = Q.copy()
+    U[:, [0, 3]] += turns
+    wrapped = robot.are_valid(Q)
+    assert 20 < wrapped.sum() < 180  # both verdicts are tested
+    assert robot.are_valid(U).tolist() == wrapped.tolist()
+    assert [robot.is_valid(u) for u in U] == wrapped.tolist()
+    assert [robot.is_valid_values(u.tolist()) for u in U] == wrapped.tolist()
+    first = int(np.argmin(wrapped))
+    assert robot.first_invalid(U) == first and robot.within_limits(U[first])
+    free = U[int(np.argmax(wrapped))]
+    np.testing.assert_array_equal(robot.check_free(free), free)
+    out = free.copy()
+    out[1] = 3.0  # a revolute joint past its 2.2-rad limit
+    assert not robot.is_valid(out) and not robot.is_valid_values(out.tolist()) and not robot.are_valid(out[None])[0]
+    for bad in (math.inf, math.nan):
+        assert not robot.is_valid_values([bad, 0.0, 0.0, 0.0])
+
+
 @pytest.mark.parametrize("planner", ["RRTConnect", "DimensionRRT"])
 def test_planners_find_the_short_way_round_and_their_paths_pass_the_motion_checks(tmp_path, planner):
     robot = RobotChecker(_chain(tmp_path, MIXED), obstacles=_post(0.7, 0.0) + [box("wall", (0.05, 0.05, 0.3),

@@ -219,7 +219,7 @@ def screened_lines_valid(robot: RobotChecker, screen: BallScreen, S: np.ndarray,
     offsets = np.cumsum(sizes) - sizes
     live = np.flatnonzero(sizes > 0)
     E = S[np.concatenate((offsets[live], offsets[live] + sizes[live] - 1))]  # first and last states
-    within = ((E >= robot.lower) & (E <= robot.upper)).all(axis=1)
+    within = robot.inside_limits(E)
     out = np.ones(len(sizes), dtype=bool)  # an empty line has no invalid state
     out[live] = within[: len(live)] & within[len(live) :]
     live = live[out[live]]
@@ -277,7 +277,7 @@ def _one_motion_valid(robot: RobotChecker, screen: BallScreen, S: np.ndarray, st
     if n == 0:
         return True
     # the states lie on a segment, and the joint box is convex: its two ends decide the limits
-    lower, upper = robot.lower, robot.upper
+    lower, upper = robot.check_lower, robot.check_upper
     if not ((S[0] >= lower).all() and (S[0] <= upper).all() and (S[-1] >= lower).all() and (S[-1] <= upper).all()):
         return False
     spacing = math.sqrt(float((S[1] - S[0]) @ (S[1] - S[0]))) if n > 1 else 0.0

@@ -56,7 +56,9 @@ def as_config_batch(Q: np.ndarray, nq: int) -> np.ndarray:
 class RobotChecker:
     """Collision checking of a URDF robot (every 1-DOF joint not locked is planned) among obstacles.
 
-    A continuous joint's coordinate is its angle in [-pi, pi] (:attr:`circular`).
+    A continuous joint's coordinate is its angle (:attr:`circular`): planners keep it in [-pi, pi] (:attr:`lower`,
+    :attr:`upper`), and the validity checks take any finite angle as the same joint position wrapped (ROS's
+    ``joint_states`` report continuous joints unwrapped, e.g. 7.0 rad).
 
     Parameters
     ----------
@@ -162,8 +164,13 @@ class RobotChecker:
         self.lower = self.model.lowerPositionLimit.copy()
         self.upper = self.model.upperPositionLimit.copy()
         self._rebuild_geometry_data()
-        self._lower_list = self.lower.tolist()
-        self._upper_list = self.upper.tolist()
+        big = np.finfo(float).max
+        self.check_lower = np.where(self.circular, -big, self.lower)
+        """:attr:`lower` as the validity checks use it: a continuous joint's is -max float (any finite angle)."""
+        self.check_upper = np.where(self.circular, big, self.upper)
+        """:attr:`upper` as the validity checks use it (inf and NaN fail both)."""
+        self._lower_list = self.check_lower.tolist()
+        self._upper_list = self.check_upper.tolist()
         log.debug("loaded %s: %d geometries, %d pairs", files.urdf, self.gmodel.ngeoms, len(self.gmodel.collisionPairs))
 
     def _load_model(self) -> LoadedModel:
@@ -339,9 +346,13 @@ class RobotChecker:
         return q
 
     def within_limits(self, q: np.ndarray) -> bool:
-        """True if q is inside the URDF joint limits."""
-        q = self.check_config(q)
-        return bool(np.all(q >= self.lower) and np.all(q <= self.upper))
+        """True if q is inside the URDF joint limits (a continuous joint has none: any finite angle)."""
+        return bool(self.inside_limits(self.check_config(q)[None])[0])
+
+    def inside_limits(self, Q: np.ndarray) -> np.ndarray:
+        """Per row of Q (N, nq), True when inside the joint limits (any finite angle for a continuous joint);
+        no input checks."""
+        return ((Q >= self.check_lower) & (Q <= self.check_upper)).all(axis=-1)
 
     def check_free(self, q: np.ndarray, name: str = "configuration") -> np.ndarray:
         """Return q (nq,) when it is finite, inside the joint limits and collision-free, else raise ValueError
@@ -387,7 +398,7 @@ class RobotChecker:
         """True if q is within limits and no checked pair is closer than its margin
         (``security_margin``, or for a pair with the static world the link's ``link_margins`` entry)."""
         q = self.check_config(q)
-        if not (np.all(q >= self.lower) and np.all(q <= self.upper)):
+        if not self.inside_limits(q[None])[0]:
             return False
         self.collision_checks += 1
         return not pin.computeCollisions(self.model, self.data, self.gmodel, self.gdata, q, True)
@@ -410,7 +421,7 @@ class RobotChecker:
     def are_valid(self, Q: np.ndarray) -> np.ndarray:
         """Batched :meth:`is_valid` for Q of shape (N, nq): one Pinocchio call; returns bool (N,)."""
         Q = as_config_batch(Q, self.nq)
-        ok = ((Q >= self.lower) & (Q <= self.upper)).all(axis=1)
+        ok = self.inside_limits(Q)
         if ok.any():
             ok[ok] = self.collision_free(Q[ok])
         return ok
@@ -428,7 +439,7 @@ class RobotChecker:
         Q = as_config_batch(Q, self.nq)
         if len(Q) == 0:
             return -1
-        outside = (~((Q >= self.lower) & (Q <= self.upper)).all(axis=1)).nonzero()[0]
+        outside = (~self.inside_limits(Q)).nonzero()[0]
         end = int(outside[0]) if len(outside) else len(Q)
         if end == 0:
             return 0
