@@ -156,6 +156,16 @@ def test_the_wearer_factory_refuses_groups_that_do_not_start_with_dof1_dof2_and_
     assert planner.groups == [[0, 1], [3], [2]] and list(planner.prescribed) == [0]
 
 
+def test_the_wearer_factory_takes_groups_none_as_its_default_groups(robot) -> None:
+    q = load_queries("planning_necessary", robot)[0]
+    si = make_simple_setup(robot, q.start, q.goal).getSpaceInformation()
+    for planner in (tpee_dimension_rrt(si, q.from_sector, q.to_sector, groups=None),
+                    tpee_dimension_rrt(si, q.from_sector, q.to_sector, DimensionRRTOptions(groups=[[0, 1], [2, 3]]),
+                                       groups=None),
+                    tpee_dimension_rrt(si, q.from_sector, q.to_sector, DimensionRRTOptions())):
+        assert planner.groups == [[0, 1], [2, 3]] and list(planner.prescribed) == [0]
+
+
 def test_a_prescribed_so2_row_is_wrapped_into_the_circle_not_refused() -> None:
     space = ob.CompoundStateSpace()
     space.addSubspace(ob.SO2StateSpace(), 1.0)

@@ -39,8 +39,8 @@ def tpee_dimension_rrt(
         Groups whose first group is not DOF1/DOF2 (``[0, 1]``, the row Table 3 prescribes), or ``h``
         other than the row's 7 steps (``max_h`` may raise it during the search).
     """
-    if options is None or options.groups is None:
-        overrides.setdefault("groups", ((0, 1), (2, 3)))
+    if overrides.get("groups", options.groups if options is not None else None) is None:
+        overrides["groups"] = ((0, 1), (2, 3))
     opts = resolve_options(options, overrides)
     if list(opts.groups[0]) != [0, 1]:
         raise ValueError(f"groups: Table 3 prescribes DOF1/DOF2, so the first group must be [0, 1], got "
