@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import dataclasses
+import json
+
 import numpy as np
 import pytest
 
@@ -128,10 +131,21 @@ def test_options_whose_rollout_or_basis_breaks_down_are_refused_not_turned_into_
 
 
 @pytest.mark.parametrize("options, match", [({"alpha_y": "48"}, "alpha_y"), ({"alpha_y": None}, "alpha_y"),
-                                            ({"n_basis": 10**12}, "n_basis"), ({"beta_y": -1.0}, "beta_y")])
+                                            ({"n_basis": 10**12}, "n_basis"), ({"beta_y": -1.0}, "beta_y"),
+                                            ({"min_amplitude_ratio": "0.5"}, "min_amplitude_ratio"),
+                                            ({"min_amplitude_ratio": True}, "min_amplitude_ratio"),
+                                            ({"min_amplitude_ratio": 1.5}, "min_amplitude_ratio")])
 def test_bad_option_values_are_value_errors_naming_the_option(options, match) -> None:
     with pytest.raises(ValueError, match=match):
         DMPOptions(**options)
+
+
+def test_numpy_scalar_options_are_kept_as_plain_numbers_that_a_saved_library_can_write() -> None:
+    options = DMPOptions(n_basis=np.int64(300), alpha_y=np.float32(48), beta_y=np.float64(12), alpha_x=np.int32(4),
+                         width=np.float32(0.5), min_amplitude_ratio=np.float64(0.5))
+    assert json.loads(json.dumps(dataclasses.asdict(options))) == dataclasses.asdict(DMPOptions(
+        n_basis=300, alpha_y=48.0, beta_y=12.0, alpha_x=4.0, width=0.5, min_amplitude_ratio=0.5))
+    assert all(type(v) in (int, float, str) for v in dataclasses.asdict(options).values())
 
 
 def test_a_grid_too_large_to_hold_is_refused_before_it_is_allocated() -> None:

@@ -102,14 +102,16 @@ class DMPOptions:
     min_amplitude_ratio: float = 0.5
 
     def __post_init__(self) -> None:
-        check_int("n_basis", self.n_basis, minimum=2, maximum=MAX_N_BASIS, optional=True)
+        # the checked values are kept as plain ints and floats: numpy scalars would fail as JSON in a saved library
+        set_ = lambda field_, value: object.__setattr__(self, field_, value)  # noqa: E731 (frozen dataclass)
+        set_("n_basis", check_int("n_basis", self.n_basis, minimum=2, maximum=MAX_N_BASIS, optional=True))
         for name in ("alpha_y", "alpha_x", "width"):
-            check_number(name, getattr(self, name), low=0.0, low_open=True)
-        check_number("beta_y", self.beta_y, low=0.0, low_open=True, optional=True)
+            set_(name, check_number(name, getattr(self, name), low=0.0, low_open=True))
+        set_("beta_y", check_number("beta_y", self.beta_y, low=0.0, low_open=True, optional=True))
         if self.scaling not in ("amplitude", "none"):
             raise ValueError(f"scaling must be 'amplitude' or 'none', got {self.scaling!r}")
-        if not (0.0 < self.min_amplitude_ratio <= 1.0):
-            raise ValueError(f"min_amplitude_ratio must be in (0, 1], got {self.min_amplitude_ratio!r}")
+        set_("min_amplitude_ratio", check_number("min_amplitude_ratio", self.min_amplitude_ratio, low=0.0,
+                                                 low_open=True, high=1.0))
 
     @property
     def beta(self) -> float:
