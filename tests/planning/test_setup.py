@@ -279,6 +279,25 @@ def test_the_batched_validator_checks_as_many_states_as_ompls_at_any_segment_cou
     assert counts["dense"] == counts["discrete"] == factor * int(np.ceil(steps))
 
 
+def test_segment_counts_of_a_real_vector_setup_are_ompls_valid_segment_counts(robot, rng):
+    """``segment_counts`` was for compound spaces only (an AttributeError on the wearer's RealVector setup)."""
+    si = make_simple_setup(robot).getSpaceInformation()
+    space, mv = si.getStateSpace(), si.getMotionValidator()
+    A, B = rng.uniform(robot.lower, robot.upper, (2, 30, robot.nq))
+    B[0] = A[0]
+    for factor in (1, 4):
+        space.setValidSegmentCountFactor(factor)
+        theirs = []
+        for a, b in zip(A, B):
+            s1, s2 = si.allocState(), si.allocState()
+            set_state(s1, a)
+            set_state(s2, b)
+            theirs.append(max(factor, space.validSegmentCount(s1, s2)))  # OMPL's validator checks >= 1 segment
+        assert mv.segment_counts(A, B).tolist() == theirs
+    with pytest.raises(ValueError, match="finite"):
+        mv.segment_counts(A[:1], np.full((1, robot.nq), np.nan))
+
+
 def test_a_margin_so_small_that_its_motion_step_is_below_the_floor_is_refused_not_densified():
     """A 1e-9-m margin made one 1-rad motion check allocate 12 GiB; a zero margin names the margin."""
     tiny = WearerArm(security_margin=1e-9)

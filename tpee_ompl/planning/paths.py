@@ -238,11 +238,16 @@ def batched_motion_states(A: np.ndarray, B: np.ndarray, step: float, factor: int
         raise ValueError("motion ends must be finite")
     _check_step(step)
     D = B - A
-    # the segment counts as motion_states computes them (one dot product per motion: the same rounding)
-    n = np.array([factor * max(1, math.ceil(math.sqrt(float(d @ d)) / step)) for d in D], dtype=np.int64)
+    n = straight_segment_counts(D, step, factor)
     S = counted_motion_states(A, D, n)
     S[np.cumsum(n) - 1] = B  # each motion's end is B[k] itself (see unchecked_motion_states)
     return S, n
+
+
+def straight_segment_counts(D: np.ndarray, step: float, factor: int = 1) -> np.ndarray:
+    """Segments of each straight motion of displacement D[k] (K, n) at ``step``, as :func:`motion_states` counts
+    them (one dot product per motion: the same rounding), times ``factor``.  Not validated (inner loops)."""
+    return np.array([factor * max(1, math.ceil(math.sqrt(float(d @ d)) / step)) for d in D], dtype=np.int64)
 
 
 def counted_motion_states(A: np.ndarray, D: np.ndarray, counts: np.ndarray) -> np.ndarray:

@@ -26,6 +26,7 @@ from collections.abc import Callable, Iterator, Sequence
 from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
 from ompl import base as ob
 from ompl import geometric as og
 from ompl import util as ou
@@ -34,7 +35,7 @@ from ..model.clearance_balls import SCREEN_COST_LIMIT, SCREEN_LEVELS, screened_a
 from ..model.robot_checker import RobotChecker
 from ..validation import MOTION_VALIDATORS, check_bool, check_number, check_seed
 from .paths import (MIN_JOINT_STEP, batched_motion_states, bisection_order, counted_motion_states, state_to_array,
-                    unchecked_motion_states)
+                    straight_segment_counts, unchecked_motion_states)
 from .space_layout import RealVectorLayout
 
 if TYPE_CHECKING:
@@ -214,10 +215,17 @@ class BatchedMotionValidator(ob.MotionValidator):
         return self._tally(ok)
 
     def segment_counts(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
-        """Segments of each motion A[k] -> B[k] in a compound space: as OMPL's ``CompoundStateSpace`` counts them
-        (the most any subspace needs, each subspace's segment its share ``step * extent_i / extent`` of the
-        step; at most ``step`` apart in the Euclidean joint metric), times the space's ``validSegmentCountFactor``
-        (which OMPL's own validator does not apply to a compound space's subspaces: this one is stricter there)."""
+        """Segments of each motion A[k] -> B[k] (K, nq), times the space's ``validSegmentCountFactor``.
+
+        In a RealVector space ``ceil(|B - A| / step)``, as OMPL's validator counts them.  In a compound space as
+        OMPL's ``CompoundStateSpace`` counts them (the most any subspace needs, each subspace's segment its share
+        ``step * extent_i / extent`` of the step; at most ``step`` apart in the Euclidean joint metric), with the
+        factor that OMPL's own validator does not apply to a compound space's subspaces (stricter there)."""
+        if self._layout is None:
+            D = np.asarray(B, dtype=float) - np.asarray(A, dtype=float)
+            if not np.isfinite(D).all():
+                raise ValueError("motion ends must be finite")
+            return straight_segment_counts(D, self.step, self.factor())
         need = np.ceil(self._layout.leaf_distances(A, B) / self._leaf_steps).max(axis=-1)
         if not np.isfinite(need).all():
             raise ValueError("motion ends must be finite")
@@ -331,8 +339,8 @@ def _real_vector(lower: np.ndarray, upper: np.ndarray) -> ob.RealVectorStateSpac
 
 def make_simple_setup(
     robot: RobotChecker,
-    start: Sequence[float] | None = None,
-    goal: Sequence[float] | None = None,
+    start: ArrayLike | None = None,
+    goal: ArrayLike | None = None,
     *,
     joint_step: float | None = None,
     batched_motion_validator: bool | None = None,
