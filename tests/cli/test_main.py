@@ -208,6 +208,16 @@ def test_python_dash_m_tpee_ompl_is_the_command_line():
     assert bad.returncode == 2 and bad.stderr.startswith("tpee-ompl aim: error:")
 
 
+def test_the_command_line_runs_with_docstrings_stripped_by_python_dash_oo():
+    """Under ``python -OO`` the parser read its description from a docstring that is None: every command failed."""
+    import subprocess
+    import sys
+
+    proc = subprocess.run([sys.executable, "-OO", "-m", "tpee_ompl", "aim", "--target", "5", "2", "1.5"],
+                          capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0 and proc.stdout.strip() and proc.stderr == ""
+
+
 def test_an_interrupt_while_the_command_cleans_up_after_its_work_ends_with_130(monkeypatch, capsys):
     """The last clean-up (a garbage collection) ran after the interrupt handling: Ctrl-C there printed a traceback
     or was lost (exit 0)."""

@@ -32,10 +32,13 @@ from .plan import register as register_plan
 
 __all__ = ["get_argument_parser", "main"]
 
+DESCRIPTION = "The tpee-ompl command line: plan, aim, track, bench, library, show, animate, workspace, view."
+"""The parser's description (the module docstring's first line; docstrings are gone under ``python -OO``)."""
+
 
 def get_argument_parser() -> argparse.ArgumentParser:
     """The full ``tpee-ompl`` argument parser."""
-    parser = Parser(prog="tpee-ompl", description=__doc__.split("\n")[0].replace("``", ""))
+    parser = Parser(prog="tpee-ompl", description=DESCRIPTION)
     parser.add_argument("-v", "--verbose", action="store_true", help="log at INFO level")
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")  # required: main() says so after other errors
