@@ -10,7 +10,7 @@ import dataclasses
 import math
 import numbers
 from collections.abc import Mapping
-from typing import Any, TypeVar
+from typing import Any, Literal, TypeVar, overload
 
 import numpy as np
 
@@ -31,6 +31,12 @@ def resolve_options(cls: type[_Options], options: _Options | None, overrides: Ma
     return dataclasses.replace(options, **overrides) if overrides else options
 
 
+@overload
+def check_int(name: str, value: Any, *, minimum: int | None = ..., maximum: int | None = ...,
+              optional: Literal[False] = ...) -> int: ...
+@overload
+def check_int(name: str, value: Any, *, minimum: int | None = ..., maximum: int | None = ...,
+              optional: bool) -> int | None: ...
 def check_int(name: str, value: Any, *, minimum: int | None = None, maximum: int | None = None,
               optional: bool = False) -> int | None:
     """``value`` as an int (a bool is refused), within [minimum, maximum]; None passes when ``optional``."""
@@ -45,6 +51,12 @@ def check_int(name: str, value: Any, *, minimum: int | None = None, maximum: int
     return v
 
 
+@overload
+def check_number(name: str, value: Any, *, low: float | None = ..., high: float | None = ...,
+                 low_open: bool = ..., high_open: bool = ..., optional: Literal[False] = ...) -> float: ...
+@overload
+def check_number(name: str, value: Any, *, low: float | None = ..., high: float | None = ...,
+                 low_open: bool = ..., high_open: bool = ..., optional: bool) -> float | None: ...
 def check_number(name: str, value: Any, *, low: float | None = None, high: float | None = None,
                  low_open: bool = False, high_open: bool = False, optional: bool = False) -> float | None:
     """``value`` as a finite float (a bool is refused) within the given bounds; None passes when ``optional``."""

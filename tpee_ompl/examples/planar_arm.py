@@ -8,6 +8,7 @@ prescribed group.
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike
 from ompl import base as ob
 from ompl import geometric as og
 
@@ -57,9 +58,9 @@ class PlanarArm(ob.StateValidityChecker):
 
 
 def make_planar_arm_setup(
-    start: np.ndarray = (0.3, 0.0, 0.0, 0.0),
-    goal: np.ndarray = (2.6, 0.0, 0.0, 0.0),
-    obstacles: np.ndarray = ((0.0, 1.55, 0.35), (1.2, 1.2, 0.25), (-1.0, 1.0, 0.3)),
+    start: ArrayLike = (0.3, 0.0, 0.0, 0.0),
+    goal: ArrayLike = (2.6, 0.0, 0.0, 0.0),
+    obstacles: ArrayLike = ((0.0, 1.55, 0.35), (1.2, 1.2, 0.25), (-1.0, 1.0, 0.3)),
     link_length: float = 0.5,
     resolution: float = 0.005,
 ) -> og.SimpleSetup:

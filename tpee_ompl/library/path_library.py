@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import inspect
 import logging
+import os
 import time
 from collections import Counter
 from collections.abc import Callable, Iterator
@@ -360,7 +361,7 @@ class PathLibrary:
         return write_library(self, path, force=check_bool("force", force))
 
     @classmethod
-    def load(cls, path: str | Path, robot: WearerArm, plan: Plan | None = None) -> PathLibrary:
+    def load(cls, path: str | os.PathLike, robot: WearerArm, plan: Plan | None = None) -> PathLibrary:
         """Read a library saved by :meth:`save` (:func:`tpee_ompl.library.storage.read_library`), with
         ``plan`` as its fallback; a file of another format version, another model, or a damaged one
         raises :class:`~tpee_ompl.library.storage.LibraryFileError`."""

@@ -11,6 +11,7 @@ from __future__ import annotations
 import os
 from collections.abc import Mapping
 from pathlib import Path
+from typing import Literal
 
 import coal
 import numpy as np
@@ -79,7 +80,7 @@ class WearerArm(RobotChecker):
     def __init__(
         self,
         urdf_path: str | os.PathLike | None = None,
-        srdf_path: str | os.PathLike | None | bool = None,
+        srdf_path: str | os.PathLike | None | Literal[False] = None,
         security_margin: float = DEFAULT_SECURITY_MARGIN,
         n_threads: int | None = None,
         link_margins: Mapping[str, float] | None = None,
