@@ -6,6 +6,7 @@ import dataclasses
 
 import numpy as np
 import pytest
+from ompl import base as ob
 
 from tpee_ompl.bench.config import CampaignConfig
 from tpee_ompl.bench.experiment import experiment_specs, group_lengths, log_name
@@ -115,3 +116,30 @@ def test_a_run_whose_path_stops_short_of_the_goal_has_no_first_solution_time(rob
     assert props["reaches_goal INTEGER"] == 0 and props["path_valid_dense INTEGER"] is None
     rec.update(waypoints=np.array([start, goal]), best_cost=float(np.linalg.norm(goal - start)))
     assert _run_properties(setup, rec, robot.collision_checks)["first_solution_time REAL"] == 0.001
+
+
+def test_an_exact_answer_short_of_the_goal_is_an_unsolved_run_without_solution_columns_or_zero_costs(tmp_path, robot):
+    """OMPL records AORRTC's start-only answer (ompl/ompl#1420) as solved with length 0, and its bestCost() 0
+    went into the progress rows: Planner Arena and OMPL's bestPlannerConfigs ranked it the best planner."""
+    import sqlite3
+
+    from helpers.bench_standins import STANDIN, tiny_config, write_query_file
+
+    from tpee_ompl.bench.campaign import run_campaign
+
+    stops = "helpers.bench_standins:make_stops_at_start"
+    cfg = tiny_config(write_query_file(tmp_path / "q.json", robot, n=2), tmp_path, sample_caps=(30,),
+                      iteration_planners=(stops, STANDIN), anytime_budgets=())
+    res = run_campaign(cfg, report=False, progress_bar=False)
+    with sqlite3.connect(res.database) as db:
+        rows = db.execute("SELECT plannerConfigs.name, runs.status, runs.solved, runs.solution_length, "
+                          "runs.correct_solution, runs.approximate_solution, runs.reaches_goal, runs.id FROM runs "
+                          "JOIN plannerConfigs ON runs.plannerid = plannerConfigs.id").fetchall()
+        costs = dict(db.execute("SELECT runid, MIN(best_cost) FROM progress GROUP BY runid").fetchall())
+    stopped = [r for r in rows if r[0].endswith("StopsAtStart")]
+    others = [r for r in rows if not r[0].endswith("StopsAtStart")]
+    assert len(stopped) == len(others) == 2
+    invalid_goal = int(ob.PlannerStatus.INVALID_GOAL.value)
+    assert [r[1:7] for r in stopped] == [(invalid_goal, 0, None, None, None, 0)] * 2
+    assert all(costs.get(r[7]) is None or costs[r[7]] > 0 for r in stopped)  # its cost-0 row is gone (inf stays)
+    assert all(r[2] == 1 and r[3] > 0 and r[4] == 1 and r[6] == 1 for r in others)  # a real path keeps its columns

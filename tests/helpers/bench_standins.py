@@ -124,6 +124,30 @@ def make_honours_threshold(si, ctx: PlannerContext):
     return planner
 
 
+class StopsAtStart(StandInPlanner):
+    """Answers as OMPL 2.0.1's AORRTC does on a query whose direct motion is free (ompl/ompl#1420): an "exact"
+    path of its start twice, bestCost() 0, status invalid goal."""
+
+    def solve(self, ptc):
+        si, pdef = self.getSpaceInformation(), self.getProblemDefinition()
+        start = self.getPlannerInputStates().nextStart()  # (pdef.getStartState(0) would be freed twice)
+        path = og.PathGeometric(si)
+        for _ in range(2):
+            s = si.allocState()
+            s[0:4] = [start[i] for i in range(4)]
+            path.append(s)
+        pdef.addSolutionPath(path, False, 0.0, self.getName())
+        self._stats = {"samples": 1, "iterations": 1, "best_cost": 0.0, "collision_checks": 0,
+                       "first_solution_time": 0.0, "progress": [(0.001, float("inf"), 0), (0.002, 0.0, 1)]}
+        return ob.PlannerStatus(ob.PlannerStatus.INVALID_GOAL)
+
+
+def make_stops_at_start(si, ctx: PlannerContext):
+    planner = StopsAtStart(si, max_samples=ctx.max_samples, seed=ctx.seed)
+    planner.setName("StopsAtStart")
+    return planner
+
+
 # --------------------------------------------------------------------------- planners that fail
 class SolveRaises(StandInPlanner):
     """Raises inside ``solve`` (called by OMPL's Benchmark from C++)."""

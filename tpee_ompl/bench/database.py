@@ -33,8 +33,8 @@ from .config import PROGRESS_PROPERTIES
 from .planners import planner_settings
 from .results import format_value, planner_name
 
-__all__ = ["NO_PATH_COLUMNS", "build_database", "check_log", "failed_run_properties", "log_text", "pad_aborted_runs",
-           "patch_recorded_data", "progress_rows", "set_aside_broken_logs"]
+__all__ = ["NO_PATH_COLUMNS", "SOLUTION_KEYS", "build_database", "check_log", "failed_run_properties", "log_text",
+           "pad_aborted_runs", "patch_recorded_data", "progress_rows", "set_aside_broken_logs"]
 
 log = logging.getLogger(__name__)
 
@@ -78,18 +78,27 @@ SAMPLED_SPACE_SETTINGS = ("projection.cellsize",)
 cell sizes): they differ from experiment to experiment and would split one planner's configuration."""
 
 
+SOLUTION_KEYS = ("approximate solution", "solution ", "correct solution", "simplif")
+"""Prefixes of OMPL's run columns written only when the run has a path."""
+
+
 def patch_recorded_data(bench: ot.Benchmark, wrappers: dict, records: dict, cap: int | None) -> None:
     """Write the post-run records into the recorded experiment data (in place, before saving).
 
     ``wrappers``: planner name -> its :class:`~tpee_ompl.bench.planners.RecordingPlanner`;
     ``records``: planner name -> one ``{"props": {column: value}, "progress": [(t, cost, n)]}`` per run.
+    A run OMPL counts as solved whose path stops short of the goal (``reaches_goal`` 0) is written unsolved.
     """
     for pl in bench.getRecordedExperimentData().planners:
         name = planner_name(pl.name)
         recs = records.get(name, [])
-        for run, rec in zip(pl.runs, recs):
+        runs = list(pl.runs)
+        for i, (run, rec) in enumerate(zip(runs, recs)):
             for k, v in rec["props"].items():
                 run[k] = format_value(v)
+            if rec["props"].get("reaches_goal INTEGER") == 0 and run.to_dict().get("solved BOOLEAN") == "1":
+                runs[i] = _unsolved(run)
+        pl.runs = runs
         settings = planner_settings(wrappers[name].inner)
         for k in PER_QUERY_SETTINGS:  # per query, not per planner: in the experiments table and the runs
             settings.pop(k, None)
@@ -104,6 +113,19 @@ def patch_recorded_data(bench: ot.Benchmark, wrappers: dict, records: dict, cap:
         pl.common["wrapper"] = "RecordingPlanner"
         pl.progressPropertyNames = list(PROGRESS_PROPERTIES)
         pl.runsProgressData = [progress_rows(rec["progress"]) for rec in recs]
+
+
+def _unsolved(run: ot.RunProperties) -> ot.RunProperties:
+    """``run`` as a run without a solution: solved 0, no solution columns (NULL).  OMPL records a planner's
+    answer that stops short of the goal as solved when the planner calls it exact: AORRTC's start state alone
+    with status *invalid goal* (ompl/ompl#1420), solved 1 with length 0, which Planner Arena and OMPL's
+    ``bestPlannerConfigs`` would rank best."""
+    out = ot.RunProperties()
+    for k, v in run.to_dict().items():
+        if not k.startswith(SOLUTION_KEYS):
+            out[k] = v
+    out["solved BOOLEAN"] = "0"
+    return out
 
 
 def progress_rows(progress: Sequence[tuple[float, float, int | None]]) -> list[dict[str, str]]:

@@ -373,7 +373,8 @@ def _set_run_events(bench: ot.Benchmark, setup: _Setup, wrappers: dict, records:
     def post_run(planner, run) -> None:
         try:
             last = wrappers[planner.getName()].last
-            rec = {"props": _run_properties(setup, last, checks_before["value"]), "progress": last["progress"]}
+            rec = {"props": _run_properties(setup, last, checks_before["value"]),
+                   "progress": _path_costs(last["progress"], float(setup.layout.distance(setup.start, setup.goal)))}
         except Exception as exc:  # noqa: BLE001 (would abort benchmark())
             log.exception("post-run event failed for %s", planner.getName())
             rec = {"props": failed_run_properties(repr(exc)), "progress": []}
@@ -381,6 +382,13 @@ def _set_run_events(bench: ot.Benchmark, setup: _Setup, wrappers: dict, records:
 
     bench.setPreRunEvent(lambda p: _guarded(pre_run, p))
     bench.setPostRunEvent(post_run)
+
+
+def _path_costs(progress: list, shortest: float) -> list:
+    """The progress rows [(t, best cost, n)] whose cost a path from start to goal can have: none is shorter than
+    ``shortest``, the start-goal distance (AORRTC's bestCost() is 0 once its answer is its start alone,
+    ompl/ompl#1420; such rows drew its progress curve at cost 0).  Rows without a path (cost inf) stay."""
+    return [row for row in progress if row[1] >= shortest * (1.0 - 1e-9)]
 
 
 def _run_properties(setup: _Setup, rec: dict, checks_before: int) -> dict:

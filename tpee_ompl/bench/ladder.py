@@ -42,7 +42,7 @@ from ompl import tools as ot
 from ..planning.paths import states_to_array
 from ..planning.setup import motion_counts, valid_motion_fraction
 from ..planning.space_layout import RealVectorLayout
-from .database import NO_PATH_COLUMNS, log_text, progress_rows
+from .database import NO_PATH_COLUMNS, SOLUTION_KEYS, log_text, progress_rows
 from .planners import PlannerContext, RecordingPlanner, planner_factory
 from .results import format_value, planner_name
 
@@ -52,9 +52,6 @@ log = logging.getLogger(__name__)
 
 LADDER_PLANNERS = ("DimensionRRT", "DimensionRRTReleased", "DimensionRRTNoShortcuts", "RRTstar")
 """Planners whose checkpoint rows are verified to equal separate capped runs (tests/bench/test_ladder.py)."""
-
-_SOLUTION_KEYS = ("approximate solution", "solution ", "correct solution", "simplif")
-"""OMPL run columns written only when the run has a path."""
 
 
 def group_ladders(specs: list[dict], enabled: bool, planners: tuple[str, ...] | list[str]) -> list[list[dict]]:
@@ -328,7 +325,7 @@ class Ladder:
     @staticmethod
     def _ompl_columns(si, pdef, row: dict, snap: dict, simplify: bool) -> dict:
         """OMPL's run columns for the checkpoint path, computed as ``Benchmark`` does."""
-        row = {k: v for k, v in row.items() if not k.startswith(_SOLUTION_KEYS)}
+        row = {k: v for k, v in row.items() if not k.startswith(SOLUTION_KEYS)}
         W = snap["waypoints"]
         st = ob.PlannerStatus.EXACT_SOLUTION if snap["exact"] else (
             ob.PlannerStatus.APPROXIMATE_SOLUTION if W is not None else ob.PlannerStatus.TIMEOUT)
