@@ -44,13 +44,15 @@ def _runs(db: Path) -> list[tuple]:
 
 def test_exceptions_in_planner_callbacks_are_failed_runs_and_ompl_logging_stays_on(query_file, tmp_path):
     cfg = tiny_config(query_file, tmp_path, sample_caps=(20,), anytime_budgets=(), max_queries=1,
-                      iteration_planners=(FAULTS + "make_solve_raises", FAULTS + "make_setup_raises", "RRTstar"))
+                      iteration_planners=(FAULTS + "make_solve_raises", FAULTS + "make_setup_raises",
+                                          FAULTS + "make_package_planner_raises", "RRTstar"))
     res = run_campaign(cfg, report=False, progress_bar=False)
     rows = {name: (status, solved, err) for name, status, solved, err in _runs(res.database)}
     assert rows["geometric_SolveRaises"] == (CRASH, 0, 1) and rows["geometric_SetupRaises"] == (CRASH, 0, 1)
+    assert rows["geometric_PackagePlannerRaises"] == (CRASH, 0, 1)  # its solve() returns CRASH: still an error
     status, _, err = rows["geometric_RRTstar"]
     assert status in UNSOLVED_OR_SOLVED and err == 0  # the rest of the experiment ran (20 iterations may not solve)
-    assert len(_runs(res.database)) == 3
+    assert len(_runs(res.database)) == 4
     assert ou.getOutputHandler() is not None
 
 

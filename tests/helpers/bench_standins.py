@@ -21,6 +21,7 @@ from ompl import geometric as og
 from tpee_ompl.bench.config import CampaignConfig
 from tpee_ompl.bench.planners import PlannerContext
 from tpee_ompl.model.sectors import posture_preset
+from tpee_ompl.planning.planner_base import PythonPlanner
 
 STANDIN = "helpers.bench_standins:make_standin"
 """The stand-in's planner name in a campaign configuration."""
@@ -171,6 +172,17 @@ class SetupRaises(StandInPlanner):
         raise ValueError("setup exploded")
 
 
+class PackagePlannerRaises(PythonPlanner):
+    """One of the package's planners (:class:`~tpee_ompl.planning.planner_base.PythonPlanner`, as DimensionRRT)
+    raising in ``_solve``: its solve() logs the exception and returns CRASH."""
+
+    def __init__(self, si):
+        super().__init__(si, "PackagePlannerRaises")
+
+    def _solve(self, ptc):
+        raise ValueError("_solve exploded")
+
+
 class _RaisingMotionValidator(ob.MotionValidator):
     def __init__(self, si):
         super().__init__(si)
@@ -195,6 +207,10 @@ def make_solve_raises(si, ctx: PlannerContext):
 
 def make_setup_raises(si, ctx: PlannerContext):
     return SetupRaises(si, max_samples=ctx.max_samples, seed=ctx.seed)
+
+
+def make_package_planner_raises(si, ctx: PlannerContext):
+    return PackagePlannerRaises(si)
 
 
 def make_aborts_benchmark(si, ctx: PlannerContext):

@@ -315,6 +315,9 @@ class RecordingPlanner(ob.Planner):
             error = repr(exc)
             status = ob.PlannerStatus(ob.PlannerStatus.CRASH)
         elapsed = time.perf_counter() - t0
+        if error is None and hasattr(inner, "last_run_stats"):  # a PythonPlanner turns its exceptions into CRASH
+            with contextlib.suppress(Exception):
+                error = inner.last_run_stats().get("error")
         checks_end = int(self.checker.collision_checks) if self.checker is not None else None
         waypoints = None
         if error is None and pdef.hasSolution():

@@ -63,7 +63,8 @@ class PythonPlanner(ob.Planner):
 
     def last_run_stats(self) -> dict[str, Any]:
         """Statistics of the last solve (a copy): at least ``first_solution_time`` (s or None),
-        ``best_cost`` (inf if none) and ``progress`` [(time_s, best_cost, samples), ...]."""
+        ``best_cost`` (inf if none) and ``progress`` [(time_s, best_cost, samples), ...]; ``error``, the
+        exception's repr, when the solve failed (status CRASH)."""
         out = dict(self._stats)
         out["progress"] = list(self._stats["progress"])
         return out
@@ -90,8 +91,9 @@ class PythonPlanner(ob.Planner):
             if not self.getSpaceInformation().isSetup():  # solved without setup(): set it up, as OMPL's planners do
                 self.setup()
             return self._solve(ptc)
-        except Exception:  # an exception escaping into ot.Benchmark would abort the whole benchmark
+        except Exception as exc:  # an exception escaping into ot.Benchmark would abort the whole benchmark
             log.exception("%s.solve failed", self.getName())
+            self._stats["error"] = repr(exc)
             return planner_status(ob.PlannerStatus.CRASH)
 
     def _solve(self, ptc: ob.PlannerTerminationCondition) -> ob.PlannerStatus:
