@@ -194,4 +194,8 @@ def test_campaign_on_a_generic_problem_fills_the_database_with_its_dimension_and
     solved = [r for r in rows if r[2] is not None and r[6] == 1]
     assert solved and all(r[5] == 1 for r in solved)  # every exact path passes checkMotion over the whole path
     assert all(r[3] + r[4] >= r[2] - 1e-9 for r in solved)  # group lengths vs the 6-D length (triangle inequality)
+    counts = con.execute("SELECT runs.iterations, progress.iterations FROM progress JOIN runs ON progress.runid = "
+                         "runs.id JOIN plannerConfigs ON runs.plannerid = plannerConfigs.id "
+                         "WHERE plannerConfigs.name = 'geometric_RRTConnectSimplify'").fetchall()
+    assert counts and all(c == (None, None) for c in counts)  # no iteration count, not 0 iterations
     gc.collect()

@@ -60,7 +60,8 @@ class SimplifiedPlanner(PythonPlanner):
 
     def last_run_stats(self) -> dict[str, Any]:
         """first_solution_time (s, the inner planner's exact path), raw_cost, best_cost (after
-        simplifying), simplify_time (s), progress [(time_s, best_cost, 0), ...]."""
+        simplifying), simplify_time (s), progress [(time_s, best_cost, None), ...] (no iteration count: RRTConnect
+        reports none)."""
         return super().last_run_stats()
 
     def clear(self) -> None:
@@ -95,7 +96,7 @@ class SimplifiedPlanner(PythonPlanner):
         now = time.perf_counter() - t0
         stats.update(first_solution_time=now, raw_cost=float(raw.cost(opt).value()))
         stats["best_cost"] = stats["raw_cost"]
-        stats["progress"].append((now, stats["raw_cost"], 0))
+        stats["progress"].append((now, stats["raw_cost"], None))  # no iteration count
         if ptc():
             return planner_status(ob.PlannerStatus.EXACT_SOLUTION)
         path = og.PathGeometric(raw)
@@ -107,7 +108,7 @@ class SimplifiedPlanner(PythonPlanner):
         if cost < stats["raw_cost"] and path_passes_motion_checks(si, path):
             pdef.addSolutionPath(path, False, 0.0, self.getName())
             stats["best_cost"] = cost
-        stats["progress"].append((time.perf_counter() - t0, stats["best_cost"], 0))
+        stats["progress"].append((time.perf_counter() - t0, stats["best_cost"], None))
         return planner_status(ob.PlannerStatus.EXACT_SOLUTION)
 
 
