@@ -133,7 +133,8 @@ def test_an_exact_answer_short_of_the_goal_is_an_unsolved_run_without_solution_c
     res = run_campaign(cfg, report=False, progress_bar=False)
     with sqlite3.connect(res.database) as db:
         rows = db.execute("SELECT plannerConfigs.name, runs.status, runs.solved, runs.solution_length, "
-                          "runs.correct_solution, runs.approximate_solution, runs.reaches_goal, runs.id FROM runs "
+                          "runs.correct_solution, runs.approximate_solution, runs.reaches_goal, runs.id, "
+                          "runs.solution_clearance FROM runs "
                           "JOIN plannerConfigs ON runs.plannerid = plannerConfigs.id").fetchall()
         costs = dict(db.execute("SELECT runid, MIN(best_cost) FROM progress GROUP BY runid").fetchall())
     stopped = [r for r in rows if r[0].endswith("StopsAtStart")]
@@ -143,3 +144,4 @@ def test_an_exact_answer_short_of_the_goal_is_an_unsolved_run_without_solution_c
     assert [r[1:7] for r in stopped] == [(invalid_goal, 0, None, None, None, 0)] * 2
     assert all(costs.get(r[7]) is None or costs[r[7]] > 0 for r in stopped)  # its cost-0 row is gone (inf stays)
     assert all(r[2] == 1 and r[3] > 0 and r[4] == 1 and r[6] == 1 for r in others)  # a real path keeps its columns
+    assert all(r[8] > 0 for r in others)  # the checker's clearance, metres from the margins (OMPL's default: 0)

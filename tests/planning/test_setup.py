@@ -394,3 +394,20 @@ def test_seed_ompl_makes_the_next_planners_draw_the_same_numbers_after_numbers_w
     seed_ompl(18)
     assert draws() != first
     assert "already started" not in capfd.readouterr().err
+
+
+def test_the_validity_checkers_clearance_is_the_workspace_distance_to_the_nearest_invalid_configuration(robot, rng):
+    """OMPL's default clearance() is 0, so Planner Arena showed every path touching an obstacle."""
+    si = make_simple_setup(robot).getSpaceInformation()
+    checker, s = si.getStateValidityChecker(), si.allocState()
+    Q = rng.uniform(robot.lower, robot.upper, (60, robot.nq))
+    seen = set()
+    for q in Q:
+        set_state(s, q)
+        c = checker.clearance(s)
+        assert c == pytest.approx(robot.clearance(q, from_margins=True))
+        assert (c >= 0) == robot.is_valid(q)  # inside a margin (invalid) is negative
+        seen.add(robot.is_valid(q))
+        margins = robot.pair_margins()
+        assert robot.clearance(q) - margins.max() - 1e-12 <= c <= robot.clearance(q) - margins.min() + 1e-12
+    assert seen == {True, False}

@@ -482,10 +482,15 @@ class RobotChecker:
             self.stall_guard.stalled(t, len(Q))
         return ~np.asarray(collides, dtype=bool)
 
-    def clearance(self, q: np.ndarray) -> float:
-        """Smallest distance (m, negative when penetrating) over all checked pairs at q."""
+    def clearance(self, q: np.ndarray, from_margins: bool = False) -> float:
+        """Smallest distance (m, negative when penetrating) over all checked pairs at q; ``from_margins``: of each
+        pair's distance less its margin, the workspace distance to the nearest invalid configuration (OMPL's
+        ``StateValidityChecker.clearance``; negative inside a margin)."""
         q = self.check_config(q)
         k = pin.computeDistances(self.model, self.data, self.gmodel, self._distance_data, q)
+        if from_margins:
+            d = np.fromiter((r.min_distance for r in self._distance_data.distanceResults), float)
+            return float((d - self.pair_margins()).min()) if len(d) else np.inf
         return float(self._distance_data.distanceResults[k].min_distance)
 
     def closest_pair(self, q: np.ndarray) -> tuple[str, str, float]:

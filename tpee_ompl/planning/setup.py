@@ -101,6 +101,13 @@ class RobotValidityChecker(ob.StateValidityChecker):
             return self.robot.is_valid_values(self._read(state).tolist())
         return self.robot.is_valid_values([state[i] for i in self._indices])
 
+    def clearance(self, state: ob.State) -> float:
+        """Workspace distance (m) to the nearest invalid configuration: the closest checked pair's distance less
+        its margin (``RobotChecker.clearance(q, from_margins=True)``); OMPL's ``Benchmark`` averages it over a
+        path's states as the solution clearance (0 for every path without this override)."""
+        q = self._read(state) if self._read is not None else np.array([state[i] for i in self._indices])
+        return self.robot.clearance(q, from_margins=True)
+
     def are_valid(self, Q: np.ndarray) -> np.ndarray:
         """Batched validity of configurations Q (N, nq)."""
         return self.robot.are_valid(Q)
