@@ -164,11 +164,10 @@ class RobotChecker:
         self.lower = self.model.lowerPositionLimit.copy()
         self.upper = self.model.upperPositionLimit.copy()
         self._rebuild_geometry_data()
-        big = np.finfo(float).max
+        big = np.finfo(float).max  # a continuous joint takes any finite angle (inf and NaN fail)
         self.check_lower = np.where(self.circular, -big, self.lower)
-        """:attr:`lower` as the validity checks use it: a continuous joint's is -max float (any finite angle)."""
         self.check_upper = np.where(self.circular, big, self.upper)
-        """:attr:`upper` as the validity checks use it (inf and NaN fail both)."""
+        """:attr:`lower` and :attr:`upper` as the validity checks use them: +/- max float for a continuous joint."""
         self._lower_list = self.check_lower.tolist()
         self._upper_list = self.check_upper.tolist()
         log.debug("loaded %s: %d geometries, %d pairs", files.urdf, self.gmodel.ngeoms, len(self.gmodel.collisionPairs))
@@ -350,8 +349,7 @@ class RobotChecker:
         return bool(self.inside_limits(self.check_config(q)[None])[0])
 
     def inside_limits(self, Q: np.ndarray) -> np.ndarray:
-        """Per row of Q (N, nq), True when inside the joint limits (any finite angle for a continuous joint);
-        no input checks."""
+        """Per row of Q (N, nq), True when inside the joint limits (:meth:`within_limits`); no input checks."""
         return ((Q >= self.check_lower) & (Q <= self.check_upper)).all(axis=-1)
 
     def check_free(self, q: np.ndarray, name: str = "configuration") -> np.ndarray:
