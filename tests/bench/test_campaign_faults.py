@@ -230,3 +230,81 @@ def test_an_interrupt_python_drops_while_plots_are_drawn_still_ends_the_campaign
     (folder,) = tmp_path.iterdir()
     assert code == 130 and f"--resume {folder}" in capsys.readouterr().err
     assert json.loads((folder / "campaign.json").read_text())["interrupted"] is True
+
+
+@pytest.mark.parametrize("stage", ["build_database", "make_plots"])
+def test_a_full_disk_after_the_runs_names_what_was_not_written_and_resume_makes_it(
+        query_file, tmp_path, monkeypatch, capsys, stage):
+    """A database or plots that could not be written said "OperationalError: disk I/O error" or "[Errno 28]" with no
+    file nor folder to resume, and campaign.json said the campaign had finished."""
+    import errno
+
+    from tpee_ompl.bench import campaign, plots
+
+    def no_space(*args, **kwargs):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(*((campaign, "build_database") if stage == "build_database" else (plots, "make_plots")),
+                        no_space)
+    code = main(_one_query_campaign(query_file, tmp_path / "out"))
+    (folder,) = (tmp_path / "out").iterdir()
+    err = capsys.readouterr().err
+    where = "the database" if stage == "build_database" else "the plots"
+    assert code == 1 and err.count("\n") == 1 and "Traceback" not in err
+    assert f"{where} " in err and "No space left on device" in err and f"--resume {folder}" in err
+    assert json.loads((folder / "campaign.json").read_text())["interrupted"] is True
+    monkeypatch.undo()
+    (folder / ".benchmark.db.k3j9.db.part").write_text("x")  # what a process killed while writing leaves
+    (folder / ".benchmark.db.k3j9.db.part-journal").write_text("x")
+    (folder / "plots").mkdir(exist_ok=True)
+    (folder / "plots" / ".fig15_ratios_batched.png.2een.png.part").write_text("x")
+    res = resume_campaign(folder, progress_bar=False)
+    assert res.database is not None and res.plots and not res.interrupted
+    assert json.loads((folder / "campaign.json").read_text())["interrupted"] is False
+    assert not list(folder.glob(".*part*")) and not list((folder / "plots").glob(".*"))  # (.lock stays)
+
+
+def test_a_campaign_whose_first_file_cannot_be_written_leaves_no_folder_that_cannot_be_resumed(
+        query_file, tmp_path, monkeypatch, capsys):
+    import errno
+
+    from tpee_ompl.bench import campaign
+
+    def too_large(*args, **kwargs):
+        raise OSError(errno.EFBIG, "File too large", "campaign.json")
+
+    monkeypatch.setattr(campaign, "write_json", too_large)
+    assert main(_one_query_campaign(query_file, tmp_path / "out")) == 1
+    assert "File too large" in capsys.readouterr().err
+    assert not list((tmp_path / "out").iterdir())
+
+
+def _workers(pid: int) -> list[int]:
+    """The spawned worker processes whose parent is ``pid`` (Linux /proc; not multiprocessing's resource tracker)."""
+    out = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+            spawned = b"spawn_main" in (stat.parent / "cmdline").read_bytes()
+        except OSError:
+            continue
+        if int(fields[1]) == pid and spawned:
+            out.append(int(stat.parent.name))
+    return out
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="/proc and PR_SET_PDEATHSIG are Linux's")
+def test_a_worker_whose_campaign_is_killed_while_it_starts_exits_without_running_its_task(query_file, tmp_path):
+    """A worker asked to die with its parent only after its imports (~1 s): a SIGKILL of the campaign in that
+    window left it running its whole task and writing logs into a campaign no one ran any more."""
+    proc = _launch(query_file, tmp_path)
+    try:
+        _wait_for(lambda: _workers(proc.pid))
+        workers = _workers(proc.pid)
+        proc.kill()  # while the worker still imports
+        proc.wait(timeout=60)
+        _wait_for(lambda: not any(Path(f"/proc/{w}").exists() for w in workers), timeout=120)
+    finally:
+        proc.kill()
+    (directory,) = tmp_path.glob("*_sig")
+    assert not list((directory / "logs").glob("*.log"))  # the orphan ran nothing

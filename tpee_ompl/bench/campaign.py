@@ -26,7 +26,9 @@ import json
 import logging
 import math
 import os
+import shutil
 import socket
+import sqlite3
 import sys
 import time
 from collections.abc import Callable
@@ -202,7 +204,6 @@ def run_campaign(
 def _run_campaign(plan: CampaignPlan, on_task_done, report: bool, progress_bar: bool, executor) -> CampaignResult:
     config, queries = plan.config, plan.queries
     directory = make_results_dir(config.out, config.name)
-    (directory / "logs").mkdir()
     cfg = dataclasses.asdict(config)
     meta = {
         "config": cfg,
@@ -220,7 +221,12 @@ def _run_campaign(plan: CampaignPlan, on_task_done, report: bool, progress_bar: 
         "started_utc": utc_now(),
         "interrupted": True,  # until the campaign ends (a killed campaign stays marked)
     }
-    write_json(directory / "campaign.json", meta)
+    try:
+        (directory / "logs").mkdir()
+        write_json(directory / "campaign.json", meta)
+    except BaseException:  # a folder without campaign.json could not be resumed: leave none
+        shutil.rmtree(directory, ignore_errors=True)
+        raise
     return _execute(directory, meta, executor, on_task_done, report, progress_bar)
 
 
@@ -405,12 +411,26 @@ def _mark_interrupted(directory: Path, meta: dict) -> None:
         write_json(directory / "campaign.json", meta)
 
 
+class CampaignOutputError(RuntimeError):
+    """The campaign's experiments ran, but its database, report or plots could not be written (a full disk,
+    a file-size limit): its logs are kept, ``campaign.json`` says it did not finish, ``--resume`` makes them."""
+
+    def __init__(self, directory: Path, what: str, exc: BaseException) -> None:
+        self.directory = directory
+        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+        super().__init__(f"{what} not written ({reason}); the experiments' logs are kept: make it with --resume "
+                         f"{directory}")
+
+
 def _finish(directory: Path, meta: dict, executor, failed: list[dict], broken: list, interrupted: bool, report: bool,
             wall_time: float) -> CampaignResult:
-    """After the tasks: the database from the finished logs, ``campaign.json``, the report and the plots."""
+    """After the tasks: the database from the finished logs, ``campaign.json``, the report and the plots
+    (:class:`CampaignOutputError` when one cannot be written)."""
     log_dir = directory / "logs"
     for part in log_dir.glob("*.part"):
         part.unlink()
+    for part in (*directory.glob(".*.part*"), *directory.glob("plots/.*.part*")):  # of a process killed writing
+        part.unlink(missing_ok=True)
     logs = sorted(log_dir.glob("*.log"))
     lost_attempts = list(getattr(executor, "lost", []) or [])
     if lost_attempts:
@@ -419,17 +439,25 @@ def _finish(directory: Path, meta: dict, executor, failed: list[dict], broken: l
                  "finished_experiments": len(logs), "wall_time_s": wall_time})
     result = CampaignResult(directory=directory, logs=logs, database=None, interrupted=interrupted,
                             failed_tasks=failed, broken_logs=[p for p, _ in broken])
-    if logs:
-        result.database, result.skipped_logs = build_database(logs, directory / "benchmark.db")
-        meta["corrupt_logs"] = [p.name for p in result.skipped_logs]
-    write_json(directory / "campaign.json", meta)
-    if result.database is not None and report:
-        from . import plots
-        from . import report as rep
+    what = f"the database {directory / 'benchmark.db'}"
+    try:
+        if logs:
+            result.database, result.skipped_logs = build_database(logs, directory / "benchmark.db")
+            meta["corrupt_logs"] = [p.name for p in result.skipped_logs]
+        if result.database is not None and report:
+            from . import plots
+            from . import report as rep
 
-        result.report = rep.write_report(result.database, directory, expected=meta)
-        result.plots = plots.make_plots(result.database, directory / "plots", result.report["planner"],
-                                        result.report["reference"])  # the planners the report compared
+            what = f"the report in {directory}"
+            result.report = rep.write_report(result.database, directory, expected=meta)
+            what = f"the plots in {directory / 'plots'}"
+            result.plots = plots.make_plots(result.database, directory / "plots", result.report["planner"],
+                                            result.report["reference"])  # the planners the report compared
+        what = f"{directory / 'campaign.json'}"
+        write_json(directory / "campaign.json", meta)  # last: it says the campaign finished
+    except (OSError, sqlite3.Error) as exc:
+        _mark_interrupted(directory, meta)
+        raise CampaignOutputError(directory, what, exc) from exc
     return result
 
 

@@ -94,10 +94,11 @@ class InProcessExecutor:
         """Nothing to release: the tasks ran in this process."""
 
 
-def _child_main(fn: TaskFn, task: dict, conn) -> None:
-    """A pool child: run ``fn(task)`` and send ``("ok", result)`` or ``("error", message)`` to the parent."""
+def _child_main(fn: TaskFn, task: dict, conn, parent: int) -> None:
+    """A pool child: run ``fn(task)`` and send ``("ok", result)`` or ``("error", message)`` to the parent
+    (process ``parent``)."""
     child_sigint(signal.SIG_IGN)  # Ctrl-C goes to the parent, which ends us
-    _die_with_parent()
+    _die_with_parent(parent)
     try:
         msg = ("ok", fn(task))
     except BaseException as exc:  # noqa: BLE001 (reported to the parent, which records the task as failed)
@@ -165,7 +166,7 @@ class ProcessPoolExecutor:
 
     def _start(self, ctx, fn: TaskFn, task: dict, attempt: int) -> None:
         recv, send = ctx.Pipe(duplex=False)
-        proc = ctx.Process(target=_child_main, args=(fn, task, send), daemon=True)
+        proc = ctx.Process(target=_child_main, args=(fn, task, send, os.getpid()), daemon=True)
         limit = task.get("time_limit_s")
         # a Ctrl-C now must not reach the child's imports; one held until the block ends finds it registered
         with sigint_blocked_for_children():
@@ -244,13 +245,16 @@ class ProcessPoolExecutor:
 
 
 # --------------------------------------------------------------------------- fresh subprocess per task
-def _die_with_parent() -> None:
-    """Linux: get SIGKILL when the parent (the Dask worker) dies, so no orphan keeps running."""
+def _die_with_parent(parent: int) -> None:
+    """Linux: get SIGKILL when the parent (process ``parent``: the campaign, or the Dask worker) dies, so no orphan
+    keeps running; exit at once when it died already, while this process started (its imports take ~1 s)."""
     if sys.platform.startswith("linux"):
         with contextlib.suppress(Exception):
             import ctypes
 
             ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
+    if os.getppid() != parent:
+        os._exit(1)
 
 
 def run_task_in_subprocess(task: dict, fn_path: str = "tpee_ompl.bench.experiment:run_query_task") -> dict:
@@ -312,7 +316,7 @@ def _run_child(task: dict, fn_path: str) -> dict:
             env["PYTHONPATH"] = os.pathsep.join(extra + [env.get("PYTHONPATH", "")]).rstrip(os.pathsep)
         limit = task.get("time_limit_s")
         proc = subprocess.run(
-            [sys.executable, "-m", "tpee_ompl.bench.executors", fn_path, str(src), str(dst)],
+            [sys.executable, "-m", "tpee_ompl.bench.executors", fn_path, str(src), str(dst), str(os.getpid())],
             env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, check=False,
             timeout=None if limit is None else float(limit),
         )
@@ -325,8 +329,8 @@ def _run_child(task: dict, fn_path: str) -> dict:
 def _subprocess_main(argv: Sequence[str]) -> int:
     import importlib
 
-    _die_with_parent()
-    fn_path, src, dst = argv
+    fn_path, src, dst, parent = argv
+    _die_with_parent(int(parent))
     mod, _, attr = fn_path.partition(":")
     fn = getattr(importlib.import_module(mod), attr)
     result = fn(json.loads(Path(src).read_text()))
