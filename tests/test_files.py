@@ -35,6 +35,17 @@ def test_a_failed_write_names_the_output_not_its_temporary_file(tmp_path):
     assert list(tmp_path.iterdir()) == []
 
 
+def test_a_write_past_a_full_disk_names_the_output(tmp_path):
+    """A failed write() carries no file name: "[Errno 28] No space left on device" named no file."""
+    import errno
+
+    target = tmp_path / "traj.csv"
+    with pytest.raises(OSError) as exc, atomic_path(target):
+        raise OSError(errno.ENOSPC, "No space left on device")
+    assert exc.value.errno == errno.ENOSPC and exc.value.filename == str(target)
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_existing_file_is_not_replaced_without_force(tmp_path):
     target = tmp_path / "r.json"
     target.write_text("keep")

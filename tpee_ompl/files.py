@@ -119,8 +119,10 @@ def atomic_path(path: str | os.PathLike, *, force: bool = True, suffix_last: boo
         else:
             _place_new(tmp, target)
     except OSError as exc:
-        if exc.filename is not None and Path(exc.filename).name.startswith(prefix):
-            # the error names the temporary file: name the file the caller asked for
+        names_temporary = exc.filename is not None and Path(exc.filename).name.startswith(prefix)
+        if names_temporary or exc.filename is None and exc.errno is not None:
+            # the error names the temporary file, or no file (a write past a full disk or `ulimit -f`): name the
+            # file the caller asked for
             raise type(exc)(exc.errno, exc.strerror, str(target)) from exc
         raise
     finally:

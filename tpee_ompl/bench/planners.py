@@ -358,7 +358,8 @@ class RecordingPlanner(ob.Planner):
                 "samples": stats.get("samples", iterations),
                 "best_cost": stats.get("best_cost"),
                 "first_solution_time": stats.get("first_solution_time"),
-                "progress": [(float(t), float(c), None if n is None else int(n)) for t, c, n in stats.get("progress", [])],
+                "progress": [(float(t), float(c), None if n is None else int(n))
+                             for t, c, n in stats.get("progress", [])],
             }
         iterations = inner.numIterations() if hasattr(inner, "numIterations") else None
         best = inner.bestCost().value() if has_cost else None

@@ -4,7 +4,8 @@ Everything is read back from the campaign's SQLite database (Planner Arena forma
 :mod:`tpee_ompl.bench.database`).  A run *succeeds* when its status is an exact solution,
 OMPL's ``correct_solution`` is 1, the raw path starts at the start and ends at the goal
 (``reaches_goal``; OMPL 2.0.1's AORRTC sometimes returns a zero-length path with status "Invalid
-goal" that Benchmark marks solved and the database unsolved, :func:`~tpee_ompl.bench.database.patch_recorded_data`) and every raw-path segment passes ``si.checkMotion``
+goal" that Benchmark marks solved and the database unsolved,
+:func:`~tpee_ompl.bench.database.patch_recorded_data`) and every raw-path segment passes ``si.checkMotion``
 again (``path_valid_dense``).  Failed and missing runs are counted, never dropped silently: the ratio of
 a query is computed only when both planners succeed on it, and ``n`` says how many queries that is.
 """
