@@ -255,6 +255,8 @@ class RobotChecker:
 
     def _rebuild_geometry_data(self) -> None:
         self._ball_screen: BallScreen | None = None
+        M = self._margin_matrix()  # (the model is fixed after loading: computed once)
+        self._pair_margins = np.array([M[cp.first, cp.second] for cp in self.gmodel.collisionPairs])
         self.separated_pairs = tuple(separated_pairs(self))
         """Pairs (``gmodel.collisionPairs`` indices) proven never within their margin, so not checked
         (:func:`~tpee_ompl.model.clearance_balls.separated_pairs`); :meth:`clearance` still measures them."""
@@ -316,8 +318,7 @@ class RobotChecker:
     def pair_margins(self) -> np.ndarray:
         """Per checked pair (``gmodel.collisionPairs`` order), its security margin in metres (shape (P,)):
         a configuration is valid only if every pair's distance is at least its margin."""
-        M = self._margin_matrix()
-        return np.array([M[cp.first, cp.second] for cp in self.gmodel.collisionPairs])
+        return self._pair_margins.copy()
 
     def max_joint_step(self, displacement: float | None = None) -> float:
         """Largest Euclidean joint step that moves no point of the robot more than ``displacement`` (m).
@@ -481,14 +482,13 @@ class RobotChecker:
         return ~np.asarray(collides, dtype=bool)
 
     def clearance(self, q: np.ndarray, from_margins: bool = False) -> float:
-        """Smallest distance (m, negative when penetrating) over all checked pairs at q; ``from_margins``: of each
-        pair's distance less its margin, the workspace distance to the nearest invalid configuration (OMPL's
-        ``StateValidityChecker.clearance``; negative inside a margin)."""
+        """Smallest distance (m, negative when penetrating) over all checked pairs at q; ``from_margins``: of each pair's
+        distance less its margin, the distance to the nearest invalid configuration (OMPL's clearance; < 0 inside one)."""
         q = self.check_config(q)
         k = pin.computeDistances(self.model, self.data, self.gmodel, self._distance_data, q)
         if from_margins:
             d = np.fromiter((r.min_distance for r in self._distance_data.distanceResults), float)
-            return float((d - self.pair_margins()).min()) if len(d) else np.inf
+            return float((d - self._pair_margins).min()) if len(d) else np.inf
         return float(self._distance_data.distanceResults[k].min_distance)
 
     def closest_pair(self, q: np.ndarray) -> tuple[str, str, float]:
