@@ -22,6 +22,8 @@ from tpee_ompl.planning.paths import (
     resample_waypoints,
     set_state,
     state_to_array,
+    straight_segment_counts,
+    unchecked_motion_states,
 )
 from tpee_ompl.planning.setup import make_simple_setup, motion_check_step
 from tpee_ompl.planning.space_layout import RealVectorLayout
@@ -104,6 +106,20 @@ def test_batched_motion_states_are_each_motions_states_bit_for_bit(rng: np.rando
     want = [motion_states(a, b, 0.037) for a, b in zip(A, B)]
     assert counts.tolist() == [len(w) for w in want]
     np.testing.assert_array_equal(S, np.concatenate(want))
+
+
+def test_straight_segment_counts_match_one_motions_count_with_the_factor(rng: np.random.Generator) -> None:
+    D = rng.standard_normal((400, 4)) * rng.choice([1e-4, 0.01, 0.5, 3.0], (400, 1))
+    D[7] = 0.0  # zero length: one segment
+    for factor in (1, 4):
+        want = [len(unchecked_motion_states(np.zeros(4), d, 0.0122, factor=factor)) for d in D]
+        assert straight_segment_counts(D, 0.0122, factor).tolist() == want
+
+
+@pytest.mark.parametrize("bad, error", [(np.inf, OverflowError), (np.nan, ValueError), (1e200, OverflowError)])
+def test_straight_segment_counts_raise_for_a_motion_without_a_count(bad, error) -> None:
+    with np.errstate(over="ignore"), pytest.raises(error):
+        straight_segment_counts(np.array([[0.1, 0.2], [bad, 0.0]]), 0.01)
 
 
 @pytest.mark.parametrize("A, B, step", [

@@ -244,9 +244,18 @@ def batched_motion_states(A: np.ndarray, B: np.ndarray, step: float, factor: int
     return S, n
 
 
+_vecdot = getattr(np, "vecdot", None)  # numpy >= 2: each row's dot product as ``d @ d`` rounds it, in one call
+_EXACT = 2.0**52  # float counts below this convert to int64 exactly
+
+
 def straight_segment_counts(D: np.ndarray, step: float, factor: int = 1) -> np.ndarray:
     """Segments of each straight motion of displacement D[k] (K, n) at ``step``, as :func:`motion_states` counts
-    them (one dot product per motion: the same rounding), times ``factor``.  Not validated (inner loops)."""
+    them (one dot product per motion: the same rounding), times ``factor``.  Not validated (inner loops); a
+    non-finite or astronomically long motion raises as ``math.ceil`` does (ValueError, OverflowError)."""
+    if _vecdot is not None and len(D):
+        q = np.maximum(1.0, np.ceil(np.sqrt(_vecdot(D, D)) / step))
+        if (q * factor < _EXACT).all():
+            return factor * q.astype(np.int64)
     return np.array([factor * max(1, math.ceil(math.sqrt(float(d @ d)) / step)) for d in D], dtype=np.int64)
 
 
@@ -255,9 +264,11 @@ def counted_motion_states(A: np.ndarray, D: np.ndarray, counts: np.ndarray) -> n
     start excluded, its end ``A[k] + D[k]`` included; callers that have the end B[k] put it in that row, as OMPL
     checks the end state itself): :func:`batched_motion_states` once the counts are known.  Not validated (inner
     loops)."""
-    idx = np.repeat(np.arange(len(A)), counts)
-    j = np.arange(int(counts.sum())) - np.repeat(np.cumsum(counts) - counts, counts) + 1
-    return A[idx] + (j / counts[idx])[:, None] * D[idx]
+    if len(counts) == 0:
+        return np.zeros((0, A.shape[-1]))
+    ends = np.cumsum(counts)
+    j = np.arange(1, int(ends[-1]) + 1) - np.repeat(ends - counts, counts)  # 1 .. counts[k] within motion k
+    return np.repeat(A, counts, axis=0) + (j / np.repeat(counts, counts))[:, None] * np.repeat(D, counts, axis=0)
 
 
 def motion_interior_states(
