@@ -217,6 +217,12 @@ def screened_lines_valid(robot: RobotChecker, screen: BallScreen, S: np.ndarray,
     others lie inside it, and so do the states a ball covers.
     """
     offsets = np.cumsum(sizes) - sizes
+    K = len(sizes)
+    if K and sizes.all():  # a motion check's lines (never empty): the common case without masks
+        within = robot.inside_limits(S[np.concatenate((offsets, offsets + sizes - 1))])
+        if (within[:K] & within[K:]).all():
+            return np.array(_blocks_valid(robot, screen, S, offsets.tolist(), sizes.tolist(), spacing.tolist(), step,
+                                          levels))
     live = np.flatnonzero(sizes > 0)
     E = S[np.concatenate((offsets[live], offsets[live] + sizes[live] - 1))]  # first and last states
     within = robot.inside_limits(E)
@@ -237,35 +243,41 @@ def _blocks_valid(robot: RobotChecker, screen: BallScreen, S: np.ndarray, starts
         if not blocks:
             break
         radius = h * step
-        pieces: list[tuple[int, int, int]] = []
-        use: list[int] = []
+        reach = [int(math.floor(radius / sp * (1 + 1e-12))) if sp > 0 else 0 for sp in spacing]  # H per line
+        left: list[tuple[int, int, int]] = []  # pieces with no state to screen at this level
+        screened: list[tuple[int, int, int]] = []
         centres: list[int] = []
         for a, m, k in blocks:
-            sp = spacing[k]
-            H = int(math.floor(radius / sp * (1 + 1e-12))) if sp > 0 else 0
+            H = reach[k]
             if H < 1:
-                pieces.append((a, m, k))
+                left.append((a, m, k))
                 continue
             width = 2 * H + 1
-            for b in range(a, a + m, width):
-                n = min(width, a + m - b)
-                if n >= 3:
-                    use.append(len(pieces))
-                    centres.append(b + (n - 1) // 2)
-                pieces.append((b, n, k))
+            full, rest = divmod(m, width)
+            end = a + full * width
+            for b in range(a, end, width):
+                screened.append((b, width, k))
+                centres.append(b + H)
+            if rest >= 3:
+                screened.append((end, rest, k))
+                centres.append(end + (rest - 1) // 2)
+            elif rest:
+                left.append((end, rest, k))
         if centres:
-            covered = {i for i, ok in zip(use, screen.clear(S[centres], radius).tolist()) if ok}
-            pieces = [p for i, p in enumerate(pieces) if i not in covered]
-        blocks = pieces
+            left += [p for p, ok in zip(screened, screen.clear(S[centres], radius).tolist()) if not ok]
+        blocks = left
     ok = [True] * len(starts)
     if len(blocks) == 1:
         a, m, k = blocks[0]
         ok[k] = bool(robot.collision_free(S[a : a + m]).all())
     elif blocks:
-        bad = ~robot.collision_free(S[np.concatenate([np.arange(a, a + m) for a, m, _ in blocks])])
-        owner = np.repeat([k for *_, k in blocks], [m for _, m, _ in blocks])  # the line of each state
-        for k in set(owner[bad].tolist()):  # not np.unique: its first call imports numpy.ma (~17 ms)
-            ok[k] = False
+        rows: list[int] = []
+        owner: list[int] = []  # the line of each row
+        for a, m, k in blocks:
+            rows.extend(range(a, a + m))
+            owner.extend([k] * m)
+        for i in np.flatnonzero(~robot.collision_free(S[rows])).tolist():
+            ok[owner[i]] = False
     return ok
 
 

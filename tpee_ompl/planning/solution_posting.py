@@ -26,9 +26,10 @@ def without_repeats(W: np.ndarray) -> np.ndarray:
     """The waypoints W without one equal to the waypoint before it (start == goal, or waypoints the released search
     collapsed): OMPL's planners post no zero-length segment, and time parametrisations downstream divide by the
     segment's length.  The path still runs from the first row to the last row's values, with two rows at least."""
-    keep = np.r_[True, np.any(W[1:] != W[:-1], axis=1)]
-    if keep.all():
+    moves = np.any(W[1:] != W[:-1], axis=1)
+    if moves.all():
         return W
+    keep = np.concatenate(([True], moves))
     return W[keep] if keep.sum() >= 2 else W[[0, -1]]
 
 
