@@ -86,10 +86,15 @@ def array_to_path(
     default is :func:`set_state` (RealVector states).  It is given one state for every waypoint in turn
     (the path keeps a copy of each), and the waypoint as an array (n,).
     """
-    write = set_state if write is None else write
+    W = np.asarray(waypoints, dtype=float)
     path = og.PathGeometric(si)
     s = si.allocState()  # one state written for each waypoint: PathGeometric.append keeps a copy
-    for w in np.asarray(waypoints, dtype=float):
+    if write is None:  # RealVector states: each row as plain floats in one slice assignment
+        for w in W.tolist():
+            s[0 : len(w)] = w
+            path.append(s)
+        return path
+    for w in W:
         write(s, w)
         path.append(s)
     return path

@@ -75,8 +75,7 @@ class SampleDraws:
         self._drawn: tuple | None = None
         self._scales = np.zeros(0)
         self._cut: int | None = None  # the offset from which every group's padding is its range_
-        self._floor = min((float(np.min(range_[gi] / (hi - lo))) for gi, (lo, hi) in self._bounds.items()),
-                          default=0.0) * (1 - 1e-12)
+        self._floor: float | None = None  # the smallest scale any padding needs (:meth:`_scale`; only once narrowing)
 
     def _refill(self, k: int) -> None:
         """A fresh buffer of 1024 samples' randomness (one uniform picking narrowed or uniform, then k values)."""
@@ -148,6 +147,9 @@ class SampleDraws:
         while self._cut is None and int(k[-1]) >= (have := len(self._scales)):
             more = range(have, max(2 * have, 128))
             self._scales = np.concatenate((self._scales, [self.narrowing ** (i / _NARROWING_UNIT) for i in more]))
+            if self._floor is None:
+                self._floor = min((float(np.min(self.range_[gi] / (hi - lo))) for gi, (lo, hi) in self._bounds.items()),
+                                  default=0.0) * (1 - 1e-12)
             below = np.flatnonzero(self._scales <= self._floor)
             self._cut = int(below[0]) if len(below) else None
         return self._scales[k if self._cut is None else np.minimum(k, self._cut)]

@@ -199,7 +199,7 @@ class RealVectorLayout:
 
     def to_path(self, si: ob.SpaceInformation, W: np.ndarray) -> og.PathGeometric:
         """An ``og.PathGeometric`` through the waypoints W (K, n)."""
-        return array_to_path(si, W, write=self.write)
+        return array_to_path(si, W) if self.is_plain else array_to_path(si, W, write=self.write)
 
     def from_path(self, path: og.PathGeometric) -> np.ndarray:
         """Waypoints of a geometric path, shape (K, n)."""
