@@ -2,14 +2,18 @@
 
 from __future__ import annotations
 
+import logging
 import math
 
 import numpy as np
 import pytest
 from helpers.wearer_configs import valid_and_colliding
+from ompl import base as ob
+from ompl import geometric as og
 
 from tpee_ompl.model import robot_checker, stall_guard
 from tpee_ompl.model.wearer_arm import WearerArm
+from tpee_ompl.planning.dimension_rrt import DimensionRRT
 from tpee_ompl.planning.grouped_space import GroupedSpace
 from tpee_ompl.planning.search_checker import _COARSE_STRIDE, Checker
 from tpee_ompl.planning.setup import make_simple_setup
@@ -158,3 +162,68 @@ def test_a_candidate_screen_checks_first_where_the_last_screen_found_a_collision
         assert not (again[1][0] and again[2][0])
         found += 1
     assert found >= 5
+
+
+class _DiscsChecker(ob.StateValidityChecker):
+    """A user's checker with the batched call (``are_valid``) beside OMPL's default motion validator."""
+
+    def __init__(self, si: ob.SpaceInformation, centres: np.ndarray, radius: float) -> None:
+        super().__init__(si)
+        self.centres, self.radius = centres, radius
+
+    def are_valid(self, Q: np.ndarray) -> np.ndarray:
+        Q = np.atleast_2d(np.asarray(Q, dtype=float))
+        return (((Q[:, None, :2] - self.centres[None]) ** 2).sum(-1) > self.radius**2).all(axis=1)
+
+    def isValid(self, state: ob.State) -> bool:  # noqa: N802 (OMPL override)
+        return bool(self.are_valid([[state[0], state[1]]])[0])
+
+
+def _discs_setup(factor: int, space: ob.StateSpace | None = None) -> og.SimpleSetup:
+    if space is None:
+        space = ob.RealVectorStateSpace(2)
+        space.setBounds(0.0, 1.0)
+    ss = og.SimpleSetup(space)
+    si = ss.getSpaceInformation()
+    centres = np.random.default_rng(3).uniform(0.15, 0.85, (40, 2))
+    ss._checker = _DiscsChecker(si, centres, 0.012)  # referenced from Python, or it is collected
+    ss.setStateValidityChecker(ss._checker)
+    si.setStateValidityCheckingResolution(0.02)
+    space.setValidSegmentCountFactor(factor)
+    ss.setOptimizationObjective(ob.PathLengthOptimizationObjective(si))
+    return ss
+
+
+@pytest.mark.parametrize("factor", [1, 2, 3])
+def test_interior_states_with_ompls_motion_validator_are_the_ones_it_checks(factor, rng) -> None:
+    """With a user's ``are_valid`` and OMPL's ``DiscreteMotionValidator``, the states the search judges a motion
+    by are OMPL's: ``validSegmentCount`` segments, ``f * ceil(d / L)`` (the search counted ``ceil(d f / L)``)."""
+    ss = _discs_setup(factor)
+    si = ss.getSpaceInformation()
+    si.setup()
+    checker = Checker(si, GroupedSpace(si, [[0], [1]], 7).layout, batch=True)
+    assert checker.batched
+    A, B = rng.uniform(0, 1, (40, 2)), rng.uniform(0, 1, (40, 2))
+    _, idx, _ = checker.interior(A, B)
+    a, b = si.allocState(), si.allocState()
+    for k in range(len(A)):
+        a[0], a[1], b[0], b[1] = *A[k], *B[k]
+        assert np.count_nonzero(idx == k) == si.getStateSpace().validSegmentCount(a, b) - 1
+
+
+def test_no_improvement_is_refused_at_posting_when_the_segment_count_factor_is_not_one(caplog) -> None:
+    """Helper probe, 2026-11-27: with factor 2, 17 of one seed's improvements passed the search's own check and
+    failed ``si.checkMotion`` at posting, and the path ended 23 % longer than without the batched call."""
+    lengths = {}
+    for batch in (True, False):
+        ss = _discs_setup(2)
+        si = ss.getSpaceInformation()
+        a, b = si.allocState(), si.allocState()
+        a[0], a[1], b[0], b[1] = 0.05, 0.05, 0.95, 0.95
+        ss.setStartAndGoalStates(a, b)
+        ss.setPlanner(DimensionRRT(si, groups=[[0], [1]], max_samples=1500, seed=4, batch=batch))
+        with caplog.at_level(logging.WARNING, logger="tpee_ompl"):
+            assert ss.solve(30.0) == ob.PlannerStatus.EXACT_SOLUTION
+        lengths[batch] = ss.getSolutionPath().length()
+    assert "rejected a path the search accepted" not in caplog.text
+    assert lengths[True] == pytest.approx(lengths[False], rel=1e-12)

@@ -277,20 +277,25 @@ def counted_motion_states(A: np.ndarray, D: np.ndarray, counts: np.ndarray) -> n
 
 
 def motion_interior_states(
-    A: np.ndarray, B: np.ndarray, step: float, lengths: np.ndarray | None = None, stride: int = 1
+    A: np.ndarray, B: np.ndarray, step: float, lengths: np.ndarray | None = None, stride: int = 1,
+    counts: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Interior states of the motions A[k] -> B[k] (K, n), as OMPL's discrete motion validator picks them.
 
     Motion k has ``n_k = max(1, ceil(d_k / step))`` segments, ``d_k`` being ``lengths[k]`` (the
-    space's metric; default Euclidean ``|B[k] - A[k]|``).  Returns its interior states
+    space's metric; default Euclidean ``|B[k] - A[k]|``), or ``counts[k]`` when given (OMPL's own
+    ``validSegmentCount``).  Returns its interior states
     ``A[k] + (j / n_k)(B[k] - A[k])``, j = 1 .. n_k - 1 (only the multiples of ``stride``), for all
     motions at once, in motion order: ``(states (M, n), motion index k (M,), step index j (M,))``.
     Neither end is included (unlike :func:`motion_states`).  Not validated: it runs in planners' inner
     loops.
     """
     D = B - A
-    d = np.sqrt((D * D).sum(-1)) if lengths is None else lengths
-    nd = np.maximum(1, np.ceil(d / step)).astype(int).tolist()
+    if counts is not None:
+        nd = np.asarray(counts).tolist()
+    else:
+        d = np.sqrt((D * D).sum(-1)) if lengths is None else lengths
+        nd = np.maximum(1, np.ceil(d / step)).astype(int).tolist()
     js = [np.arange(stride, n, stride) for n in nd]  # a few motions per call: one small arange each
     idx = np.repeat(np.arange(len(A)), [len(x) for x in js])
     j = np.concatenate(js) if js else np.zeros(0, dtype=int)

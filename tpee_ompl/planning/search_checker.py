@@ -68,6 +68,7 @@ class Checker:
         are_valid = getattr(svc, "are_valid", None)
         self.step: float | None = None
         self.euclid = True
+        self._ompl_counts = False
         if batch and callable(are_valid):
             factor = max(1, int(si.getStateSpace().getValidSegmentCountFactor()))
             if isinstance(getattr(mv, "step", None), float) and callable(getattr(mv, "check_motions", None)):
@@ -76,6 +77,8 @@ class Checker:
             elif type(mv) is ob.MotionValidator:  # the C++ default, DiscreteMotionValidator
                 self.step = float(si.getStateSpace().getLongestValidSegmentLength()) / factor
                 self.euclid = layout.is_plain
+                # its verdicts are the interior states (:meth:`interior`): the motion validator's own count
+                self._ompl_counts = True
         self.batched = self.step is not None
         self._are_valid = are_valid if self.batched else None
         first_invalid = getattr(svc, "first_invalid", None)
@@ -195,10 +198,24 @@ class Checker:
         SO2 entries move the short way round and are wrapped into [-pi, pi), as ``SO2StateSpace``
         interpolates."""
         lay = self.layout
+        counts = self._segment_counts(A, B) if self._ompl_counts else None
         if not lay.has_circular:
-            return motion_interior_states(A, B, self._coarse_step, None if self.euclid else lay.distance(A, B), stride)
-        S, idx, j = motion_interior_states(A, A + lay.delta(A, B), self._coarse_step, lay.distance(A, B), stride)
+            return motion_interior_states(A, B, self._coarse_step, None if self.euclid else lay.distance(A, B), stride,
+                                          counts)
+        S, idx, j = motion_interior_states(A, A + lay.delta(A, B), self._coarse_step, lay.distance(A, B), stride,
+                                           counts)
         return lay.wrap(S), idx, j
+
+    def _segment_counts(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
+        """OMPL's ``validSegmentCount`` of each motion A[k] -> B[k]: the segments ``DiscreteMotionValidator`` checks
+        (``f * ceil(d / L)``, the most any subspace needs in a compound space); asked of the space itself."""
+        space, lay, s1, s2 = self.si.getStateSpace(), self.layout, self._s1, self._s2
+        out = np.empty(len(A), dtype=np.int64)
+        for k in range(len(A)):
+            lay.write(s1, A[k])
+            lay.write(s2, B[k])
+            out[k] = space.validSegmentCount(s1, s2)
+        return out
 
     def coarse(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
         """Whether every 16th interior state of the motions A[k] -> B[k] is valid (one batched call, or
