@@ -176,3 +176,64 @@ def test_a_prescribed_so2_row_is_wrapped_into_the_circle_not_refused() -> None:
     got = planner.prescribed[0][:, 0]
     assert np.all((got >= -np.pi) & (got < np.pi))
     np.testing.assert_allclose(np.mod(got - np.array(row) + np.pi, 2 * np.pi) - np.pi, 0.0, atol=1e-12)
+
+
+def _free_so2_pair() -> og.SimpleSetup:
+    """Two continuous joints, no obstacles, from (2.9, 0) to (-2.9, 0.5): the short way round crosses +-pi."""
+    space = ob.CompoundStateSpace()
+    for _ in range(2):
+        space.addSubspace(ob.SO2StateSpace(), 1.0)
+    ss = og.SimpleSetup(space)
+    si = ss.getSpaceInformation()
+    ss.setStateValidityChecker(lambda s: True)
+    ss.setOptimizationObjective(ob.PathLengthOptimizationObjective(si))
+    a, b = si.allocState(), si.allocState()
+    a[0].value, a[1].value, b[0].value, b[1].value = 2.9, 0.0, -2.9, 0.5
+    ss.setStartAndGoalStates(a, b)
+    return ss
+
+
+def test_a_first_guess_with_an_so2_angle_of_plus_pi_is_taken_as_minus_pi_and_its_paths_are_posted() -> None:
+    """atan2 returns +pi, which SO2StateSpace's bounds refuse: the guess was accepted as given and every path
+    through it refused at posting (TIMEOUT on a free space; helper review, 2026-11-27)."""
+    ss = _free_so2_pair()
+    t = np.linspace(2.9, 2 * np.pi - 2.9, 7)
+    j0 = np.arctan2(np.sin(t), np.cos(t))
+    j0[3] = np.pi
+    guess = np.column_stack([j0, [0.0, 0.3, 0.6, 0.7, 0.6, 0.55, 0.5]])
+    planner = DimensionRRT(ss.getSpaceInformation(), groups=[[0], [1]], max_samples=300, seed=0,
+                           initial_waypoints=guess)
+    ss.setPlanner(planner)
+    assert ss.solve(10.0) == ob.PlannerStatus.EXACT_SOLUTION
+    assert planner.last_run_stats()["solutions_posted"] >= 1
+    assert path_passes_motion_checks(ss.getSpaceInformation(), ss.getSolutionPath(), in_bounds=True)
+
+
+@pytest.mark.parametrize("given", ["prescribed", "initial_waypoints"])
+def test_waypoints_within_rounding_of_a_bound_are_put_on_it_and_paths_through_them_are_posted(given) -> None:
+    """A row 5e-13 above the bound passed the planner's tolerance, but si.satisfiesBounds refused every path along
+    it: TIMEOUT after the whole budget (helper review, 2026-11-27)."""
+    space = ob.RealVectorStateSpace(2)
+    space.setBounds(0.0, 1.0)
+    ss = og.SimpleSetup(space)
+    si = ss.getSpaceInformation()
+    ss.setStateValidityChecker(lambda s: True)
+    ss.setOptimizationObjective(ob.PathLengthOptimizationObjective(si))
+    _ends(ss, [0.1, 1.0], [0.9, 1.0])
+    row = np.array([1.0, 0.8, 0.6, 1.0 + 5e-13, 0.6, 0.8, 1.0])
+    if given == "prescribed":
+        planner = DimensionRRT(si, groups=[[1], [0]], prescribed={0: row[:, None]}, max_samples=300, seed=0)
+        assert planner.prescribed[0].max() == 1.0
+    else:
+        guess = np.column_stack([np.linspace(0.1, 0.9, 7), row])
+        planner = DimensionRRT(si, groups=[[0], [1]], max_samples=300, seed=0, initial_waypoints=guess)
+    ss.setPlanner(planner)
+    assert ss.solve(10.0) == ob.PlannerStatus.EXACT_SOLUTION
+    assert path_passes_motion_checks(si, ss.getSolutionPath(), in_bounds=True)
+
+
+def test_a_prescribed_row_refused_for_the_bounds_names_the_value_in_full() -> None:
+    ss, si = _box()
+    row = [-0.8, -0.5, 0.0, 1.0 + 1e-9, 0.0, 0.5, 0.8]
+    with pytest.raises(ValueError, match=r"DOF 0 = 1\.000000001\d* is outside \[-1, 1\]"):
+        DimensionRRT(si, groups=[[0], [1]], prescribed={0: row})

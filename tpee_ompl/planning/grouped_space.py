@@ -148,7 +148,9 @@ def validate_prescribed(
             if out_of.any():
                 t, j = (int(v) for v in np.argwhere(out_of)[0])
                 raise ValueError(f"prescribed trajectory of group {int(key)} leaves the space's bounds: step {t}, "
-                                 f"DOF {dims[j]} = {arr[t, j]:g} is outside [{lower[dims[j]]:g}, {upper[dims[j]]:g}]")
+                                 f"DOF {dims[j]} = {float(arr[t, j])!r} is outside [{lower[dims[j]]:g}, "
+                                 f"{upper[dims[j]]:g}]")
+            arr = np.clip(arr, lower[dims], upper[dims])  # within _BOUND_TOL: on the bound, where OMPL accepts it
         arr.setflags(write=False)
         out[int(key)] = arr
     return out
@@ -245,9 +247,10 @@ class GroupedSpace:
             raise ValueError(f"initial_waypoints must have shape ({self.h}, {layout.n}), got {arr.shape}")
         if not np.all(np.isfinite(arr)):
             raise ValueError("initial_waypoints contains NaN or inf")
+        arr = layout.wrap(arr)  # SO2 values into [-pi, pi), as the space keeps them (atan2 gives +pi)
         if np.any(arr < layout.lower - _BOUND_TOL) or np.any(arr > layout.upper + _BOUND_TOL):
             raise ValueError("initial_waypoints lie outside the state space bounds")
-        return arr
+        return np.clip(arr, layout.lower, layout.upper)  # within _BOUND_TOL: on the bound, where OMPL accepts it
 
     def endpoint_mismatch(self, start: np.ndarray, goal: np.ndarray, tol: float = 1e-6) -> str | None:
         """None if start/goal lie on every prescribed trajectory, else "start" or "goal"."""

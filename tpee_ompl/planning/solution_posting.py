@@ -99,4 +99,5 @@ class SolutionPoster:
             self.notify(path, cost)
         else:
             log.warning("DimensionRRT: si.checkMotion or the bounds rejected a path the search accepted; not reported")
+            self.found_cost = self.best_cost  # not found after all: the loop must not stop on its cost
         self._spent += time.perf_counter() - t
