@@ -216,8 +216,10 @@ def screened_lines_valid(robot: RobotChecker, screen: BallScreen, S: np.ndarray,
     limits is invalid at once (as in ``are_valid``); the joint box is convex, so the states of the
     others lie inside it, and so do the states a ball covers.
     """
-    offsets = np.cumsum(sizes) - sizes
     K = len(sizes)
+    if K == 1:  # one motion (a compound space's si.checkMotion)
+        return np.array([_one_motion_valid(robot, screen, S[: int(sizes[0])], step, levels, float(spacing[0]))])
+    offsets = np.cumsum(sizes) - sizes
     if K and sizes.all():  # a motion check's lines (never empty): the common case without masks
         within = robot.inside_limits(S[np.concatenate((offsets, offsets + sizes - 1))])
         if (within[:K] & within[K:]).all():
@@ -281,10 +283,30 @@ def _blocks_valid(robot: RobotChecker, screen: BallScreen, S: np.ndarray, starts
     return ok
 
 
+PROBES = 2
+"""States of a single motion checked plainly before its screen, as OMPL's ``DiscreteMotionValidator`` starts: its end,
+then the middle, ... (bisection), up to the first invalid one.  A colliding motion is mostly found there; a free one
+pays these checks on top of its screen."""
+
+
+def _probe_rows(n: int, k: int) -> list[int]:
+    """The first ``k`` of a motion's n states in the order OMPL checks them: the last (the end state), then the
+    middles of the rest, breadth first."""
+    rows, spans = [n - 1], [(0, n - 2)]
+    while len(rows) < min(k, n) and spans:
+        lo, hi = spans.pop(0)
+        if lo <= hi:
+            mid = (lo + hi) // 2
+            rows.append(mid)
+            spans += [(lo, mid - 1), (mid + 1, hi)]
+    return rows
+
+
 def _one_motion_valid(robot: RobotChecker, screen: BallScreen, S: np.ndarray, step: float,
-                      levels: tuple[float, ...]) -> bool:
+                      levels: tuple[float, ...], spacing: float | None = None) -> bool:
     """:func:`screened_all_valid` for one chunk (``si.checkMotion``'s case, once per motion): the limit test
-    on its two ends without building arrays, then :func:`_blocks_valid`."""
+    on its two ends without building arrays, :data:`PROBES` states plainly, then :func:`_blocks_valid`.
+    ``spacing``: of the states along the (unwrapped) line, when S[1] - S[0] is not it (wrapped SO2 values)."""
     n = len(S)
     if n == 0:
         return True
@@ -292,5 +314,8 @@ def _one_motion_valid(robot: RobotChecker, screen: BallScreen, S: np.ndarray, st
     lower, upper = robot.check_lower, robot.check_upper
     if not ((S[0] >= lower).all() and (S[0] <= upper).all() and (S[-1] >= lower).all() and (S[-1] <= upper).all()):
         return False
-    spacing = math.sqrt(float((S[1] - S[0]) @ (S[1] - S[0]))) if n > 1 else 0.0
+    if PROBES and robot.first_invalid(S[_probe_rows(n, PROBES)]) >= 0:
+        return False
+    if spacing is None:
+        spacing = math.sqrt(float((S[1] - S[0]) @ (S[1] - S[0]))) if n > 1 else 0.0
     return _blocks_valid(robot, screen, S, [0], [n], [spacing], step, levels)[0]
