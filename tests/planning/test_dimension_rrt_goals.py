@@ -244,3 +244,15 @@ def test_bad_max_goals_is_refused_naming_it(value) -> None:
     ss = _point_setup()
     with pytest.raises(ValueError, match="max_goals"):
         DimensionRRT(ss.getSpaceInformation(), max_goals=value)
+
+
+def test_a_termination_condition_true_before_a_valid_goal_is_drawn_is_a_timeout_not_an_invalid_goal() -> None:
+    """Helper review, 2026-11-27: GoalStates with an invalid first state and a valid second, solved with a condition
+    already true: INVALID_GOAL (RRTConnect: TIMEOUT); the goal was fine, the drawing had stopped."""
+    ss = _point_setup()
+    ss.setGoal(_goal_states(ss, [(0.5, 0.5), (0.2, 0.9)]))  # inside the wall, then free
+    for planner in (og.RRTConnect(ss.getSpaceInformation()), DimensionRRT(ss.getSpaceInformation(), seed=1)):
+        ss.clear()
+        ss.setPlanner(planner)
+        ss.setup()
+        assert planner.solve(ob.PlannerTerminationCondition(lambda: True)) == ob.PlannerStatus.TIMEOUT

@@ -89,7 +89,7 @@ def goal_states(planner: PythonPlanner, ptc: ob.PlannerTerminationCondition, max
     keeps the ``max_goals`` nearest, so below that cap the choice does not depend on OMPL's rotating sample
     position; a ``GoalLazySamples`` holding none yet: its first waited for until ``ptc``).  Any other
     ``GoalSampleableRegion``: the first ``max_goals`` valid states drawn from it (with OMPL's random
-    numbers, not the planner's seed); INVALID_GOAL when none is found.  Another goal type: UNRECOGNIZED_GOAL_TYPE, with an error naming it."""
+    numbers, not the planner's seed); INVALID_GOAL when none is found, TIMEOUT when ``ptc`` stopped the drawing first.  Another goal type: UNRECOGNIZED_GOAL_TYPE, with an error naming it."""
     goal = planner.getProblemDefinition().getGoal()
     if isinstance(goal, ob.GoalState):
         state = planner._goal_state()
@@ -115,6 +115,8 @@ def goal_states(planner: PythonPlanner, ptc: ob.PlannerTerminationCondition, max
         if state is not None and finite_state(si, state):
             states[b""] = read(state)
     if not states:
+        if ptc() and pis.haveMoreGoalStates() and tries < _GOAL_TRIES * want:  # stopped drawing, not out of goals
+            return planner_status(ob.PlannerStatus.TIMEOUT)
         log.error("%s: no valid goal state could be drawn from the goal region", planner.getName())
         return planner_status(ob.PlannerStatus.INVALID_GOAL)
     return list(states.values())
