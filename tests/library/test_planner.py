@@ -146,6 +146,8 @@ def test_bad_settings_raise_value_error_naming_them(robot, library, kwargs, matc
 @pytest.mark.parametrize(("kwargs", "match"), [
     ({"groups": [[0, 1], [2]]}, "DOF"),  # DOF 3 in no group
     ({"range_": [0.1, 0.1]}, "range_"),
+    ({"h": 9}, "h must be 7"),  # these two were accepted and every planned solve dropped Table 3's row (helper review)
+    ({"groups": [[2, 3], [0, 1]]}, r"first group must be \[0, 1\]"),
 ])
 def test_settings_the_refining_planner_would_refuse_are_refused_when_the_pipeline_is_made(robot, library, kwargs,
                                                                                           match):
@@ -364,3 +366,25 @@ def test_of_several_start_states_the_pipeline_says_once_which_it_plans_from(robo
         assert ss.solve(5.0) == ob.PlannerStatus.EXACT_SOLUTION
     assert planner.last_run_stats()["samples"] > 0
     assert caplog.text.count("the first valid of the 2 given") == 1
+
+
+def test_bounds_locked_after_the_pipeline_was_made_keep_its_posted_path_exact(robot, library):
+    """Helper review, 2026-11-27: DOF4's bounds narrowed to one value after construction; the free direct motion was
+    posted, then building the refining planner raised, and the solve said CRASH beside an exact path."""
+    rng = np.random.default_rng(0)
+    s, g = _query(robot, 3, 4, 5)
+    g[3] = s[3]
+    while not robot.is_valid(g):
+        g[2] = rng.uniform(robot.lower[2], robot.upper[2])
+    ss = make_simple_setup(robot, s, g)
+    planner = LibraryDimensionRRT(ss.getSpaceInformation(), library, max_samples=50, seed=0)
+    ss.setPlanner(planner)
+    ss.setup()
+    old, bounds = ss.getStateSpace().getBounds(), ob.RealVectorBounds(4)
+    for k in range(4):
+        bounds.setLow(k, float(s[3]) if k == 3 else old.low[k])
+        bounds.setHigh(k, float(s[3]) if k == 3 else old.high[k])
+    ss.getStateSpace().setBounds(bounds)
+    assert ss.solve(5.0) == ob.PlannerStatus.EXACT_SOLUTION and "error" not in planner.last_run_stats()
+    assert planner.last_run_stats()["library_outcome"] == "straight"
+    assert path_passes_motion_checks(ss.getSpaceInformation(), ss.getSolutionPath(), in_bounds=True)

@@ -28,7 +28,7 @@ from ..model.sectors import check_sector, infer_sector, posture_preset
 from ..planning.dimension_rrt import RELEASE_AFTER, DimensionRRT, DimensionRRTOptions, shortcuts_on
 from ..planning.paths import array_to_path, path_passes_motion_checks, state_to_array
 from ..planning.planner_base import PythonPlanner, check_space_information, planner_status, problem_objective
-from ..planning.tpee import tpee_dimension_rrt
+from ..planning.tpee import tpee_dimension_rrt, tpee_options
 from ..validation import sub_seed
 from .path_library import PathLibrary
 
@@ -98,6 +98,7 @@ class LibraryDimensionRRT(PythonPlanner):
             raise ValueError(f"options must be a DimensionRRTOptions, got {type(opts).__name__}")
         opts = dataclasses.replace(opts, name=name, **overrides)
         DimensionRRT.checked_setup(si, opts)  # the refining planner is built at solve time: its settings are checked now
+        tpee_options(opts)  # groups and h that tpee_dimension_rrt refuses at solve time, refused now
         super().__init__(si, name)
         self.library = library
         self.pair = pair
@@ -241,7 +242,12 @@ class LibraryDimensionRRT(PythonPlanner):
                                            and seed.shape[0] == self.options.h else None)
             except ValueError as e:  # e.g. a space whose bounds the Table 3 row leaves
                 log.warning("LibraryDimensionRRT: planned over every DOF, without Table 3's row: %s", e)
-        inner = DimensionRRT(si, opts) if inner is None else inner
+        if inner is None:
+            try:
+                inner = DimensionRRT(si, opts)
+            except ValueError as e:  # e.g. bounds changed since this planner was made: a DOF of zero width
+                log.error("LibraryDimensionRRT: no refinement: %s", e)
+                return planner_status(ob.PlannerStatus.EXACT_SOLUTION if have_exact else ob.PlannerStatus.ABORT)
         inner._say_start_choice = not read_ends  # noqa: SLF001 (the pipeline said which start it took)
         inner.setProblemDefinition(pdef)
         self._inner = inner

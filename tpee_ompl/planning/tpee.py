@@ -15,7 +15,7 @@ from ..model.sectors import cross_sector_trajectory
 from .dimension_rrt import DimensionRRT, DimensionRRTOptions
 from .dimension_rrt_options import resolve_options
 
-__all__ = ["tpee_dimension_rrt"]
+__all__ = ["tpee_dimension_rrt", "tpee_options"]
 
 
 def tpee_dimension_rrt(
@@ -39,14 +39,22 @@ def tpee_dimension_rrt(
         Groups whose first group is not DOF1/DOF2 (``[0, 1]``, the row Table 3 prescribes), or ``h``
         other than the row's 7 steps (``max_h`` may raise it during the search).
     """
+    row = cross_sector_trajectory(from_sector, to_sector)
+    return DimensionRRT(si, tpee_options(options, **overrides), prescribed={0: row}, initial_waypoints=initial_waypoints)
+
+
+def tpee_options(options: DimensionRRTOptions | None = None, **overrides: Any) -> DimensionRRTOptions:
+    """The options :func:`tpee_dimension_rrt` plans with: ``options`` with the overrides, groups ``[[0, 1], [2, 3]]``
+    when none are given; ValueError (as there) for a first group other than ``[0, 1]`` or ``h`` other than Table 3's
+    steps.  The library pipeline checks its settings with it when it is made."""
     if overrides.get("groups", options.groups if options is not None else None) is None:
         overrides["groups"] = ((0, 1), (2, 3))
     opts = resolve_options(options, overrides)
     if list(opts.groups[0]) != [0, 1]:
         raise ValueError(f"groups: Table 3 prescribes DOF1/DOF2, so the first group must be [0, 1], got "
                          f"{[list(g) for g in opts.groups]} (DimensionRRT plans other groupings without the rows)")
-    row = cross_sector_trajectory(from_sector, to_sector)
-    if opts.h != len(row):
-        raise ValueError(f"h must be {len(row)} for the wearer arm (Table 3's rows have {len(row)} fake-time steps), "
+    steps = len(cross_sector_trajectory(1, 2))  # every row of Table 3 has as many
+    if opts.h != steps:
+        raise ValueError(f"h must be {steps} for the wearer arm (Table 3's rows have {steps} fake-time steps), "
                          f"got {opts.h}; max_h lets the search raise it")
-    return DimensionRRT(si, opts, prescribed={0: row}, initial_waypoints=initial_waypoints)
+    return opts
