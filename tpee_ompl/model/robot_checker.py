@@ -294,9 +294,7 @@ class RobotChecker:
         revolute joint (an upper bound on the distance from its axis to any point it moves), 1 for a
         prismatic joint.  Points: every geometry (its bounding sphere) and the ``extra_points`` frames.
 
-        Used to bound how far the robot can move for a given joint step (see :meth:`max_joint_step`).
-        The model is fixed after loading, so this is computed once.
-        """
+        Used to bound how far the robot can move for a given joint step (see :meth:`max_joint_step`); computed once."""
         if self._lever_arms is None:
             self._lever_arms = joint_lever_arms(self.model, self.gmodel, self._extra_frames)
         return self._lever_arms.copy()
@@ -323,9 +321,8 @@ class RobotChecker:
     def max_joint_step(self, displacement: float | None = None) -> float:
         """Largest Euclidean joint step that moves no point of the robot more than ``displacement`` (m).
 
-        A step dq moves any point at most sum_i |dq_i| r_i <= ||dq||_2 ||r||_2 (Cauchy-Schwarz),
-        with r the lever arms.  Default displacement: the security margin.
-        """
+        A step dq moves any point at most sum_i |dq_i| r_i <= ||dq||_2 ||r||_2 (Cauchy-Schwarz), with r the lever
+        arms.  Default displacement: the security margin."""
         if displacement is None:
             if not self.security_margin > 0:
                 raise ValueError("security_margin is 0: a zero margin gives no motion-check guarantee (no step moves "
@@ -362,7 +359,9 @@ class RobotChecker:
             raise ValueError(f"{name}: {exc}") from None
         shown = f"[{', '.join(f'{v:.4g}' for v in q)}]"
         if not self.within_limits(q):
-            raise ValueError(f"{name} {shown} is outside the joint limits")
+            k = int(np.flatnonzero((q < self.check_lower) | (q > self.check_upper))[0])
+            raise ValueError(f"{name} {shown} is outside the joint limits: {self.joint_names[k]} = {q[k]:.6g} is "
+                             f"outside [{self.lower[k]:.6g}, {self.upper[k]:.6g}]")
         if not self.is_valid(q):
             a, b, d = self.closest_pair(q)
             hint = ("; neighbouring links: if they always touch, disable the pair in the SRDF"
