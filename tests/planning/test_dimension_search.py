@@ -278,6 +278,20 @@ def test_a_block_of_connect_samples_ends_when_stop_says_so() -> None:
     assert search.iterate(64) == 0 and search.samples == 69
 
 
+def test_fitting_a_long_connect_path_to_the_steps_stops_when_stop_says_so() -> None:
+    """A helper's maze (2026-11-27): fitting a 184-point path to 7 steps took ~25,000 checks past the budget."""
+    si, _ = box_problem(lo=(-0.05, -1.0), hi=(0.05, 0.5))  # a wall with a gap at the top
+    grouped = GroupedSpace(si, [[0, 1]], 7)
+    search = Search(grouped, Checker(si, grouped.layout, False), np.random.default_rng(0),
+                    np.array([-0.8, 0.0]), np.array([0.8, 0.0]),
+                    settings=SearchSettings(narrow_after=50, narrowing=0.5), range_={0: np.full(2, 0.02)})
+    P = np.column_stack([np.linspace(-0.8, 0.8, 40), np.r_[np.linspace(0.0, 0.8, 20), np.linspace(0.8, 0.0, 20)]])
+    before = search.checker.counter()
+    assert not search._fit(P, lambda: True)
+    assert search.checker.counter() == before and search.unfitted is P  # no shortcut checked; kept for a higher h
+    assert search._fit(P, lambda: False)  # the same path fits when nothing stops it
+
+
 class _ThinWalls(ob.StateValidityChecker):
     """3-D box with three thin walls across x (boxes invalid inside)."""
 

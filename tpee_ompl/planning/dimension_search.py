@@ -203,7 +203,7 @@ class Search(SampleDraws):
             self._known[key] = True
             self.checker.passed.add(key)
         self._connect = None
-        return int(self._fit(P))
+        return int(self._fit(P, stop))
 
     def _seed_path(self, P: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The polyline P (K, n) at h evenly spaced points, with their validity and their motions'."""
@@ -221,17 +221,21 @@ class Search(SampleDraws):
             self._known[W[k : k + 2].tobytes()] = bool(E[k])
         return W, V, E
 
-    def _fit(self, P: np.ndarray) -> bool:
+    def _fit(self, P: np.ndarray, stop: Callable[[], bool] | None = None) -> bool:
         """Take the turning points P (K, n) from start to goal as the path when they fit the h steps.
 
         While K > h, the interior point whose shortcut saves most and passes in full is dropped; the
         runs are checked as whole motions and the path adopted with its points held (:meth:`_adopt`).
-        False when more points than steps remain or a run fails as one motion; :attr:`unfitted` then
-        holds the points, for a higher h or the layered trees."""
+        False when more points than steps remain, a run fails as one motion or ``stop()`` (asked before each
+        shortcut's check: a long path costs up to K^2 of them); :attr:`unfitted` then holds the points, for a
+        higher h or the layered trees."""
         h, dist = self.g.h, self.dist
         while len(P) > h:
             gain = dist(P[:-2], P[1:-1]) + dist(P[1:-1], P[2:]) - dist(P[:-2], P[2:])
             for i in (np.argsort(-gain, kind="stable") + 1).tolist():
+                if stop is not None and stop():
+                    self.unfitted = P
+                    return False
                 if not self._check_segments(P[[i - 1, i + 1]]):
                     P = np.delete(P, i, axis=0)
                     break
