@@ -96,3 +96,19 @@ def test_bad_max_h_is_refused(bad) -> None:
     space.setBounds(-1.0, 1.0)
     with pytest.raises(ValueError, match="max_h"):
         DimensionRRT(ob.SpaceInformation(space), max_h=bad)
+
+
+def test_h_is_not_raised_while_the_connect_trees_have_not_met() -> None:
+    """Helper review, 2026-11-27: every 500 samples without a path raised h and started the connect trees again, on a
+    2-D maze up to h = 8193 (h only matters once the trees met and their path is fitted to the steps)."""
+    space = ob.RealVectorStateSpace(2)
+    space.setBounds(-1.0, 1.0)
+    ss = og.SimpleSetup(space)
+    ss.setStateValidityChecker(lambda s: not -0.05 < s[0] < 0.05)  # a full wall: the trees never meet
+    si = ss.getSpaceInformation()
+    a, b = si.allocState(), si.allocState()
+    a[0], a[1], b[0], b[1] = -0.9, 0.0, 0.9, 0.0
+    ss.setStartAndGoalStates(a, b)
+    planner, status = _solve(ss, h=3, max_h=10_000, max_samples=2500)
+    assert status == ob.PlannerStatus.TIMEOUT
+    assert planner.last_run_stats()["h"] == 3 and planner.last_run_stats()["samples"] == 2500

@@ -95,6 +95,11 @@ class Search(SampleDraws):
         return bool(self.V.all() and self.E.all())
 
     @property
+    def connecting(self) -> bool:
+        """Whether the connect trees are growing (a higher h would only start them again: h matters once they met)."""
+        return self._connect is not None
+
+    @property
     def trees(self) -> LayeredTrees | None:
         """The feasibility phase's layered trees while they grow (else None): for inspection only."""
         return self._tree

@@ -29,7 +29,8 @@ __all__ = ["GoalLoop", "LoopLimits", "NewSearch"]
 log = logging.getLogger("tpee_ompl.planning.dimension_rrt")
 
 REFINE_AFTER = 500
-"""Samples without a first path after which ``h`` is raised (when ``max_h`` allows; see "Raising h")."""
+"""Samples without a first path after which ``h`` is raised (when ``max_h`` allows, not while the connect trees
+grow; see "Raising h")."""
 PROGRESS_PERIOD = 0.01
 """Seconds between progress-trace entries (OMPL's benchmark records progress about as often)."""
 PASS_BATCH = 64
@@ -105,7 +106,7 @@ class GoalLoop:
             run.stopped = True  # converged: nothing shorter in the last ``stall`` samples
             return not all(r.stopped for r in self.runs)
         elif (not search.valid and 2 * run.grouped.h - 1 <= self.limits.max_h
-              and (search.samples >= REFINE_AFTER or search.unfitted is not None)):
+              and ((search.samples >= REFINE_AFTER and not search.connecting) or search.unfitted is not None)):
             self._raise_h(run)
         else:
             self._pass(run, ptc)
