@@ -73,8 +73,8 @@ def single_motions(probes: int) -> None:
             for k, (v, c, t) in res.items():
                 assert (np.array(v) == ok).all(), "the verdicts differ"
                 c, t = np.array(c), np.array(t)
-                line += (f"  probes {k}: {c[~ok].mean():5.1f} / {c[ok].mean():5.1f} checks, {1e3 * t[~ok].mean():5.2f} / "
-                         f"{1e3 * t[ok].mean():5.2f} ms")
+                line += (f"  probes {k}: {c[~ok].mean():5.1f} / {c[ok].mean():5.1f} checks, "
+                         f"{1e3 * t[~ok].mean():5.2f} / {1e3 * t[ok].mean():5.2f} ms")
             print(line, flush=True)
 
 

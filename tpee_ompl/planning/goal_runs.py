@@ -89,7 +89,8 @@ def goal_states(planner: PythonPlanner, ptc: ob.PlannerTerminationCondition, max
     keeps the ``max_goals`` nearest, so below that cap the choice does not depend on OMPL's rotating sample
     position; a ``GoalLazySamples`` holding none yet: its first waited for until ``ptc``).  Any other
     ``GoalSampleableRegion``: the first ``max_goals`` valid states drawn from it (with OMPL's random
-    numbers, not the planner's seed); INVALID_GOAL when none is found, TIMEOUT when ``ptc`` stopped the drawing first.  Another goal type: UNRECOGNIZED_GOAL_TYPE, with an error naming it."""
+    numbers, not the planner's seed); INVALID_GOAL when none is found, TIMEOUT when ``ptc`` stopped the drawing
+    first.  Another goal type: UNRECOGNIZED_GOAL_TYPE, with an error naming it."""
     goal = planner.getProblemDefinition().getGoal()
     if isinstance(goal, ob.GoalState):
         state = planner._goal_state()

@@ -40,7 +40,8 @@ def tpee_dimension_rrt(
         other than the row's 7 steps (``max_h`` may raise it during the search).
     """
     row = cross_sector_trajectory(from_sector, to_sector)
-    return DimensionRRT(si, tpee_options(options, **overrides), prescribed={0: row}, initial_waypoints=initial_waypoints)
+    return DimensionRRT(si, tpee_options(options, **overrides), prescribed={0: row},
+                        initial_waypoints=initial_waypoints)
 
 
 def tpee_options(options: DimensionRRTOptions | None = None, **overrides: Any) -> DimensionRRTOptions:
