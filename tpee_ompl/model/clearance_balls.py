@@ -189,22 +189,24 @@ class BallScreen:
 
 
 def screened_all_valid(robot: RobotChecker, screen: BallScreen, chunks: list[np.ndarray], step: float,
-                       levels: tuple[float, ...] = SCREEN_LEVELS) -> np.ndarray:
+                       levels: tuple[float, ...] = SCREEN_LEVELS, probes: int = 0) -> np.ndarray:
     """Per chunk (the dense states of one straight motion, evenly spaced along it), True iff every
     state of it is valid: the same answer as ``robot.are_valid(chunk).all()``, with fewer checks
-    (:func:`screened_lines_valid` on the chunks one after the other)."""
+    (:func:`screened_lines_valid` on the chunks one after the other; ``probes``: as there)."""
     K = len(chunks)
     if K == 0:
         return np.zeros(0, dtype=bool)
     if K == 1:
-        return np.array([_one_motion_valid(robot, screen, np.asarray(chunks[0], dtype=float), step, levels)])
+        return np.array([_one_motion_valid(robot, screen, np.asarray(chunks[0], dtype=float), step, levels,
+                                           probes=probes)])
     sizes = np.array([len(c) for c in chunks], dtype=np.int64)
     spacing = np.array([float(np.linalg.norm(c[1] - c[0])) if len(c) > 1 else 0.0 for c in chunks])
     return screened_lines_valid(robot, screen, np.concatenate(chunks), sizes, spacing, step, levels)
 
 
 def screened_lines_valid(robot: RobotChecker, screen: BallScreen, S: np.ndarray, sizes: np.ndarray,
-                         spacing: np.ndarray, step: float, levels: tuple[float, ...] = SCREEN_LEVELS) -> np.ndarray:
+                         spacing: np.ndarray, step: float, levels: tuple[float, ...] = SCREEN_LEVELS,
+                         probes: int = 0) -> np.ndarray:
     """:func:`screened_all_valid` for K lines given as one array: S (sum of ``sizes``, nq) holds line k's
     ``sizes[k]`` states, evenly ``spacing[k]`` apart along a straight segment, after line k - 1's.
 
@@ -214,11 +216,13 @@ def screened_lines_valid(robot: RobotChecker, screen: BallScreen, S: np.ndarray,
     and a block whose middle passes is covered.  One batched call per level over all lines; the states
     left go to one :meth:`RobotChecker.collision_free` call.  A line with an end outside the joint
     limits is invalid at once (as in ``are_valid``); the joint box is convex, so the states of the
-    others lie inside it, and so do the states a ball covers.
+    others lie inside it, and so do the states a ball covers.  ``probes``: for one line, that many of its states
+    checked plainly first, as OMPL's validator starts (:data:`PROBES`, what ``si.checkMotion`` asks for).
     """
     K = len(sizes)
-    if K == 1:  # one motion (a compound space's si.checkMotion)
-        return np.array([_one_motion_valid(robot, screen, S[: int(sizes[0])], step, levels, float(spacing[0]))])
+    if K == 1:  # one motion (a compound space's si.checkMotion among others)
+        return np.array([_one_motion_valid(robot, screen, S[: int(sizes[0])], step, levels, float(spacing[0]),
+                                           probes)])
     offsets = np.cumsum(sizes) - sizes
     if K and sizes.all():  # a motion check's lines (never empty): the common case without masks
         within = robot.inside_limits(S[np.concatenate((offsets, offsets + sizes - 1))])
@@ -284,9 +288,10 @@ def _blocks_valid(robot: RobotChecker, screen: BallScreen, S: np.ndarray, starts
 
 
 PROBES = 2
-"""States of a single motion checked plainly before its screen, as OMPL's ``DiscreteMotionValidator`` starts: its end,
-then the middle, ... (bisection), up to the first invalid one.  A colliding motion is mostly found there; a free one
-pays these checks on top of its screen."""
+"""States of a motion that ``si.checkMotion`` asks about (the native planners' single calls) checked plainly before
+its screen, as OMPL's ``DiscreteMotionValidator`` starts: its end, then the middle, ... (bisection), up to the first
+invalid one.  A colliding motion is mostly found there; a free one pays these checks on top of its screen.  The
+batched calls (dimension-RRT's, which screens its motions first, stopping at a collision) take none."""
 
 
 def _probe_rows(n: int, k: int) -> list[int]:
@@ -303,9 +308,9 @@ def _probe_rows(n: int, k: int) -> list[int]:
 
 
 def _one_motion_valid(robot: RobotChecker, screen: BallScreen, S: np.ndarray, step: float,
-                      levels: tuple[float, ...], spacing: float | None = None) -> bool:
+                      levels: tuple[float, ...], spacing: float | None = None, probes: int = 0) -> bool:
     """:func:`screened_all_valid` for one chunk (``si.checkMotion``'s case, once per motion): the limit test
-    on its two ends without building arrays, :data:`PROBES` states plainly, then :func:`_blocks_valid`.
+    on its two ends without building arrays, ``probes`` states plainly (:data:`PROBES`), then :func:`_blocks_valid`.
     ``spacing``: of the states along the (unwrapped) line, when S[1] - S[0] is not it (wrapped SO2 values)."""
     n = len(S)
     if n == 0:
@@ -314,7 +319,7 @@ def _one_motion_valid(robot: RobotChecker, screen: BallScreen, S: np.ndarray, st
     lower, upper = robot.check_lower, robot.check_upper
     if not ((S[0] >= lower).all() and (S[0] <= upper).all() and (S[-1] >= lower).all() and (S[-1] <= upper).all()):
         return False
-    if PROBES and robot.first_invalid(S[_probe_rows(n, PROBES)]) >= 0:
+    if probes and robot.first_invalid(S[_probe_rows(n, probes)]) >= 0:
         return False
     if spacing is None:
         spacing = math.sqrt(float((S[1] - S[0]) @ (S[1] - S[0]))) if n > 1 else 0.0

@@ -238,8 +238,10 @@ class Checker:
     def check_motions(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
         """:meth:`check_motion` of each motion A[k] -> B[k]; with the project's validator, through its own
         ``check_motions`` (all motions batched together, each with ``checkMotion``'s verdict)."""
-        if self._check_motions is None or len(A) < 2:
+        if self._check_motions is None:
             return np.array([self.check_motion(a, b) for a, b in zip(A, B)], dtype=bool)
+        if len(A) == 0:
+            return np.zeros(0, dtype=bool)
         if self._counter_owner is None:  # else counter() reads the robot's exact count
             self.own_checks += int(np.maximum(1, np.ceil(self.layout.distance(A, B) / self.step)).sum())  # at most
         ok = np.asarray(self._check_motions(A, B), dtype=bool)

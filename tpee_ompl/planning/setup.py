@@ -31,6 +31,7 @@ from ompl import base as ob
 from ompl import geometric as og
 from ompl import util as ou
 
+from ..model import clearance_balls
 from ..model.clearance_balls import SCREEN_COST_LIMIT, SCREEN_LEVELS, screened_all_valid, screened_lines_valid
 from ..model.robot_checker import RobotChecker
 from ..validation import MOTION_VALIDATORS, check_bool, check_number, check_seed
@@ -189,7 +190,7 @@ class BatchedMotionValidator(ob.MotionValidator):
         ``DiscreteMotionValidator`` answers)."""
         a, b = self.read_state(s1), self.read_state(s2)
         if self._layout is not None:
-            return bool(self.check_motions(a[None], b[None])[0])
+            return bool(self._checked(a[None], b[None], clearance_balls.PROBES)[0])
         self.motions_checked += 1
         try:
             states = unchecked_motion_states(a, b, self.step, factor=self.factor())
@@ -197,24 +198,28 @@ class BatchedMotionValidator(ob.MotionValidator):
             if np.isfinite(a).all() and np.isfinite(b).all():
                 raise
             return False
-        return self._tally(bool(self.all_valid([states])[0]))
+        return self._tally(bool(self.all_valid([states], clearance_balls.PROBES)[0]))
 
     def check_motions(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
         """Validity of many motions A[k] -> B[k] (each excluding its start), batched together; a motion with a NaN
         or inf end is invalid."""
-        A, B = np.atleast_2d(A), np.atleast_2d(B)
-        try:
-            return self._check_finite_motions(A, B)
-        except (ValueError, OverflowError):
-            return finite_motions_checked(A, B, self._check_finite_motions, self)
+        return self._checked(np.atleast_2d(A), np.atleast_2d(B))
 
-    def _check_finite_motions(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
+    def _checked(self, A: np.ndarray, B: np.ndarray, probes: int = 0) -> np.ndarray:
+        """:meth:`check_motions`; ``probes``: a single motion's states checked plainly before its screen (the
+        native planners' ``checkMotion``; :data:`~tpee_ompl.model.clearance_balls.PROBES`)."""
+        try:
+            return self._check_finite_motions(A, B, probes)
+        except (ValueError, OverflowError):
+            return finite_motions_checked(A, B, lambda A, B: self._check_finite_motions(A, B, probes), self)
+
+    def _check_finite_motions(self, A: np.ndarray, B: np.ndarray, probes: int = 0) -> np.ndarray:
         if self._layout is not None:
-            return self._check_geodesics(A, B)
+            return self._check_geodesics(A, B, probes)
         S, counts = batched_motion_states(A, B, self.step, factor=self.factor())
         self.motions_checked += len(counts)
         if len(counts) < 2 or not self.screen_levels:
-            ok = self.all_valid(np.split(S, np.cumsum(counts)[:-1]) if len(counts) else [])
+            ok = self.all_valid(np.split(S, np.cumsum(counts)[:-1]) if len(counts) else [], probes)
         else:
             spacing = np.sqrt(((B - A) ** 2).sum(-1)) / counts  # the states are evenly spaced along each motion
             ok = screened_lines_valid(self.robot, self.robot.ball_screen(), S, counts, spacing, self.step,
@@ -238,7 +243,7 @@ class BatchedMotionValidator(ob.MotionValidator):
             raise ValueError("motion ends must be finite")
         return self.factor() * np.maximum(1, need).astype(np.int64)
 
-    def _check_geodesics(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
+    def _check_geodesics(self, A: np.ndarray, B: np.ndarray, probes: int = 0) -> np.ndarray:
         """:meth:`check_motions` in a compound space: each motion along the space's geodesic (continuous joints
         the short way round, wrapped into [-pi, pi)), the states ``DiscreteMotionValidator`` checks at
         ``validSegmentCountFactor`` 1 (:meth:`segment_counts`)."""
@@ -251,7 +256,7 @@ class BatchedMotionValidator(ob.MotionValidator):
         if self.screen_levels:  # the states are evenly spaced along each motion's joint-space line (unwrapped)
             spacing = np.linalg.norm(D, axis=1) / counts
             ok = screened_lines_valid(self.robot, self.robot.ball_screen(), S, counts, spacing, self.step,
-                                      self.screen_levels)
+                                      self.screen_levels, probes)
         else:
             ok = self.all_valid(np.split(S, np.cumsum(counts)[:-1]) if len(counts) else [])
         return self._tally(np.asarray(ok, dtype=bool))
@@ -261,13 +266,15 @@ class BatchedMotionValidator(ob.MotionValidator):
         self.motions_valid += int(np.count_nonzero(ok))
         return ok
 
-    def all_valid(self, chunks: list[np.ndarray]) -> np.ndarray:
+    def all_valid(self, chunks: list[np.ndarray], probes: int = 0) -> np.ndarray:
         """Per chunk of evenly spaced states along a line (a motion's dense states), True iff all are valid: screened
-        (``screen_levels``), else one chunk in bisection order up to its first invalid state, several in one batch."""
+        (``screen_levels``; one chunk's ``probes`` states plainly first), else one chunk in bisection order up to its
+        first invalid state, several in one batch."""
         if not chunks:
             return np.zeros(0, dtype=bool)
         if self.screen_levels:
-            return screened_all_valid(self.robot, self.robot.ball_screen(), chunks, self.step, self.screen_levels)
+            return screened_all_valid(self.robot, self.robot.ball_screen(), chunks, self.step, self.screen_levels,
+                                      probes)
         if len(chunks) == 1:  # one motion (si.checkMotion): as OMPL's DiscreteMotionValidator, in bisection order up to
             S = chunks[0]  # the first invalid state (all states in one batch took 1 s on a colliding xArm7 motion)
             return np.array([self.robot.first_invalid(S[bisection_order(len(S))]) < 0])
