@@ -208,3 +208,28 @@ def test_a_single_motion_into_a_collision_stops_at_its_end_state_as_ompls_valida
         assert not si.checkMotion(a, b)
         assert robot.collision_checks - c0 <= 2  # the end state (with two threads: the middle one beside it)
         assert not dense.checkMotion(a, b)
+
+
+def test_only_si_check_motion_probes_a_free_motion_the_batched_call_does_not(robot):
+    """The probe is OMPL's validator's start, for the native planners' single calls; dimension-RRT's batched calls
+    come after its own screens, which stop at any collision, so a probe there would only add checks."""
+    rng = np.random.default_rng(9)
+    si = make_simple_setup(robot).getSpaceInformation()
+    mv = si.getMotionValidator()
+    Q = rng.uniform(robot.lower, robot.upper, (400, robot.nq))
+    Q = Q[robot.are_valid(Q)]
+    a, b = si.allocState(), si.allocState()
+    found = 0
+    for q0 in Q[1:]:
+        q1 = q0 + 0.2 * (Q[0] - q0) / np.linalg.norm(Q[0] - q0)  # 17 states
+        if not robot.are_valid(motion_states(q0, q1, robot.max_joint_step())).all():
+            continue
+        for k in range(robot.nq):
+            a[k], b[k] = q0[k], q1[k]
+        c0 = robot.collision_checks
+        assert mv.check_motions(q0[None], q1[None])[0]
+        c1 = robot.collision_checks
+        assert si.checkMotion(a, b)
+        assert robot.collision_checks - c1 == (c1 - c0) + 2  # the end state and the middle, then the same screen
+        found += 1
+    assert found >= 10
