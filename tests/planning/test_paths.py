@@ -260,3 +260,13 @@ def test_batched_whole_path_check_agrees_with_checkmotion_segment_by_segment(rob
         assert path_passes_motion_checks(si, W, segments=segments) == expected
         verdicts.add(expected)
     assert verdicts == ({True} if segments == [] else {True, False})  # both verdicts were compared (none to check: True)
+
+
+def test_path_to_array_and_array_to_path_name_their_argument_order_when_given_the_other() -> None:
+    """A helper setting up Baxter's arm called path_to_array(si, path) and got an AttributeError from the bindings."""
+    si, _ = box_problem()
+    path = array_to_path(si, np.array([[0.0, 0.0], [0.1, 0.1]]))
+    with pytest.raises(ValueError, match=r"path_to_array\(path, n\) takes an og.PathGeometric first"):
+        path_to_array(si, path)
+    with pytest.raises(ValueError, match=r"array_to_path\(si, waypoints\) takes an ob.SpaceInformation first"):
+        array_to_path(path, si)

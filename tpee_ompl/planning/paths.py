@@ -61,8 +61,12 @@ def path_to_array(
     """Waypoints of a geometric path as an array (K, n).
 
     ``read(state) -> (n,)`` reads other state types (e.g. :meth:`RealVectorLayout.read` for a compound
-    space); the default reads the first n values of a RealVector state.
+    space); the default reads the first n values of a RealVector state.  Anything but a path first is a ValueError
+    naming the order (``array_to_path`` takes the SpaceInformation first).
     """
+    if not isinstance(path, og.PathGeometric):
+        raise ValueError(f"path_to_array(path, n) takes an og.PathGeometric first, got {type(path).__name__} "
+                         "(array_to_path is the one that takes the SpaceInformation first)")
     return states_to_array(path.getStates(), n, read=read)
 
 
@@ -84,8 +88,12 @@ def array_to_path(
 
     ``write(state, values)`` writes other state types (e.g. :meth:`RealVectorLayout.write`); the
     default is :func:`set_state` (RealVector states).  It is given one state for every waypoint in turn
-    (the path keeps a copy of each), and the waypoint as an array (n,).
+    (the path keeps a copy of each), and the waypoint as an array (n,).  Anything but a SpaceInformation first is a
+    ValueError naming the order (``path_to_array`` takes the path first).
     """
+    if not isinstance(si, ob.SpaceInformation):
+        raise ValueError(f"array_to_path(si, waypoints) takes an ob.SpaceInformation first, got {type(si).__name__} "
+                         "(path_to_array is the one that takes the path first)")
     W = np.asarray(waypoints, dtype=float)
     path = og.PathGeometric(si)
     s = si.allocState()  # one state written for each waypoint: PathGeometric.append keeps a copy
