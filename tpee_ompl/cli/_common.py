@@ -279,7 +279,9 @@ def on_postures(start: Any, goal: Any, from_sector: int, to_sector: int) -> tupl
 
 def add_model_args(p: argparse.ArgumentParser) -> None:
     """``--urdf`` / ``--srdf``: another wearer + arm model than the packaged one."""
-    p.add_argument("--urdf", type=nonempty, default=None, help="URDF of a wearer + arm model (the 4 arm joints and the muzzle link; default: the packaged one)")
+    p.add_argument("--urdf", type=nonempty, default=None,
+                   help="URDF of a wearer + arm model (the 4 arm joints and the muzzle link; default: the "
+                        "packaged one)")
     p.add_argument("--srdf", type=nonempty, default=None, help="SRDF file with disabled collision pairs (with --urdf)")
 
 
