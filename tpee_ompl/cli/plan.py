@@ -150,6 +150,7 @@ def plan_motion(args: argparse.Namespace) -> tuple[dict, WearerArm]:
     from ompl import util as ou
 
     from ..planning.paths import path_passes_motion_checks, path_to_array
+    from ..planning.planner_base import status_text
     from ..planning.setup import make_simple_setup, seed_ompl
 
     check_plan_args(args)
@@ -176,7 +177,7 @@ def plan_motion(args: argparse.Namespace) -> tuple[dict, WearerArm]:
     else:
         status = ss.solve(args.time)
     result: dict = {"planner": args.planner, "from_sector": args.from_sector, "to_sector": args.to_sector,
-                    "query_id": qid, "status": str(status), "exact": bool(ss.haveExactSolutionPath()),
+                    "query_id": qid, "status": status_text(status), "exact": bool(ss.haveExactSolutionPath()),
                     "time_s": ss.getLastPlanComputationTime(), "collision_checks": robot.collision_checks - checks0,
                     "samples": _samples_drawn(planner)}
     if ss.haveSolutionPath():

@@ -15,7 +15,7 @@ from typing import Any
 
 from ompl import base as ob
 
-__all__ = ["PythonPlanner", "check_space_information", "finite_state", "planner_status"]
+__all__ = ["PythonPlanner", "check_space_information", "finite_state", "planner_status", "status_text"]
 
 log = logging.getLogger(__name__)
 
@@ -42,6 +42,14 @@ def check_space_information(si: object) -> ob.SpaceInformation:
 def planner_status(code: Any) -> ob.PlannerStatus:
     """An ``ob.PlannerStatus`` object (OMPL needs the object, not the enum value)."""
     return ob.PlannerStatus(code)
+
+
+_UNNAMED = {ob.PlannerStatus.ABORT: "Abort", ob.PlannerStatus.INFEASIBLE: "Infeasible"}
+
+
+def status_text(status: ob.PlannerStatus) -> str:
+    """What ``str(status)`` says, except for ABORT and INFEASIBLE, which the bindings print as "Unknown status"."""
+    return _UNNAMED.get(status.getStatus(), str(status))
 
 
 class PythonPlanner(ob.Planner):
