@@ -31,7 +31,7 @@ from ompl import base as ob
 from ..model.robot_checker import RobotChecker
 from ..validation import check_int, check_number
 from .paths import state_to_array, unchecked_motion_states
-from .setup import BatchedMotionValidator, finite_motions_checked
+from .motion_validator import BatchedMotionValidator, finite_motions_checked
 
 __all__ = ["CertifiedMotionOptions", "ClearanceGroups", "CertifiedMotionValidator"]
 
@@ -236,10 +236,11 @@ class CertifiedMotionValidator(BatchedMotionValidator):
         """Validity of many motions A[k] -> B[k]; their uncertified parts go to one batched call (a motion with a
         NaN or inf end is invalid)."""
         A, B = np.atleast_2d(np.asarray(A, dtype=float)), np.atleast_2d(np.asarray(B, dtype=float))
+        check = self._check_finite_motions if self.checker is None else self._through_checker
         try:
-            return self._check_finite_motions(A, B)
+            return check(A, B)
         except (ValueError, OverflowError):
-            return finite_motions_checked(A, B, self._check_finite_motions, self)
+            return finite_motions_checked(A, B, check, self)
 
     def _check_finite_motions(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
         verdicts = [self.certify(a, b) for a, b in zip(A, B)]

@@ -15,7 +15,8 @@ from typing import Any
 
 from ompl import base as ob
 
-__all__ = ["PythonPlanner", "check_space_information", "finite_state", "planner_status", "status_text"]
+__all__ = ["PythonPlanner", "check_space_information", "finite_state", "planner_status", "status_text",
+           "validator_mismatch"]
 
 log = logging.getLogger(__name__)
 
@@ -42,6 +43,25 @@ def check_space_information(si: object) -> ob.SpaceInformation:
 def planner_status(code: Any) -> ob.PlannerStatus:
     """An ``ob.PlannerStatus`` object (OMPL needs the object, not the enum value)."""
     return ob.PlannerStatus(code)
+
+
+def validator_mismatch(si: ob.SpaceInformation) -> str | None:
+    """Why ``si.checkMotion`` would pass states ``si.isValid`` rejects, or None: the validators of
+    :func:`~tpee_ompl.planning.setup.make_simple_setup` check with the robot (or the checker their setup was given),
+    and a checker set on ``si`` itself (which :class:`~tpee_ompl.planning.setup.RobotSimpleSetup` cannot follow) is
+    not the one they consult."""
+    from .motion_validator import BatchedMotionValidator
+    from .setup import checks_as_robot
+
+    mv = si.getMotionValidator()
+    if not isinstance(mv, BatchedMotionValidator):
+        return None
+    svc = si.getStateValidityChecker()
+    if svc is mv.checker if mv.checker is not None else checks_as_robot(svc, mv.robot):
+        return None
+    return ("the motion validator does not check states with the state validity checker set now (set with "
+            "si.setStateValidityChecker?): set checkers with the setStateValidityChecker of the setup "
+            "make_simple_setup returned, which tells its motion validator")
 
 
 _UNNAMED = {ob.PlannerStatus.ABORT: "Abort", ob.PlannerStatus.INFEASIBLE: "Infeasible"}
@@ -98,6 +118,9 @@ class PythonPlanner(ob.Planner):
                 return planner_status(ob.PlannerStatus.ABORT)
             if not self.getSpaceInformation().isSetup():  # solved without setup(): set it up, as OMPL's planners do
                 self.setup()
+            if (why := validator_mismatch(self.getSpaceInformation())) is not None:
+                log.error("%s: %s", self.getName(), why)
+                return planner_status(ob.PlannerStatus.ABORT)
             return self._solve(ptc)
         except Exception as exc:  # an exception escaping into ot.Benchmark would abort the whole benchmark
             log.exception("%s.solve failed", self.getName())
