@@ -73,3 +73,15 @@ def locked_dimension_space(n: int, locked: int, value: float = 0.5, bound: float
     bounds.setHigh(locked, value)
     space.setBounds(bounds)
     return space
+
+
+class PathLengthTimes100(ob.PathLengthOptimizationObjective):
+    """:class:`LengthTimes100` as a subclass of OMPL's path-length objective overriding its ``motionCost``: an
+    ``isinstance`` test would take it for path length."""
+
+    def __init__(self, si: ob.SpaceInformation) -> None:
+        super().__init__(si)
+        self._si = si
+
+    def motionCost(self, a: ob.State, b: ob.State) -> ob.Cost:
+        return ob.Cost(100.0 * self._si.distance(a, b))

@@ -15,7 +15,7 @@ from ompl import base as ob
 from ompl import geometric as og
 
 from tests.helpers.planning_arms import planar_arm_setup
-from tests.helpers.planning_spaces import LengthTimes100
+from tests.helpers.planning_spaces import LengthTimes100, PathLengthTimes100
 from tpee_ompl.examples.planar_arm import make_planar_arm_setup
 from tpee_ompl.planning.dimension_rrt import DimensionRRT
 from tpee_ompl.planning.paths import path_passes_motion_checks, set_state
@@ -65,11 +65,12 @@ def test_finite_cost_threshold_stops_once_satisfied() -> None:
     assert stats["best_cost"] <= threshold and stats["samples"] < CAP
 
 
-def test_another_objectives_threshold_is_asked_with_its_own_cost(caplog: pytest.LogCaptureFixture) -> None:
+@pytest.mark.parametrize("objective", [LengthTimes100, PathLengthTimes100])
+def test_another_objectives_threshold_is_asked_with_its_own_cost(objective, caplog: pytest.LogCaptureFixture) -> None:
     ss = make_planar_arm_setup()
     first = _run(ss, seed=5, max_samples=400)[0].last_run_stats()["progress"]
     length = next(c for _, c, _ in first if math.isfinite(c))
-    opt = LengthTimes100(ss.getSpaceInformation())
+    opt = objective(ss.getSpaceInformation())
     opt.setCostThreshold(ob.Cost(2.0 * length))  # any path's length is below it; no path's cost (100 x length) is
     ss.setOptimizationObjective(opt)
     with caplog.at_level(logging.WARNING):

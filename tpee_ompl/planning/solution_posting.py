@@ -33,6 +33,13 @@ def without_repeats(W: np.ndarray) -> np.ndarray:
     return W[keep] if keep.sum() >= 2 else W[[0, -1]]
 
 
+def _is_path_length(opt: ob.OptimizationObjective) -> bool:
+    """Whether ``opt`` costs a path by its length: OMPL's objective, or a subclass overriding none of its costs."""
+    costs = ("motionCost", "stateCost", "combineCosts", "identityCost", "motionCostHeuristic", "costToGo")
+    base = ob.PathLengthOptimizationObjective
+    return isinstance(opt, base) and all(getattr(type(opt), c, None) is getattr(base, c, None) for c in costs)
+
+
 class SolutionPoster:
     """Hands improved paths to OMPL as they are found (see :mod:`tpee_ompl.planning.dimension_rrt`, "Stopping").
 
@@ -47,7 +54,7 @@ class SolutionPoster:
         self.planner, self.si, self.pdef, self.t0 = planner, si, pdef, t0
         self.to_path, self.notify = to_path, notify
         self.opt = problem_objective(pdef)
-        self._own_cost = self.opt is not None and not isinstance(self.opt, ob.PathLengthOptimizationObjective)
+        self._own_cost = self.opt is not None and not _is_path_length(self.opt)
         """The objective is not path length: whether a path satisfies it is asked with its own cost of the path."""
         if self._own_cost:
             log.warning("%s minimises path length; the objective '%s' only says when a path is good enough",
