@@ -299,3 +299,11 @@ def test_generate_refuses_a_stride_that_is_not_a_positive_integer(library, strid
 def test_a_library_tries_at_least_one_candidate(robot: WearerArm) -> None:
     with pytest.raises(ValueError, match="n_candidates"):
         PathLibrary(robot, {}, n_candidates=0)
+
+
+@pytest.mark.parametrize("robot", [None, "wearer", 4])
+def test_load_names_a_robot_that_is_not_a_wearer_arm(robot) -> None:
+    from tpee_ompl.resources import default_library_path
+
+    with pytest.raises(ValueError, match="^robot must be a WearerArm"):
+        PathLibrary.load(default_library_path(), robot)

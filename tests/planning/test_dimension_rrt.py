@@ -365,3 +365,10 @@ def test_a_run_ended_by_a_raising_validity_checker_still_reports_what_it_posted(
     assert status == ob.PlannerStatus.CRASH and ss.haveExactSolutionPath()  # a path was posted before the crash
     assert stats["solutions_posted"] >= 1 and stats["first_solution_time"] is not None
     assert stats["best_cost"] == pytest.approx(ss.getProblemDefinition().getSolutionPath().length())
+
+
+@pytest.mark.parametrize("options", ["x", 3, {"h": 7}])
+def test_tpee_options_that_are_not_an_options_object_are_named_in_the_error(robot: WearerArm, options) -> None:
+    ss = make_simple_setup(robot)
+    with pytest.raises(ValueError, match="^options must be a DimensionRRTOptions"):
+        tpee_dimension_rrt(ss.getSpaceInformation(), 1, 2, options=options)

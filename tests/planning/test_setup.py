@@ -326,6 +326,9 @@ def test_setup_arguments_are_named_in_their_errors(robot):
         make_simple_setup(robot, check_endpoints=None)
     with pytest.raises(ValueError, match="contradicts"):
         make_simple_setup(robot, batched_motion_validator=True, motion_validator="discrete")
+    for bad in (None, "wearer", robot.nq):
+        with pytest.raises(ValueError, match="^robot must be a RobotChecker"):
+            make_simple_setup(bad)
 
 
 def test_a_robot_whose_screen_costs_more_than_it_saves_is_checked_densely_with_the_same_verdicts(rng, monkeypatch):

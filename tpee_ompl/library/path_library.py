@@ -364,6 +364,8 @@ class PathLibrary:
     def load(cls, path: str | os.PathLike, robot: WearerArm, plan: Plan | None = None) -> PathLibrary:
         """Read a library saved by :meth:`save` (:func:`tpee_ompl.library.storage.read_library`), with
         ``plan`` as its fallback; a file of another format version, another model, or a damaged one
-        raises :class:`~tpee_ompl.library.storage.LibraryFileError`."""
+        raises :class:`~tpee_ompl.library.storage.LibraryFileError`; a ``robot`` that is not a WearerArm, ValueError."""
+        if not isinstance(robot, WearerArm):
+            raise ValueError(f"robot must be a WearerArm (the library's model), got {type(robot).__name__}")
         pairs, settings = read_library(path, robot)
         return cls(robot, pairs, plan=plan, **settings)

@@ -178,15 +178,16 @@ def _real_vector(lower: np.ndarray, upper: np.ndarray) -> ob.RealVectorStateSpac
 def checks_as_robot(checker: object, robot: RobotChecker) -> bool:
     """Whether a state validity checker answers as ``robot`` does (a :class:`RobotValidityChecker` of it, its checks
     not overridden): the validators of :func:`make_simple_setup` check states with the robot itself."""
+    own = ("isValid", "are_valid", "first_invalid")
     return isinstance(checker, RobotValidityChecker) and checker.robot is robot and all(
-        getattr(type(checker), m) is getattr(RobotValidityChecker, m) for m in ("isValid", "are_valid", "first_invalid"))
+        getattr(type(checker), m) is getattr(RobotValidityChecker, m) for m in own)
 
 
 class RobotSimpleSetup(og.SimpleSetup):
     """:func:`make_simple_setup`'s setup.  Its validator checks states with the robot, so another checker (a user's
     constraint) given to ``setStateValidityChecker`` becomes the validator's :attr:`~BatchedMotionValidator.checker`
     (every state through it), the robot's own puts the batched checks back (``si.setStateValidityChecker`` cannot
-    be followed: the package's planners then refuse to plan, :func:`~tpee_ompl.planning.planner_base.validator_mismatch`)."""
+    be followed: the package's planners then refuse to plan, :func:`.planner_base.validator_mismatch`)."""
 
     def setStateValidityChecker(self, checker: object) -> None:  # noqa: N802 (OMPL's name)
         super().setStateValidityChecker(checker)
@@ -239,6 +240,8 @@ def make_simple_setup(
     ``getSpaceInformation()`` is fully set up on return; :func:`motion_check_step` gives back the
     joint step it checks motions at.
     """
+    if not isinstance(robot, RobotChecker):
+        raise ValueError(f"robot must be a RobotChecker (a WearerArm, the Panda, any URDF), got {type(robot).__name__}")
     check_endpoints = check_bool("check_endpoints", check_endpoints)
     space = make_space(robot)
     extent = float(space.getMaximumExtent())

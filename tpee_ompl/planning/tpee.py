@@ -48,6 +48,8 @@ def tpee_options(options: DimensionRRTOptions | None = None, **overrides: Any) -
     """The options :func:`tpee_dimension_rrt` plans with: ``options`` with the overrides, groups ``[[0, 1], [2, 3]]``
     when none are given; ValueError (as there) for a first group other than ``[0, 1]`` or ``h`` other than Table 3's
     steps.  The library pipeline checks its settings with it when it is made."""
+    if options is not None and not isinstance(options, DimensionRRTOptions):
+        raise ValueError(f"options must be a DimensionRRTOptions, got {type(options).__name__}")
     if overrides.get("groups", options.groups if options is not None else None) is None:
         overrides["groups"] = ((0, 1), (2, 3))
     opts = resolve_options(options, overrides)
