@@ -256,3 +256,40 @@ def test_a_termination_condition_true_before_a_valid_goal_is_drawn_is_a_timeout_
         ss.setPlanner(planner)
         ss.setup()
         assert planner.solve(ob.PlannerTerminationCondition(lambda: True)) == ob.PlannerStatus.TIMEOUT
+
+
+def _thin_goal_region(valid_window: float) -> og.SimpleSetup:
+    """A 2-D point whose goal region (x in [0.89, 0.91]) is valid only in a band of y of this width (none if 0)."""
+    space = ob.RealVectorStateSpace(2)
+    space.setBounds(0.0, 1.0)
+    ss = og.SimpleSetup(space)
+    ss.setStateValidityChecker(lambda s: not (s[0] > 0.85 and not 0.5 <= s[1] <= 0.5 + valid_window))
+    si = ss.getSpaceInformation()
+    ss.setStartState(set_state(si.allocState(), (0.1, 0.1)))
+    region = ob.RealVectorStateSpace(2)
+    bounds = ob.RealVectorBounds(2)
+    bounds.setLow(0, 0.89)
+    bounds.setHigh(0, 0.91)
+    bounds.setLow(1, 0.0)
+    bounds.setHigh(1, 1.0)
+    region.setBounds(bounds)
+    goal = ob.GoalSpace(si)
+    goal.setSpace(region)
+    ss.setGoal(goal)
+    ss._region = region  # type: ignore[attr-defined]  # kept alive beside the goal
+    return ss
+
+
+def test_a_goal_region_whose_valid_states_are_rare_is_drawn_from_until_one_comes() -> None:
+    """Helper review, 2026-11-27: 800 draws then INVALID_GOAL in 10 ms, where RRTConnect (drawing until its
+    termination condition) solved it in 11-62 ms; the valid band is 1 / 2000 of the region."""
+    ss = _thin_goal_region(0.0005)
+    ss.setPlanner(DimensionRRT(ss.getSpaceInformation(), seed=1, max_samples=2000))
+    assert ss.solve(10.0) == ob.PlannerStatus.EXACT_SOLUTION
+    assert 0.5 <= path_to_array(ss.getSolutionPath(), 2)[-1, 1] <= 0.5005
+
+
+def test_a_goal_region_without_a_valid_state_is_drawn_from_until_the_time_is_up_then_a_timeout() -> None:
+    ss = _thin_goal_region(-1.0)
+    ss.setPlanner(DimensionRRT(ss.getSpaceInformation(), seed=1))
+    assert ss.solve(0.2) == ob.PlannerStatus.TIMEOUT

@@ -89,8 +89,10 @@ def goal_states(planner: PythonPlanner, ptc: ob.PlannerTerminationCondition, max
     keeps the ``max_goals`` nearest, so below that cap the choice does not depend on OMPL's rotating sample
     position; a ``GoalLazySamples`` holding none yet: its first waited for until ``ptc``).  Any other
     ``GoalSampleableRegion``: the first ``max_goals`` valid states drawn from it (with OMPL's random
-    numbers, not the planner's seed); INVALID_GOAL when none is found, TIMEOUT when ``ptc`` stopped the drawing
-    first.  Another goal type: UNRECOGNIZED_GOAL_TYPE, with an error naming it."""
+    numbers, not the planner's seed; drawn until ``ptc`` while none is valid, as RRTConnect's ``nextGoal(ptc)``,
+    then at most :data:`_GOAL_TRIES` per goal state wanted); INVALID_GOAL when the goal has no more states to give
+    and none was valid, TIMEOUT when ``ptc`` stopped the drawing first.  Another goal type: UNRECOGNIZED_GOAL_TYPE,
+    with an error naming it."""
     goal = planner.getProblemDefinition().getGoal()
     if isinstance(goal, ob.GoalState):
         state = planner._goal_state()
@@ -105,7 +107,9 @@ def goal_states(planner: PythonPlanner, ptc: ob.PlannerTerminationCondition, max
         pis.restart()
     states: dict[bytes, np.ndarray] = {}  # distinct values, in the order drawn
     tries = 0  # nextGoal() draws one state, None when it is invalid; it reuses one state, so read at once
-    while len(states) < want and pis.haveMoreGoalStates() and tries < _GOAL_TRIES * want and not (tries and ptc()):
+    region = not isinstance(goal, ob.GoalStates)  # drawn until a valid state comes (OMPL's nextGoal(ptc)) or ptc
+    while (len(states) < want and pis.haveMoreGoalStates() and (tries < _GOAL_TRIES * want or region and not states)
+           and not (tries and ptc())):
         tries += 1
         state = pis.nextGoal()
         if state is not None and finite_state(si, state):  # OMPL's bounds check lets NaN through
@@ -116,7 +120,7 @@ def goal_states(planner: PythonPlanner, ptc: ob.PlannerTerminationCondition, max
         if state is not None and finite_state(si, state):
             states[b""] = read(state)
     if not states:
-        if ptc() and pis.haveMoreGoalStates() and tries < _GOAL_TRIES * want:  # stopped drawing, not out of goals
+        if ptc() and pis.haveMoreGoalStates():  # stopped drawing, not out of goals
             return planner_status(ob.PlannerStatus.TIMEOUT)
         log.error("%s: no valid goal state could be drawn from the goal region", planner.getName())
         return planner_status(ob.PlannerStatus.INVALID_GOAL)
