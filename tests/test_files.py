@@ -189,3 +189,13 @@ def test_a_file_system_without_hard_links_still_gets_new_files_without_force(tmp
             tmp.write_text("mine")
             (tmp_path / "other.png").write_text("precious")
     assert (tmp_path / "other.png").read_text() == "precious"
+
+
+@pytest.mark.skipif(not os.path.isdir("/proc/self"), reason="needs Linux's /proc")
+def test_a_folder_no_file_can_be_made_in_is_refused_before_any_work_even_for_root() -> None:
+    """A helper, running as root, had ``library build --library /sys/x.npz`` build for minutes and then fail:
+    ``os.access`` says yes to root everywhere.  A file is made and removed in the folder instead."""
+    with pytest.raises(ValueError, match="^--output /proc/x.csv: folder /proc is not writable"):
+        check_output_path("/proc/x.csv", what="--output")
+    with pytest.raises(ValueError, match="^--out /proc/runs: folder /proc is not writable"):
+        check_writable_folder("/proc/runs", what="--out")

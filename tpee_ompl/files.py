@@ -63,6 +63,10 @@ def _check_nearest_folder(candidates, label: str) -> None:
                 raise ValueError(f"{label}: {parent} is a file, not a folder")
             if not os.access(parent, os.W_OK | os.X_OK):
                 raise ValueError(f"{label}: folder {parent} is not writable")
+            try:  # access() says yes to root everywhere, also in /proc and /sys: a file made and gone at once
+                tempfile.TemporaryFile(dir=parent).close()
+            except OSError as exc:
+                raise ValueError(f"{label}: folder {parent} is not writable ({exc.strerror or exc})") from None
             return
 
 
