@@ -67,3 +67,30 @@ def test_a_sigterm_while_children_start_is_held_until_they_have() -> None:
         except KeyboardInterrupt:
             reached.append("raised at the end")
     assert reached == [True, "raised at the end"]
+
+
+def test_an_interrupt_python_drops_prints_nothing_and_other_dropped_errors_still_print() -> None:
+    """A helper's Ctrl-C while matplotlib drew a campaign's plots printed Python's "Exception ignored ... Traceback
+    ... KeyboardInterrupt" page before the package's one line (2 runs of 7)."""
+    import subprocess
+    import sys
+    import textwrap
+    from pathlib import Path
+
+    script = textwrap.dedent("""
+        import signal, weakref
+        from helpers.interrupts import interrupt_in_a_weakref_callback
+        from tpee_ompl.signals import interrupts, sigterm_as_keyboard_interrupt
+        class Node: pass
+        def fail(_ref): raise ValueError("a real error in a callback")
+        with sigterm_as_keyboard_interrupt():
+            interrupt_in_a_weakref_callback(signal.SIGINT)
+            node = Node(); ref = weakref.ref(node, fail); del node
+        print("interrupts", interrupts())
+    """)
+    tests = Path(__file__).parent
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(tests), str(tests.parent)])}
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120, env=env)
+    assert done.returncode == 0 and "interrupts 1" in done.stdout
+    assert "KeyboardInterrupt" not in done.stderr
+    assert "a real error in a callback" in done.stderr

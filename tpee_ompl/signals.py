@@ -12,13 +12,15 @@ while it started left a traceback at exit).
 :func:`sigterm_as_keyboard_interrupt`: within it SIGTERM (``kill``, a cluster's scheduler) ends the work the
 way Ctrl-C does, so the same cleanup runs (finished logs kept, child processes ended).  Both signals are
 also counted (:func:`interrupts`): Python drops an exception raised in a weakref callback or ``__del__``
-(matplotlib's, while plots are drawn), so a caller asks after the work whether one came.
+(matplotlib's, while plots are drawn), so a caller asks after the work whether one came; within the block such a
+dropped KeyboardInterrupt prints nothing (``sys.unraisablehook``), other dropped exceptions print as before.
 """
 
 from __future__ import annotations
 
 import contextlib
 import signal
+import sys
 import threading
 from collections.abc import Callable, Iterator
 from typing import Any
@@ -81,12 +83,18 @@ def sigterm_as_keyboard_interrupt() -> Iterator[None]:
             return
         raise KeyboardInterrupt(f"signal {signum}")
 
+    def unraisable(info: Any) -> None:  # an interrupt Python dropped (counted above): no "Exception ignored" page
+        if not (isinstance(info.exc_type, type) and issubclass(info.exc_type, KeyboardInterrupt)):
+            previous_hook(info)
+
     previous = signal.signal(signal.SIGTERM, handler)
     default_int = signal.getsignal(signal.SIGINT) is signal.default_int_handler  # (not a handler of someone else's)
     previous_int = signal.signal(signal.SIGINT, handler) if default_int else None
+    previous_hook, sys.unraisablehook = sys.unraisablehook, unraisable
     try:
         yield
     finally:
+        sys.unraisablehook = previous_hook
         signal.signal(signal.SIGTERM, previous)
         if previous_int is not None:
             signal.signal(signal.SIGINT, previous_int)
