@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import functools
-import subprocess
 from pathlib import Path
 
 __version__ = "0.1.0"
@@ -14,6 +13,8 @@ def code_version() -> str:
     """What a result was made with: ``__version__``, plus ``+g<commit>`` (``.dirty`` with uncommitted changes to
     tracked files, ``.unknown`` when git could not tell) when the package runs from a git checkout that tracks it;
     ``__version__`` alone from a wheel."""
+    import subprocess  # here, not at import: ``import tpee_ompl`` (the console script's first step) stays short
+
     here = Path(__file__).resolve().parent
 
     def git(*args: str) -> str | None:
