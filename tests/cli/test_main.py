@@ -231,3 +231,16 @@ def test_an_interrupt_while_the_command_cleans_up_after_its_work_ends_with_130(m
     monkeypatch.setattr(cli_main.gc, "collect", interrupted)
     assert cli_main.main(["aim", "--target", "5", "2", "1.5"]) == 130
     assert capsys.readouterr().err.strip().endswith("interrupted")
+
+
+def test_a_model_given_without_its_srdf_whose_every_configuration_collides_is_warned_about(capsys, caplog):
+    """A helper's ``aim --urdf <the packaged URDF>`` (no ``--srdf``) said "collision-free: False" for a free pose,
+    and ``workspace`` drew "0 of 200 configurations collision-free", without a word on why."""
+    from tpee_ompl.resources import model_file
+
+    urdf, srdf = model_file("wearer_arm.urdf"), model_file("wearer_arm.srdf")
+    main(["aim", "--target", "5", "2", "1.5", "--urdf", str(urdf)])
+    assert "without --srdf no collision pair is disabled" in caplog.text
+    caplog.clear()
+    assert main(["aim", "--target", "5", "2", "1.5", "--urdf", str(urdf), "--srdf", str(srdf)]) == 0
+    assert "collision pair" not in caplog.text
