@@ -174,6 +174,7 @@ RUNTIME = [
      "model_hash"),
     ("library-query-set-other-model", ["library", "query", "--query-set", "{in}/q_other_model.json"], "model_hash"),
     ("animate-empty-path", ["animate", "--path", "{in}/path_empty.json", "-o", "m.gif"], "--path"),
+    ("animate-one-waypoint", ["animate", "--path", "{in}/path_one.json", "-o", "m.gif"], "at least two waypoints"),
     ("animate-path-of-strings", ["animate", "--path", "{in}/path_strings.json", "-o", "m.gif"], "waypoint 0"),
     ("animate-path-three-values", ["animate", "--path", "{in}/path_short.json", "-o", "m.gif"], "waypoint 1"),
     ("animate-path-not-json", ["animate", "--path", "{in}/path_not_json.json", "-o", "m.gif"], "--path"),
@@ -197,6 +198,7 @@ def inputs(tmp_path_factory) -> Path:
     other_model_query_file(d / "q_other_model.json")
     write_path_file(d / "path_ok.json", [START, GOAL])
     write_path_file(d / "path_empty.json", [])
+    write_path_file(d / "path_one.json", [START])
     write_path_file(d / "path_strings.json", [[str(v) for v in START], GOAL])
     write_path_file(d / "path_short.json", [START, GOAL[:3]])
     write_path_file(d / "path_huge.json", [START, [1e300, 0.0, 0.0, 0.0]])

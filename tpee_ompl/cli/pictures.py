@@ -66,8 +66,8 @@ def cmd_show(args: argparse.Namespace) -> int:
 
 
 def _read_path(file: str, robot: WearerArm) -> np.ndarray:
-    """The 'path' list of waypoints in a JSON file (e.g. from ``plan --json``): at least one waypoint of the
-    robot's ``nq`` finite numbers (JSON numbers, not strings or booleans) within its joint limits; ValueError
+    """The 'path' list of waypoints in a JSON file (e.g. from ``plan --json``): at least two waypoints (a motion) of
+    the robot's ``nq`` finite numbers (JSON numbers, not strings or booleans) within its joint limits; ValueError
     naming the file and the waypoint otherwise."""
     try:
         with open(file, encoding="utf-8") as fh:
@@ -77,6 +77,8 @@ def _read_path(file: str, robot: WearerArm) -> np.ndarray:
     W = doc.get("path") if isinstance(doc, dict) else None
     if not isinstance(W, list) or not W:
         raise ValueError(f"--path {file}: expected a JSON object with a non-empty 'path' list of waypoints")
+    if len(W) < 2:
+        raise ValueError(f"--path {file}: a motion needs at least two waypoints, the 'path' list has one")
     nq = robot.nq
     for k, w in enumerate(W):
         try:
