@@ -67,6 +67,7 @@ USAGE = [
     ("track-output-a-folder", ["track", "--duration", "1", "-o", "adir"], "--output"),
     ("track-output-exists", ["track", "--duration", "1", "-o", "existing.csv"], "--output"),
     ("track-exabytes", ["track", "--duration", "1e9", "--rate", "1e9"], "--duration"),
+    ("track-samples-with-the-default-planner", ["track", "--duration", "1", "--samples", "5"], "--samples"),
     ("track-beyond-the-trackers-clock", ["track", "--duration", "2e10", "--rate", "1e-9"], "--duration"),
     ("track-rate-inf", ["track", "--rate", "inf"], "--rate"),
     ("track-duration-zero", ["track", "--duration", "0"], "--duration"),

@@ -119,8 +119,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="run the queries as Dask tasks: 'local' starts a LocalCluster here, an address uses that "
                         "scheduler (needs the dask extra: pip install 'tpee_ompl[dask]')")
     g.add_argument("--scheduler", metavar="tcp://HOST:PORT", type=nonempty, default=None, help="same as --dask tcp://HOST:PORT")
-    g.add_argument("--dask-workers", type=positive_int, default=2, help="workers of --dask local (default: %(default)s)")
-    g.add_argument("--retries", type=count, default=2, help="Dask retries of a task that raises (default: %(default)s)")
+    g.add_argument("--dask-workers", type=positive_int, default=None, help="workers of --dask local (default: 2)")
+    g.add_argument("--retries", type=count, default=None, help="Dask retries of a task that raises (default: 2)")
     p.set_defaults(bench_prog=p.prog)
     p.add_argument("--resume", metavar="DIR", type=nonempty, default=None,
                    help="finish an interrupted campaign in DIR: run only its missing experiments (configuration "
@@ -205,6 +205,12 @@ def run(args: argparse.Namespace) -> int:
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     prog = getattr(args, "bench_prog", "bench")
     try:
+        dask = args.scheduler or args.dask
+        for option, value in (("--dask-workers", args.dask_workers), ("--retries", args.retries)):
+            if value is not None and not dask:
+                raise ValueError(f"{option} applies to a Dask executor: give --dask too")
+        if args.dask_workers is not None and dask != "local":
+            raise ValueError("--dask-workers sizes --dask local; a scheduler at an address has its own workers")
         if args.resume:  # its own worker count (the checker's threads follow it) unless --workers is given
             if Path(args.resume).is_dir() and not os.access(args.resume, os.W_OK | os.X_OK):
                 raise ValueError(f"--resume {args.resume}: the folder is not writable (the campaign's logs, lock and "
@@ -221,8 +227,9 @@ def run(args: argparse.Namespace) -> int:
             logging.getLogger(__name__).warning("--workers %d on a machine with %d core(s): runs compete for the CPU, "
                                                 "so times and time-budgeted results are not those of one run alone",
                                                 workers, cores)
-        executor = make_executor(workers, dask=args.scheduler or args.dask, dask_workers=args.dask_workers,
-                                 retries=args.retries)
+        executor = make_executor(workers, dask=args.scheduler or args.dask,
+                                 dask_workers=2 if args.dask_workers is None else args.dask_workers,
+                                 retries=2 if args.retries is None else args.retries)
     except (ValueError, FileNotFoundError, ImportError) as exc:
         print(f"{prog}: error: {_user_message(exc)}", file=sys.stderr)
         return 1 if isinstance(exc, QuerySetError) else 2  # a damaged query file is a runtime error, as in ``plan``

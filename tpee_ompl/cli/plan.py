@@ -308,6 +308,10 @@ def cmd_track(args: argparse.Namespace) -> int:
         if args.planner not in ("default", "library"):
             raise CliError(f"--library is read by --planner default and library, not {args.planner}")
         check_input_file(args.library, "--library", "path library")
+    if args.samples is not None and args.planner == "default":
+        raise CliError("--samples caps dimension-RRT in --planner dimension-rrt and library; the default planner "
+                       "refines by time")
+    samples = default_of(dimension_rrt_planner, "max_samples") if args.samples is None else args.samples
     robot = load_robot(args)
     if args.library is not None:  # (read by the default and library planners only: refused above for the others)
         check_library_model(args.library, robot)
@@ -315,7 +319,7 @@ def cmd_track(args: argparse.Namespace) -> int:
         packaged = _packaged_library(robot, required=args.planner == "library")
         args.library = None if packaged is None else str(packaged)
     if args.planner == "dimension-rrt":
-        plan = dimension_rrt_planner(robot, max_samples=args.samples, seed=args.seed)
+        plan = dimension_rrt_planner(robot, max_samples=samples, seed=args.seed)
 
         def planner(start: np.ndarray, goal: np.ndarray, i: int, j: int) -> np.ndarray:
             path = plan(start, goal, i, j) if i != j else None
@@ -326,7 +330,7 @@ def cmd_track(args: argparse.Namespace) -> int:
         from ..library import PathLibrary
 
         lib = PathLibrary.load(args.library, robot,
-                               plan=dimension_rrt_planner(robot, max_samples=args.samples, seed=args.seed))
+                               plan=dimension_rrt_planner(robot, max_samples=samples, seed=args.seed))
         # same-sector re-aims have no demonstrations: the default planner's straight motion or RRTConnect, seeded
         planner = lib.as_planner(same_sector=make_default_planner(robot, seed=args.seed, library=None))
     else:
@@ -392,8 +396,9 @@ def register(sub: argparse._SubParsersAction, fmt: type) -> None:
     p.add_argument("--library", type=nonempty, default=None, metavar="FILE",
                    help="path library file (default and library planners; default: the packaged one when it was "
                         "built for the model, else none: the default planner then plans without it)")
-    p.add_argument("--samples", type=positive_int, default=default_of(dimension_rrt_planner, "max_samples"),
-                   help="dimension-RRT sample cap")
+    p.add_argument("--samples", type=positive_int, default=None,
+                   help="dimension-RRT sample cap (--planner dimension-rrt and library; default: "
+                        f"{default_of(dimension_rrt_planner, 'max_samples')})")
     p.add_argument("--duration", type=positive_float, default=20.0, help=f"seconds of target motion (duration x rate <= {MAX_TRACK_SAMPLES})")
     p.add_argument("--rate", type=positive_float, default=10.0, help="target samples per second")
     p.add_argument("--seed", type=seed, default=1, help="OMPL / planner seed, 1..2^32-1 (default 1)")
