@@ -176,3 +176,9 @@ def test_a_track_that_lasts_more_than_two_seconds_shows_its_progress_unless_no_p
 def test_a_short_track_prints_nothing_on_stderr(capsys):
     assert main(["track", "--script", "jitter", "--duration", "2", "--json"]) == 0
     assert capsys.readouterr().err == ""
+
+
+def test_track_json_says_where_its_csv_went(capsys, tmp_path):
+    csv = tmp_path / "traj.csv"
+    assert main(["track", "--script", "jitter", "--duration", "1", "--json", "-o", str(csv)]) == 0
+    assert json.loads(capsys.readouterr().out)["output"] == str(csv) and csv.is_file()

@@ -350,7 +350,7 @@ def cmd_track(args: argparse.Namespace) -> int:
                        header=header, comments="", fmt=["%.17g"] * 5 + ["%d"])
     if args.json:
         print(json.dumps({"script": args.script, "samples": len(stream), "trajectory_points": len(result.times),
-                          "events": summary}))
+                          "events": summary, "output": args.output}))
     else:
         print(f"{args.script}: {len(stream)} target samples -> {len(result.times)} trajectory points; "
               + ", ".join(f"{k} {v}" for k, v in summary.items()))
