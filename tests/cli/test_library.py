@@ -231,7 +231,7 @@ def test_a_damaged_packaged_library_is_said_not_taken_for_another_models(tmp_pat
     assert "unreadable" in capsys.readouterr().err
 
 
-def test_plan_and_track_with_another_models_library_say_it_as_library_stats_does(other_model, tmp_path, capsys):
+def test_plan_and_track_refuse_another_models_library_and_library_stats_describes_it(other_model, tmp_path, capsys):
     from helpers.cli_queries import start_goal_args
 
     urdf, srdf = other_model
@@ -240,6 +240,10 @@ def test_plan_and_track_with_another_models_library_say_it_as_library_stats_does
                  "--library", str(lib), "--urdf", urdf, "--srdf", srdf]) == 0
     capsys.readouterr()
     for argv in (["plan", "--from", "1", "--to", "4", *start_goal_args(), "--library", str(lib)],
-                 ["track", "--duration", "1", "--library", str(lib)], ["library", "stats", "--library", str(lib)]):
+                 ["track", "--duration", "1", "--library", str(lib)]):
         assert main(argv) == 2, argv
         assert "give the --urdf/--srdf it was built for" in capsys.readouterr().err
+    # stats describes it from what the file says of itself (a helper: "describe a library file" refused it)
+    assert main(["library", "stats", "--library", str(lib)]) == 0
+    out = capsys.readouterr().out
+    assert "built for model" in out and "pairs: 1->4" in out and '"per_pair": 1' in out

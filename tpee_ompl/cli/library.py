@@ -20,6 +20,7 @@ import numpy as np
 from ..library.build import LibraryBuildOptions
 from ..library.demos import dimension_rrt_planner
 from ..library.dmp import DMPOptions
+from ..library.storage import library_model_hash, library_settings
 from ..library import PathLibrary
 from ..planning.paths import path_length
 from ..resources import default_library_path
@@ -176,7 +177,17 @@ def run_query(args: argparse.Namespace) -> int:
 def run_stats(args: argparse.Namespace) -> int:
     """Print what a library file holds: demonstrations per pair, build parameters and counters."""
     path = _check_library_file(Path(args.library))
-    lib = _load(path, load_robot(args), fallback=False)
+    robot = load_robot(args)
+    if library_model_hash(path) != robot.model_hash:  # described from its metadata: the demos need their model
+        meta = library_settings(path)
+        print(f"{path}: built for model {meta['model_hash']}, not the loaded model {robot.model_hash} (its "
+              "demonstrations are read with the --urdf/--srdf it was built for)")
+        print("pairs: " + ", ".join(f"{i}->{j}" for i, j in meta["pairs"]))
+        print(f"per_step {meta['per_step']}, query_stride {meta['query_stride']}, n_candidates {meta['n_candidates']}")
+        print("build parameters: " + json.dumps(meta["build_params"]))
+        print("build counters: " + json.dumps(meta["build_stats"] or {}))
+        return 0
+    lib = _load(path, robot, fallback=False)
     print(f"{path}: {len(lib)} demonstrations, {path.stat().st_size / 1e6:.2f} MB, model {lib.robot.model_hash}")
     print("per pair: " + ", ".join(f"{i}->{j}: {len(pd.starts)}" for (i, j), pd in sorted(lib.pairs.items())))
     print(f"per_step {lib.per_step}, query_stride {lib.query_stride}, n_candidates {lib.n_candidates}")

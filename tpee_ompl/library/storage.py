@@ -306,6 +306,16 @@ def library_model_hash(path: str | Path) -> str:
     return meta["model_hash"]
 
 
+def library_settings(path: str | Path) -> dict[str, Any]:
+    """What a library file says of itself without a model: its model hash and its checked settings (pairs, per_step,
+    n_candidates, query_stride, DMP options, build parameters and counters); the demonstrations are not read.
+    Raises as :func:`library_model_hash`, or LibraryFileError naming a bad field."""
+    path = Path(path)
+    with _open_archive(path) as archive:
+        meta = _read_meta(archive)
+    return {"model_hash": library_model_hash(path), **_check_meta(meta, path)}
+
+
 def packaged_library_for(robot: WearerArm) -> Path | None:
     """The packaged path library when it was built for ``robot``'s model (it was for the packaged one), else None;
     a damaged packaged library raises (:func:`library_model_hash`)."""
