@@ -162,8 +162,8 @@ def test_a_library_for_another_urdf_is_built_inspected_and_planned_with(other_mo
     capsys.readouterr()
     assert main(["library", "stats", "--library", str(lib), *model]) == 0
     assert "1 demonstrations" in capsys.readouterr().out
-    assert main(["library", "stats", "--library", str(lib)]) == 2  # the packaged model: another hash
-    assert "give the --urdf/--srdf it was built for" in capsys.readouterr().err
+    assert main(["library", "stats", "--library", str(lib)]) == 0  # the packaged model: described from its metadata
+    assert "built for model" in capsys.readouterr().out
     assert main(["plan", "--from", "1", "--to", "4", *start_goal_args(), *model, "--library", str(lib), "--time", "0.05",
                  "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["planner"] == "library"

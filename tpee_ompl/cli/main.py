@@ -48,6 +48,11 @@ def get_argument_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _lower_level(record: logging.LogRecord) -> bool:
+    record.lowlevel = record.levelname.lower()
+    return True
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``tpee-ompl``; returns the exit code."""
     parser = get_argument_parser()
@@ -58,8 +63,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.command is None:
         parser.error("the following arguments are required: COMMAND")
     args.prog = command.prog  # "tpee-ompl library query": who says an error or an interruption
-    logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
-                        format="%(levelname)s %(name)s: %(message)s")
+    # a warning reads like the command's errors ("tpee-ompl: warning: ..."); -v adds the level and the logger's name
+    said = "%(levelname)s %(name)s: %(message)s" if args.verbose else "tpee-ompl: %(lowlevel)s: %(message)s"
+    logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING, format=said)
+    for handler in logging.getLogger().handlers:
+        handler.addFilter(_lower_level)
     seen = interrupts()
     try:
         with sigterm_as_keyboard_interrupt():  # kill / a scheduler: the same cleanup as Ctrl-C (temporary files, workers)
