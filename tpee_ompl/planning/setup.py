@@ -221,7 +221,8 @@ def make_simple_setup(
     start, goal : sequence of nq floats (radians, metres for prismatic joints), optional
     joint_step : float, radians
         Longest joint-space step between checked states (default ``robot.max_joint_step()``,
-        the guarantee in the module docstring).
+        the guarantee in the module docstring).  The motion validator keeps it: a resolution set later with
+        ``si.setStateValidityCheckingResolution`` changes what OMPL's own code reads, not its checks (give it here).
     batched_motion_validator : bool, optional
         Old switch: True is ``motion_validator="batched"``, False is ``"discrete"``.
     check_endpoints : bool
