@@ -365,7 +365,7 @@ class PathLibrary:
         """Read a library saved by :meth:`save` (:func:`tpee_ompl.library.storage.read_library`), with
         ``plan`` as its fallback; a file of another format version, another model, or a damaged one
         raises :class:`~tpee_ompl.library.storage.LibraryFileError`; a ``robot`` that is not a WearerArm, ValueError."""
-        if not isinstance(robot, WearerArm):
+        if not isinstance(getattr(robot, "model_hash", None), str):  # (what the file is checked against)
             raise ValueError(f"robot must be a WearerArm (the library's model), got {type(robot).__name__}")
         pairs, settings = read_library(path, robot)
         return cls(robot, pairs, plan=plan, **settings)
