@@ -211,3 +211,22 @@ def test_a_motion_to_a_non_finite_state_is_invalid_in_a_compound_space(tmp_path,
     c[1] = bad
     assert not si.checkMotion(layout.write(si.allocState(), a), layout.write(si.allocState(), c))
     assert mv.check_motions(np.stack([a, a]), np.stack([c, b])).tolist() == [False, True]
+
+
+def test_a_checker_set_on_the_setup_checks_the_short_way_round_across_plus_minus_pi(tmp_path):
+    robot = RobotChecker(_chain(tmp_path, MIXED))
+    ss = make_simple_setup(robot)
+    si = ss.getSpaceInformation()
+    layout = RealVectorLayout(si.getStateSpace())
+    a = layout.write(si.allocState(), np.array([2.8, 0.3, 0.3, 0.0]))
+    b = layout.write(si.allocState(), np.array([-2.8, 0.3, 0.3, 0.0]))  # the short way passes +/-pi
+    assert si.checkMotion(a, b)
+    own = si.getStateValidityChecker()
+
+    class AwayFromPi(ob.StateValidityChecker):
+        def isValid(self, s: ob.State) -> bool:  # noqa: N802
+            return bool(own.isValid(s) and abs(layout.read(s)[0]) < 3.0)  # (a numpy bool: std::bad_cast)
+
+    checker = AwayFromPi(si)
+    ss.setStateValidityChecker(checker)
+    assert si.isValid(a) and si.isValid(b) and not si.checkMotion(a, b)

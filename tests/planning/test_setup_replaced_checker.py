@@ -74,3 +74,14 @@ def test_a_checker_set_on_the_space_information_makes_the_packages_planners_refu
     ss.setPlanner(DimensionRRT(si, seed=1))
     assert ss.solve(1.0) == ob.PlannerStatus.ABORT
     assert not ss.haveExactSolutionPath()
+
+
+def test_a_function_answering_a_numpy_bool_is_taken_as_a_bool(robot, query):
+    """OMPL's bindings raise std::bad_cast on a numpy bool (a test of the continuous-joint set-up met it)."""
+    ss = make_simple_setup(robot, query.start, query.goal)
+    si = ss.getSpaceInformation()
+    own = si.getStateValidityChecker()
+    ss.setStateValidityChecker(lambda s: np.bool_(own.isValid(s)) & np.bool_(s[3] < 5.0))
+    a, x, _, _ = _into_the_box(si, query)
+    assert si.isValid(x) is True and si.checkMotion(a, x)
+

@@ -155,11 +155,7 @@ class BatchedMotionValidator(ob.MotionValidator):
         """:meth:`check_motions` in a compound space: each motion along the space's geodesic (continuous joints
         the short way round, wrapped into [-pi, pi)), the states ``DiscreteMotionValidator`` checks at
         ``validSegmentCountFactor`` 1 (:meth:`segment_counts`)."""
-        lay = self._layout
-        D = lay.delta(A, B)
-        counts = self.segment_counts(A, B)
-        S = lay.wrap(counted_motion_states(A, D, counts))
-        S[np.cumsum(counts) - 1] = B  # each end is the state itself, as OMPL checks s2
+        S, counts, D = self._geodesic_states(A, B)
         self.motions_checked += len(counts)
         if self.screen_levels:  # the states are evenly spaced along each motion's joint-space line (unwrapped)
             spacing = np.linalg.norm(D, axis=1) / counts
@@ -175,9 +171,7 @@ class BatchedMotionValidator(ob.MotionValidator):
         if self._layout is None:
             S, counts = batched_motion_states(A, B, self.step, factor=self.factor())
         else:
-            counts = self.segment_counts(A, B)
-            S = self._layout.wrap(counted_motion_states(A, self._layout.delta(A, B), counts))
-            S[np.cumsum(counts) - 1] = B
+            S, counts, _ = self._geodesic_states(A, B)
         self.motions_checked += len(counts)
         if self._scratch is None:
             self._scratch, self._writer = self._space.allocState(), RealVectorLayout(self._space)
@@ -187,6 +181,15 @@ class BatchedMotionValidator(ob.MotionValidator):
             order = [len(M) - 1] + [i for i in bisection_order(len(M)).tolist() if i != len(M) - 1]
             ok[k] = all(is_valid(write(state, M[i])) for i in order)
         return self._tally(ok)
+
+    def _geodesic_states(self, A: np.ndarray, B: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """In a compound space: the motions' states along the space's geodesics (wrapped into [-pi, pi)), each
+        motion's count of them, and the motions' joint-space displacements."""
+        D = self._layout.delta(A, B)
+        counts = self.segment_counts(A, B)
+        S = self._layout.wrap(counted_motion_states(A, D, counts))
+        S[np.cumsum(counts) - 1] = B  # each end is the state itself, as OMPL checks s2
+        return S, counts, D
 
     def _tally(self, ok):
         """Count the valid verdicts among ``ok`` (one bool or an array of them) into ``motions_valid``; return ``ok``."""

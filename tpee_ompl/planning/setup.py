@@ -190,6 +190,9 @@ class RobotSimpleSetup(og.SimpleSetup):
     be followed: the package's planners then refuse to plan, :func:`.planner_base.validator_mismatch`)."""
 
     def setStateValidityChecker(self, checker: object) -> None:  # noqa: N802 (OMPL's name)
+        if callable(checker) and not isinstance(checker, ob.StateValidityChecker):
+            fn = checker  # a function's numpy bool would reach OMPL as std::bad_cast: its answer made a bool
+            self._tpee_function = checker = lambda state: bool(fn(state))
         super().setStateValidityChecker(checker)
         robot, _, validator = getattr(self, "_tpee_refs", (None, None, None))
         if not isinstance(validator, BatchedMotionValidator):  # being built, or OMPL's own validator already
