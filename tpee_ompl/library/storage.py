@@ -298,22 +298,24 @@ def library_model_hash(path: str | Path) -> str:
 
     Raises FileNotFoundError (no such file) or LibraryFileError (not a regular file, unreadable, no model hash):
     a damaged library is said as such, never taken for one of another model."""
-    path = Path(path)
+    return _meta_with_model(Path(path))["model_hash"]
+
+
+def _meta_with_model(path: Path) -> dict[str, Any]:
+    """The metadata record of a library file, which names a model (LibraryFileError otherwise)."""
     with _open_archive(path) as archive:
         meta = _read_meta(archive)
     if not isinstance(meta, dict) or not isinstance(meta.get("model_hash"), str):
         raise LibraryFileError(f"path library {path} has no valid metadata: no model hash")
-    return meta["model_hash"]
+    return meta
 
 
 def library_settings(path: str | Path) -> dict[str, Any]:
     """What a library file says of itself without a model: its model hash and its checked settings (pairs, per_step,
     n_candidates, query_stride, DMP options, build parameters and counters); the demonstrations are not read.
     Raises as :func:`library_model_hash`, or LibraryFileError naming a bad field."""
-    path = Path(path)
-    with _open_archive(path) as archive:
-        meta = _read_meta(archive)
-    return {"model_hash": library_model_hash(path), **_check_meta(meta, path)}
+    meta = _meta_with_model(Path(path))
+    return {"model_hash": meta["model_hash"], **_check_meta(meta, Path(path))}
 
 
 def packaged_library_for(robot: WearerArm) -> Path | None:
