@@ -28,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-from ..model.sectors import check_sector, cross_sector_trajectory
+from ..model.sectors import check_sector, cross_sector_trajectory, infer_sector, posture_preset
 from ..model.wearer_arm import WearerArm
 from ..planning.paths import motion_is_valid, motion_step, planned_waypoints, resample_waypoints
 from ..validation import check_bool, check_int
@@ -255,6 +255,18 @@ class PathLibrary:
         path[0], path[-1] = start, goal
         return path
 
+    def check_robot(self, robot: object, what: str = "library") -> None:
+        """ValueError naming ``what`` unless ``robot`` checks as the library's own does (its model and margins): its
+        paths are validated with the library's robot, so a library of another model gives paths that model's
+        robot may reject."""
+        mine = self.robot
+        if getattr(robot, "model_hash", None) != mine.model_hash:
+            raise ValueError(f"{what}: built for model {mine.model_hash!r}, not the robot's "
+                             f"{getattr(robot, 'model_hash', None)!r} (load or build one for this model)")
+        if not np.array_equal(robot.pair_margins, mine.pair_margins):
+            raise ValueError(f"{what}: its robot has other collision margins than this robot (security_margin "
+                             f"{mine.security_margin:g} against {robot.security_margin:g} m): load it with this robot")
+
     def query(
         self, start: np.ndarray, goal: np.ndarray, from_sector: int, to_sector: int, step: float | None = None
     ) -> QueryResult:
@@ -273,6 +285,10 @@ class PathLibrary:
         i, j = check_sector(from_sector), check_sector(to_sector)
         if i == j:
             raise ValueError(f"({i}, {j}) is not a cross-sector motion")
+        for name, q, k in (("start", start, i), ("goal", goal, j)):
+            if infer_sector(q) != k:  # the paths follow the (i, j) row of Table 3, from posture i to posture j
+                raise ValueError(f"{name}: DOF1/DOF2 {np.round(q[:2], 4).tolist()} are not sector {k}'s Table-1 "
+                                 f"posture {np.round(posture_preset(k), 4).tolist()}")
         self._counts["queries"] += 1
         pd = self.pairs.get((i, j))
         tried = 0

@@ -84,6 +84,9 @@ class LibraryDimensionRRT(PythonPlanner):
         if not isinstance(library, PathLibrary):
             raise ValueError(f"library must be a PathLibrary, got {type(library).__name__}")
         check_space_information(si)
+        robot = getattr(si.getStateValidityChecker(), "robot", None)  # a make_simple_setup set-up's robot
+        if robot is not None:
+            library.check_robot(robot)
         space, nq = si.getStateSpace(), library.robot.nq
         if not isinstance(space, ob.RealVectorStateSpace) or space.getDimension() != nq:
             raise ValueError(f"LibraryDimensionRRT plans in the library robot's joint space, a RealVectorStateSpace({nq}) "

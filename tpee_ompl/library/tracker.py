@@ -134,6 +134,11 @@ class Tracker:
         initial_sector: int = 3,
         options: TrackerOptions | None = None,
     ) -> None:
+        if not isinstance(robot, WearerArm):
+            raise ValueError(f"robot must be a WearerArm, got {type(robot).__name__}")
+        if not callable(planner):
+            raise ValueError(f"planner must be a callable (start, goal, from_sector, to_sector) -> waypoints, got "
+                             f"{type(planner).__name__}")
         self.robot = robot
         self.planner = planner
         self.options = options or TrackerOptions()
@@ -218,7 +223,8 @@ class Tracker:
         waypoints[0], waypoints[-1] = self.q, goal
         if not motion_is_valid(self.robot, waypoints, self.check_step):
             raise ValueError(f"planner path {self.sector}->{k} collides or leaves the joint limits (checked every "
-                             f"{self.check_step:g} rad)")
+                             f"{self.check_step:g} rad; a planner must check its paths at least this finely: "
+                             "make_default_planner(step=...))")
         self.events.append(TrackEvent(t, "cross-sector", k, f"{self.sector}->{k}: {why}, {len(waypoints)} waypoints"))
         clock = t
         for i in range(1, len(waypoints)):
@@ -313,6 +319,7 @@ def make_default_planner(
     seed: int | None = 1,
     library: PathLibrary | str | os.PathLike | None = "default",
     library_time: float = 0.05,
+    step: float | None = None,
 ) -> Planner:
     """The tracker's cross-sector planner: the paper's pipeline, with plain fallbacks.
 
@@ -322,8 +329,9 @@ def make_default_planner(
     for), a file, a loaded :class:`PathLibrary`, or None to skip this step.  Otherwise, and for same-sector re-aims: Table 3's straight motion
     (:func:`tpee_ompl.model.queries.straight_motion`; within a sector a straight joint motion) when
     collision-free, else OMPL RRTConnect on :func:`tpee_ompl.planning.setup.make_simple_setup` for
-    at most ``timeout`` seconds, simplified.  Every path is checked at the tracker's default step
-    (:data:`~tpee_ompl.library.path_library.CHECK_STEP`, or the robot's motion step if smaller); raises
+    at most ``timeout`` seconds, simplified.  Every path is checked at ``step`` (default the tracker's default step,
+    :data:`~tpee_ompl.library.path_library.CHECK_STEP`; the robot's motion step if smaller: give a tracker's finer
+    ``check_step`` here); a loaded ``library`` of another model or other margins than ``robot`` is refused; raises
     RuntimeError if none is found.  OMPL's log level is left as the caller set it (its "Info:" lines are off
     while a motion is planned), and OMPL's seed generator is set to ``seed`` here (:func:`seed_ompl`).  ``seed`` fixes the samples,
     not the time: the library step stops after ``library_time`` seconds of wall-clock time, so how far it
@@ -341,9 +349,10 @@ def make_default_planner(
     library_time = check_number("library_time (seconds)", library_time, low=0.0, low_open=True, high=MAX_SECONDS)
     if seed is not None:
         seed_ompl(seed)
-    step = motion_step(robot, CHECK_STEP)
+    step = motion_step(robot, CHECK_STEP if step is None else step)
     lib: PathLibrary | None = None
     if isinstance(library, PathLibrary):
+        library.check_robot(robot)
         lib = library
     elif library == "default":  # the packaged library, when it was built for this model (else none, as track does)
         from .storage import packaged_library_for
