@@ -106,6 +106,28 @@ def test_resume_moves_truncated_and_corrupt_logs_aside_and_runs_their_experiment
     assert meta["interrupted"] is False and meta["finished_experiments"] == 4
 
 
+def test_a_valid_log_of_another_experiment_is_left_out_of_the_database_and_a_resume_adds_its_time(
+        query_file, tmp_path, caplog):
+    """A helper's resume took another campaign's log into the database ("expected 4, finished 5"), and a resume that
+    ran nothing replaced the campaign's 13-s wall time with its own 0.1 s."""
+    other = run_campaign(tiny_config(query_file, tmp_path / "other", sample_caps=(30,), anytime_budgets=(),
+                                     max_queries=1), report=False, progress_bar=False)
+    res = run_campaign(tiny_config(query_file, tmp_path, sample_caps=(20,), anytime_budgets=(), max_queries=2),
+                       report=False, progress_bar=False)
+    before = json.loads((res.directory / "campaign.json").read_text())["wall_time_s"]
+    stray = other.logs[0]
+    assert stray.name not in {p.name for p in res.logs}
+    (res.directory / "logs" / stray.name).write_bytes(stray.read_bytes())
+
+    again = resume_campaign(res.directory, report=False, progress_bar=False)
+
+    assert sorted(p.name for p in again.logs) == sorted(p.name for p in res.logs)
+    assert len(_experiment_names(again.database)) == 2 and stray.name in caplog.text
+    meta = json.loads((res.directory / "campaign.json").read_text())
+    assert meta["stray_logs"] == [stray.name] and meta["finished_experiments"] == 2
+    assert meta["wall_time_s"] > before
+
+
 def test_database_build_skips_a_corrupt_log_by_name(query_file, tmp_path, caplog):
     cfg = tiny_config(query_file, tmp_path, sample_caps=(20, 40), anytime_budgets=(), max_queries=1)
     res = run_campaign(cfg, report=False, progress_bar=False)

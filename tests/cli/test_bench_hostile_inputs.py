@@ -116,6 +116,7 @@ CASES = [
     ("dask-workers-zero", ["--dask-workers", "0"], 2, ["--dask-workers"]),
     ("dask-workers-without-dask", ["--dask-workers", "3"], 2, ["--dask-workers", "give --dask"]),
     ("retries-without-dask", ["--retries", "1"], 2, ["--retries", "give --dask"]),
+    ("scheduler-malformed-is-named-as-given", ["--scheduler", "foo"], 2, ["--scheduler 'foo'"]),
     ("dask-workers-with-a-scheduler-address", ["--dask", "tcp://127.0.0.1:1", "--dask-workers", "2"], 2,
      ["--dask-workers sizes --dask local"]),
     ("retries-negative", ["--retries", "-1"], 2, ["--retries"]),

@@ -431,12 +431,21 @@ def _finish(directory: Path, meta: dict, executor, failed: list[dict], broken: l
         part.unlink()
     for part in (*directory.glob(".*.part*"), *directory.glob("plots/.*.part*")):  # of a process killed writing
         part.unlink(missing_ok=True)
-    logs = sorted(log_dir.glob("*.log"))
+    ours = {log_name(q, k, spec) for k, q in enumerate(meta["query_data"])
+            for spec in experiment_specs(meta["config"], k)}
+    logs = sorted(p for p in log_dir.glob("*.log") if p.name in ours)
+    strays = sorted(p.name for p in log_dir.glob("*.log") if p.name not in ours)
+    if strays:  # another campaign's, or one of this campaign's settings before its campaign.json was edited
+        log.warning("%d log(s) in %s are none of this campaign's experiments, left out of the database: %s",
+                    len(strays), log_dir, ", ".join(strays[:5]) + (", ..." if len(strays) > 5 else ""))
+    meta["stray_logs"] = strays
     lost_attempts = list(getattr(executor, "lost", []) or [])
     if lost_attempts:
         meta.setdefault("lost_attempts", []).extend({**a, "utc": utc_now()} for a in lost_attempts)
+    spent = meta.get("wall_time_s")  # a resume adds its time to the campaign's
     meta.update({"finished_utc": utc_now(), "interrupted": interrupted, "failed_tasks": failed,
-                 "finished_experiments": len(logs), "wall_time_s": wall_time})
+                 "finished_experiments": len(logs),
+                 "wall_time_s": wall_time + (float(spent) if isinstance(spent, (int, float)) and spent >= 0 else 0.0)})
     result = CampaignResult(directory=directory, logs=logs, database=None, interrupted=interrupted,
                             failed_tasks=failed, broken_logs=[p for p, _ in broken])
     what = f"the database {directory / 'benchmark.db'}"

@@ -357,9 +357,10 @@ def _quiet_dask_logs() -> Iterator[None]:
     if logging.getLogger().isEnabledFor(logging.INFO):
         yield
         return
-    logging.getLogger("distributed").setLevel(logging.ERROR)  # back at the executor's shutdown
+    # critical: a task whose process was killed is an ERROR record with a traceback ("Compute Failed")
+    logging.getLogger("distributed").setLevel(logging.CRITICAL)  # back at the executor's shutdown
     key, before = "DASK_LOGGING__DISTRIBUTED", os.environ.get("DASK_LOGGING__DISTRIBUTED")
-    os.environ[key] = "error"  # the worker processes started within the block configure their logging from it
+    os.environ[key] = "critical"  # the worker processes started within the block configure their logging from it
     try:
         yield
     finally:

@@ -64,10 +64,11 @@ _OPTION_OF = {"sample_caps": "--samples", "anytime_budgets": "--anytime", "itera
 """:class:`CampaignConfig` field -> option, to name the option in a refusal."""
 
 
-def _user_message(exc: BaseException) -> str:
-    """``exc`` as one line, naming the command-line option instead of the configuration field."""
+def _user_message(exc: BaseException, given: dict[str, str] | None = None) -> str:
+    """``exc`` as one line, naming the command-line option instead of the configuration field (``given``: fields
+    that another option set, e.g. the scheduler by ``--scheduler``)."""
     msg = " ".join(str(exc).split())
-    for field_name, option in _OPTION_OF.items():
+    for field_name, option in {**_OPTION_OF, **(given or {})}.items():
         if msg.startswith(field_name + " ") or msg.startswith(field_name + ":"):
             msg = option + msg[len(field_name):]
         elif "_" in field_name:
@@ -231,7 +232,8 @@ def run(args: argparse.Namespace) -> int:
                                  dask_workers=2 if args.dask_workers is None else args.dask_workers,
                                  retries=2 if args.retries is None else args.retries)
     except (ValueError, FileNotFoundError, ImportError) as exc:
-        print(f"{prog}: error: {_user_message(exc)}", file=sys.stderr)
+        given = {"scheduler": "--scheduler"} if args.scheduler and not args.dask else None
+        print(f"{prog}: error: {_user_message(exc, given)}", file=sys.stderr)
         return 1 if isinstance(exc, QuerySetError) else 2  # a damaged query file is a runtime error, as in ``plan``
     seen = interrupts()
     try:
