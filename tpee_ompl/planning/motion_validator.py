@@ -74,6 +74,7 @@ class BatchedMotionValidator(ob.MotionValidator):
         validity checker that replaced it (:class:`~tpee_ompl.planning.setup.RobotSimpleSetup` sets it): every
         state goes through its ``isValid``, the end state first, then in bisection order, as OMPL's validator."""
         self._scratch: ob.State | None = None  # the state the checker is given (the space's: si's would keep si alive)
+        self._writer: RealVectorLayout | None = None  # writes the states into it (both made on the first use)
 
     checks_geodesics = True
     """:meth:`check_motions` follows the space's geodesics in a compound space (continuous joints the short way)."""
