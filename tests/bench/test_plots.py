@@ -100,3 +100,13 @@ def test_a_save_that_fails_halfway_leaves_the_previous_plots_untouched(tmp_path,
     with pytest.raises(OSError):
         make_plots(db, folder)
     assert {p.name: p.read_bytes() for p in folder.iterdir()} == before
+
+
+def test_plots_an_earlier_build_drew_and_this_one_cannot_are_removed_other_files_kept(tmp_path):
+    folder = tmp_path / "plots"
+    folder.mkdir()
+    for name in ("box_time.png", "fig15_ratios_batched.png", "notes.png", "readme.txt"):
+        (folder / name).write_bytes(b"earlier")
+    db = make_db(tmp_path / "b.db", RUNS, PROGRESS)  # anytime runs only: no box or ratio plot
+    out = make_plots(db, folder)
+    assert sorted(p.name for p in folder.iterdir()) == sorted([p.name for p in out] + ["notes.png", "readme.txt"])

@@ -129,12 +129,21 @@ CASES = [
     ("resume-bad-query-data", ["--resume", "{in}/bad_query_data"], 2, ["--resume", "query_data", "entry 0"]),
     ("resume-config-a-list", ["--resume", "{in}/config_list"], 2, ["--resume", "config"]),
     ("resume-config-without-seed", ["--resume", "{in}/no_seed"], 2, ["--resume", "no seed"]),
+    ("resume-with-campaign-options", ["--resume", "{in}/not_a_campaign", "--samples", "30", "--seed", "4"], 2,
+     ["--resume", "--samples, --seed would be ignored"]),
+    ("anytime-queries-without-budgets", ["--anytime-queries", "2"], 2, ["--anytime-queries", "give --anytime"]),
+    ("alt-checker-queries-with-one-validator", ["--checkers", "discrete", "--alt-checker-queries", "1"], 2,
+     ["--alt-checker-queries", "has one (discrete)"]),
+    ("alt-checker-samples-without-samples", ["--checkers", "batched", "discrete", "--samples", "--anytime", "1",
+                                             "--alt-checker-samples", "20"], 2, ["--alt-checker-samples", "give --samples"]),
 ]
 
 
 def _args(args: list[str], inputs: Path, out: Path) -> list[str]:
     base = ["bench", "--queries", str(inputs / "good.json"), "--samples", "20", "--anytime",
             "--planners", "RRTstar", "InformedRRTstar", "--workers", "1", "--out", str(out), "--no-progress"]
+    if "--resume" in args:  # a resumed campaign's options are its campaign.json's: giving them is refused
+        base = ["bench", "--workers", "1", "--no-progress"]
     return base + [a.format(**{"in": inputs}) for a in args]
 
 

@@ -42,7 +42,23 @@ def make_plots(db_path: str | Path, directory: str | Path, planner: str | None =
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)
         warnings.simplefilter("ignore", RuntimeWarning)
-        return _make_plots(db_path, directory, planner, reference)
+        written = _make_plots(db_path, directory, planner, reference)
+    _remove_stale_plots(Path(directory), written)
+    return written
+
+
+_PLOT_PATTERNS = ("fig15_ratios_*.png", "box_time.png", "box_length.png", "anytime_cost.png", "anytime_within_best.png")
+"""The names :func:`make_plots` writes."""
+
+
+def _remove_stale_plots(directory: Path, written: list[Path]) -> None:
+    """Remove the plots of an earlier build that this one did not draw (a resumed campaign whose data no longer
+    allow them), so the folder shows the database it sits beside; other files are left alone."""
+    keep = {p.name for p in written}
+    for pattern in _PLOT_PATTERNS:
+        for p in directory.glob(pattern):
+            if p.name not in keep:
+                p.unlink(missing_ok=True)
 
 
 def _make_plots(db_path: str | Path, directory: str | Path, planner: str | None, reference: str | None) -> list[Path]:

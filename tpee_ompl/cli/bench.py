@@ -18,7 +18,7 @@ import traceback
 from collections.abc import Sequence
 from pathlib import Path
 
-from ..bench.config import CHECKERS, KNOWN_PLANNERS, CampaignConfig, check_planner_name
+from ..bench.config import CHECKERS, DEFAULT_CHECKERS, KNOWN_PLANNERS, CampaignConfig, check_planner_name
 from ..bench.problems import DEFAULT_PROBLEM, get_problem
 from ..signals import interrupts
 from ._common import Parser, count, nonempty, positive_int, seconds, seed
@@ -125,7 +125,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.set_defaults(bench_prog=p.prog)
     p.add_argument("--resume", metavar="DIR", type=nonempty, default=None,
                    help="finish an interrupted campaign in DIR: run only its missing experiments (configuration "
-                        "from DIR/campaign.json; the other campaign options are ignored, --workers and the "
+                        "from DIR/campaign.json, so the other campaign options are refused; --workers and the "
                         "executor options apply)")
 
 
@@ -212,6 +212,7 @@ def run(args: argparse.Namespace) -> int:
                 raise ValueError(f"{option} applies to a Dask executor: give --dask too")
         if args.dask_workers is not None and dask != "local":
             raise ValueError("--dask-workers sizes --dask local; a scheduler at an address has its own workers")
+        _refuse_options_that_change_nothing(args)
         if args.resume:  # its own worker count (the checker's threads follow it) unless --workers is given
             if Path(args.resume).is_dir() and not os.access(args.resume, os.W_OK | os.X_OK):
                 raise ValueError(f"--resume {args.resume}: the folder is not writable (the campaign's logs, lock and "
@@ -265,6 +266,38 @@ def run(args: argparse.Namespace) -> int:
               + f"; run them again with --resume {result.directory}", file=sys.stderr)
         return 1
     return 0
+
+
+_CAMPAIGN_OPTIONS = ("problem", "queries", "name", "samples", "anytime", "planners", "anytime_planners", "checkers",
+                     "alt_checker_queries", "alt_checker_samples", "anytime_queries", "max_queries", "runs", "seed",
+                     "max_time", "out")
+"""Options that make the configuration: a resumed campaign takes them from its ``campaign.json``."""
+
+
+def _refuse_options_that_change_nothing(args: argparse.Namespace) -> None:
+    """Raise ValueError naming an option that would be ignored: a campaign option with ``--resume``, the
+    anytime or non-headline-validator subsets of a comparison that does not run."""
+    if args.resume:
+        defaults = vars(build_parser().parse_args([]))
+        plain = lambda v: tuple(v) if isinstance(v, list) else v  # noqa: E731 (a list given, a tuple by default)
+        given = ["--" + d.replace("_", "-") for d in _CAMPAIGN_OPTIONS if plain(getattr(args, d)) != plain(defaults[d])]
+        if given:
+            raise ValueError(f"--resume takes the campaign's configuration from its campaign.json: {', '.join(given)} "
+                             "would be ignored (drop it, or start a new campaign)")
+        return
+    if args.anytime_queries is not None and not args.anytime:
+        raise ValueError("--anytime-queries applies to the anytime comparison: give --anytime budgets too")
+    checkers = (args.checkers if args.checkers is not None
+                else [c for c in get_problem(args.problem).checkers if c in DEFAULT_CHECKERS])  # as for_problem
+    for option, value in (("--alt-checker-queries", args.alt_checker_queries),
+                          ("--alt-checker-samples", args.alt_checker_samples)):
+        if value is None:
+            continue
+        if not args.samples:
+            raise ValueError(f"{option} applies to the sample-cap comparison: give --samples too")
+        if len(checkers) < 2:
+            raise ValueError(f"{option} applies to the motion validators after the first: this campaign has one "
+                             f"({checkers[0]}); name more with --checkers")
 
 
 def _lost_line(failed: list[dict], shown: int = 5) -> str:
