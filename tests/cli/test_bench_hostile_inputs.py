@@ -44,6 +44,10 @@ def inputs(tmp_path_factory, robot) -> Path:
     (d / "not_a_campaign" / "notes.txt").write_text("hello\n")
     (d / "bad_campaign").mkdir()
     (d / "bad_campaign" / "campaign.json").write_text('{"config": ')
+    for name, part, folder in (("logs_a_file", "logs", False), ("lock_a_folder", ".lock", True)):
+        (d / name).mkdir()
+        (d / name / "campaign.json").write_text("{}")
+        (d / name / part).mkdir() if folder else (d / name / part).write_text("x")
     (d / "list_campaign").mkdir()
     (d / "list_campaign" / "campaign.json").write_text("[]")
     meta = {"config": {"queries": None, "seed": 1}, "query_set": "good", "expected_experiments": 1,
@@ -129,6 +133,8 @@ CASES = [
     ("resume-bad-query-data", ["--resume", "{in}/bad_query_data"], 2, ["--resume", "query_data", "entry 0"]),
     ("resume-config-a-list", ["--resume", "{in}/config_list"], 2, ["--resume", "config"]),
     ("resume-config-without-seed", ["--resume", "{in}/no_seed"], 2, ["--resume", "no seed"]),
+    ("resume-logs-a-file", ["--resume", "{in}/logs_a_file"], 2, ["--resume", "logs there is a file"]),
+    ("resume-lock-a-folder", ["--resume", "{in}/lock_a_folder"], 2, ["--resume", ".lock there is a folder"]),
     ("resume-with-campaign-options", ["--resume", "{in}/not_a_campaign", "--samples", "30", "--seed", "4"], 2,
      ["--resume", "--samples, --seed would be ignored"]),
     ("anytime-queries-without-budgets", ["--anytime-queries", "2"], 2, ["--anytime-queries", "give --anytime"]),

@@ -7,7 +7,8 @@ campaign cleanly and :func:`resume_campaign` finishes it later.
 
 Where the rest lives:
 
-* :mod:`tpee_ompl.bench.config`: :class:`~tpee_ompl.bench.config.CampaignConfig` and the names;
+* :mod:`tpee_ompl.bench.config`: :class:`~tpee_ompl.bench.config.CampaignConfig`, the names, and
+  :func:`~tpee_ompl.bench.config.load_campaign` (a folder's saved configuration, checked for a resume);
 * :mod:`tpee_ompl.bench.planners`: planner factories and the recording wrapper;
 * :mod:`tpee_ompl.bench.experiment`: one query's experiments (in a worker process);
 * :mod:`tpee_ompl.bench.database`: patching the recorded data, the SQLite database;
@@ -22,9 +23,7 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
-import json
 import logging
-import math
 import os
 import shutil
 import socket
@@ -35,7 +34,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from .config import CampaignConfig, CampaignResult
+from .config import CampaignConfig, CampaignResult, load_campaign
 from .database import build_database, set_aside_broken_logs
 from .experiment import experiment_specs, log_name, run_query_task
 from ..files import check_writable_folder, write_new_file
@@ -228,57 +227,6 @@ def _run_campaign(plan: CampaignPlan, on_task_done, report: bool, progress_bar: 
         shutil.rmtree(directory, ignore_errors=True)
         raise
     return _execute(directory, meta, executor, on_task_done, report, progress_bar)
-
-
-def load_campaign(directory: str | os.PathLike) -> dict:
-    """The ``campaign.json`` of a campaign folder, checked for resuming; ValueError naming what is wrong."""
-    directory = Path(directory)
-    if not directory.is_dir():
-        raise ValueError(f"resume {directory}: not a folder")
-    path = directory / "campaign.json"
-    if not path.is_file():
-        raise ValueError(f"resume {directory}: not a campaign folder (no campaign.json there)")
-    try:
-        meta = json.loads(path.read_text())
-    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise ValueError(f"resume {directory}: campaign.json is not JSON ({exc})") from None
-    if not isinstance(meta, dict) or not all(k in meta for k in ("config", "query_set", "expected_experiments")):
-        raise ValueError(f"resume {directory}: campaign.json is not a campaign's (no config/query_set)")
-    if "query_data" not in meta:
-        raise ValueError(f"resume {directory}: written by an older version (no query_data): cannot resume")
-    if not isinstance(meta["config"], dict):
-        raise ValueError(f"resume {directory}: campaign.json has a bad config (not an object)")
-    if "seed" not in meta["config"]:  # a default would silently run other queries' runs than the campaign's
-        raise ValueError(f"resume {directory}: campaign.json's config has no seed (every query's runs derive from it)")
-    meta["config"].setdefault("problem", "wearer")  # written before campaigns had problems
-    try:
-        config = CampaignConfig(**{k: tuple(v) if isinstance(v, list) else v for k, v in meta["config"].items()})
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"resume {directory}: campaign.json has a bad config ({exc})") from None
-    from .problems import get_problem
-
-    bad = _bad_query_data(meta["query_data"], get_problem(config.problem).dimension)
-    if bad:
-        raise ValueError(f"resume {directory}: campaign.json has bad query_data ({bad})")
-    return meta
-
-
-def _bad_query_data(rows: object, n: int) -> str | None:
-    """What is wrong with a campaign's ``query_data`` (a list of queries, each with an ``id`` and a finite
-    ``start`` and ``goal`` of the problem's dimension ``n``), or None."""
-    if not isinstance(rows, list) or not rows:
-        return "not a non-empty list"
-    for k, q in enumerate(rows):
-        if not isinstance(q, dict):
-            return f"entry {k} is not an object"
-        if not isinstance(q.get("id"), (int, str)) or isinstance(q.get("id"), bool):
-            return f"entry {k} has no id"
-        for end in ("start", "goal"):
-            v = q.get(end)
-            if (not isinstance(v, list) or len(v) != n
-                    or not all(isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) for x in v)):
-                return f"entry {k}: {end} is not {n} finite numbers"
-    return None
 
 
 def resume_campaign(

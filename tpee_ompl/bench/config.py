@@ -1,5 +1,6 @@
 """What a benchmark campaign runs (:class:`CampaignConfig`), where it wrote (:class:`CampaignResult`),
-and the names the campaign knows: planners, motion validators, progress columns.
+a campaign folder's saved configuration read back for a resume (:func:`load_campaign`), and the names the
+campaign knows: planners, motion validators, progress columns.
 
 Imports no OMPL: the command-line parser (``tpee-ompl --help``) is built from this module alone.
 The command line takes its defaults from :class:`CampaignConfig`'s fields (one source).
@@ -7,6 +8,8 @@ The command line takes its defaults from :class:`CampaignConfig`'s fields (one s
 
 from __future__ import annotations
 
+import json
+import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -25,6 +28,7 @@ __all__ = [
     "PROGRESS_PROPERTIES",
     "check_planner_name",
     "default_workers",
+    "load_campaign",
 ]
 
 ITERATION_PLANNERS = ("DimensionRRT", "RRTstar")
@@ -246,3 +250,58 @@ class CampaignResult:
     broken_logs: list[Path] = field(default_factory=list)
     """Logs found unreadable at resume, moved to ``logs/broken/`` and run again."""
     plots: list[Path] = field(default_factory=list)
+
+
+def load_campaign(directory: str | os.PathLike) -> dict:
+    """The ``campaign.json`` of a campaign folder, checked for resuming; ValueError naming what is wrong."""
+    directory = Path(directory)
+    if not directory.is_dir():
+        raise ValueError(f"resume {directory}: not a folder")
+    path = directory / "campaign.json"
+    if not path.is_file():
+        raise ValueError(f"resume {directory}: not a campaign folder (no campaign.json there)")
+    for name, folder in (("logs", True), ("tasks.jsonl", False), (".lock", False), ("plots", True)):
+        if (directory / name).exists() and (directory / name).is_dir() != folder:  # the OS would say "File exists"
+            raise ValueError(f"resume {directory}: {name} there is a {'file' if folder else 'folder'}; the campaign "
+                             f"writes a {'folder' if folder else 'file'} of that name (move it away)")
+    try:
+        meta = json.loads(path.read_text())
+    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise ValueError(f"resume {directory}: campaign.json is not JSON ({exc})") from None
+    if not isinstance(meta, dict) or not all(k in meta for k in ("config", "query_set", "expected_experiments")):
+        raise ValueError(f"resume {directory}: campaign.json is not a campaign's (no config/query_set)")
+    if "query_data" not in meta:
+        raise ValueError(f"resume {directory}: written by an older version (no query_data): cannot resume")
+    if not isinstance(meta["config"], dict):
+        raise ValueError(f"resume {directory}: campaign.json has a bad config (not an object)")
+    if "seed" not in meta["config"]:  # a default would silently run other queries' runs than the campaign's
+        raise ValueError(f"resume {directory}: campaign.json's config has no seed (every query's runs derive from it)")
+    meta["config"].setdefault("problem", "wearer")  # written before campaigns had problems
+    try:
+        config = CampaignConfig(**{k: tuple(v) if isinstance(v, list) else v for k, v in meta["config"].items()})
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"resume {directory}: campaign.json has a bad config ({exc})") from None
+    from .problems import get_problem
+
+    bad = _bad_query_data(meta["query_data"], get_problem(config.problem).dimension)
+    if bad:
+        raise ValueError(f"resume {directory}: campaign.json has bad query_data ({bad})")
+    return meta
+
+
+def _bad_query_data(rows: object, n: int) -> str | None:
+    """What is wrong with a campaign's ``query_data`` (a list of queries, each with an ``id`` and a finite
+    ``start`` and ``goal`` of the problem's dimension ``n``), or None."""
+    if not isinstance(rows, list) or not rows:
+        return "not a non-empty list"
+    for k, q in enumerate(rows):
+        if not isinstance(q, dict):
+            return f"entry {k} is not an object"
+        if not isinstance(q.get("id"), (int, str)) or isinstance(q.get("id"), bool):
+            return f"entry {k} has no id"
+        for end in ("start", "goal"):
+            v = q.get(end)
+            if (not isinstance(v, list) or len(v) != n
+                    or not all(isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) for x in v)):
+                return f"entry {k}: {end} is not {n} finite numbers"
+    return None
