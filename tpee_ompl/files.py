@@ -42,7 +42,7 @@ def check_output_path(path: str | os.PathLike, *, force: bool = False, what: str
     _check_nearest_folder((Path(os.path.realpath(p)) if p.is_symlink() else p).parents,  # a link: where it is written
                           f"{what} {p}")
     if p.exists() and not force:
-        raise OutputExistsError(f"{what} {p} exists; pass --force to replace it")
+        raise OutputExistsError(f"{what} {p} exists; pass --force (in Python: force=True) to replace it")
     return p
 
 
@@ -102,7 +102,7 @@ def atomic_path(path: str | os.PathLike, *, force: bool = True, suffix_last: boo
     target = Path(path)
     _check_replaceable(target, "output file")
     if target.exists() and not force:
-        raise OutputExistsError(f"{target} exists; pass --force to replace it")
+        raise OutputExistsError(f"{target} exists; pass --force (in Python: force=True) to replace it")
     if target.is_symlink():  # the file it points to is replaced, the link stays
         target = Path(os.path.realpath(target))
     target.parent.mkdir(parents=True, exist_ok=True)
@@ -159,7 +159,7 @@ def _place_new(tmp: Path, target: Path) -> None:
             os.replace(tmp, target)
             return
     what = "a link to itself" if target.is_symlink() else "written while this ran"
-    raise OutputExistsError(f"{target} exists ({what}); pass --force to replace it")
+    raise OutputExistsError(f"{target} exists ({what}); pass --force (in Python: force=True) to replace it")
 
 
 def atomic_write(path: str | os.PathLike, write: Callable[[Path], object], *, force: bool = True) -> Path:

@@ -178,6 +178,14 @@ def test_tracker_times_and_joint_speeds_are_held_to_what_time_stamps_resolve(rob
     tracker.step(1.7e9, np.array([5.0, 2.0, 1.5]))  # a Unix time is fine
 
 
+def test_tracker_new_target_flag_must_be_a_bool(robot, planner):
+    tracker = Tracker(robot, planner, initial_sector=3)
+    with pytest.raises(ValueError, match="new_target"):
+        tracker.step(0.0, np.array([5.0, 2.0, 1.5]), new_target="no")  # a truthy string marked every sample new
+    assert tracker.events == []
+    tracker.step(0.0, np.array([5.0, 2.0, 1.5]), new_target=np.bool_(True))
+
+
 def test_tracker_rejects_a_planner_path_with_wrong_ends(robot):
     tracker = Tracker(robot, lambda s, g, i, j: np.array([s, s]), initial_sector=3)
     with pytest.raises(ValueError, match="does not start"):

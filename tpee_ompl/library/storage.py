@@ -66,7 +66,7 @@ def write_library(library: PathLibrary, path: str | Path, *, force: bool = True)
     """
     path = Path(path)
     if path.exists() and not force:
-        raise OutputExistsError(f"path library {path} exists; pass --force to replace it")
+        raise OutputExistsError(f"path library {path} exists; pass --force (in Python: force=True) to replace it")
     meta = {
         "format_version": FORMAT_VERSION,
         "model_hash": library.robot.model_hash,

@@ -26,7 +26,7 @@ from ..model.pointing import AimingError, BlindAreaError, PointingGeometry, aim_
 from ..model.sectors import SECTORS, check_sector, in_pointing_sector, infer_sector, posture_preset, posture_sector
 from ..model.wearer_arm import WearerArm
 from ..planning.paths import MIN_JOINT_STEP, motion_is_valid, motion_states, motion_step, planned_waypoints
-from ..validation import MAX_SECONDS, as_float_array, check_number
+from ..validation import MAX_SECONDS, as_float_array, check_bool, check_number
 from .path_library import CHECK_STEP, PathLibrary
 
 __all__ = [
@@ -246,9 +246,11 @@ class Tracker:
         Raises
         ------
         ValueError
-            If t is not a finite number within +/-``MAX_TIME`` or target is not 3 numbers.
+            If t is not a finite number within +/-``MAX_TIME``, target is not 3 numbers or ``new_target``
+            is not a bool.
         """
         t = check_number("time t (seconds)", t, low=-MAX_TIME, high=MAX_TIME)
+        new_target = check_bool("new_target", new_target)
         raw = as_float_array(target, "target")
         if raw.shape != (3,):
             raise ValueError(f"target must have shape (3,); got {raw.shape}")
