@@ -164,7 +164,8 @@ def _wait_for(pred, timeout: float = 60.0) -> None:
 
 @pytest.mark.slow
 @pytest.mark.parametrize(("sig", "moment"), [(signal.SIGINT, "first_log"), (signal.SIGTERM, "start")])
-def test_signal_keeps_finished_runs_never_half_writes_the_db_and_resume_completes(query_file, tmp_path, sig, moment):
+def test_signal_keeps_finished_runs_never_half_writes_the_db_and_resume_completes(query_file, tmp_path, sig, moment,
+                                                                                  capsys):
     proc = _launch(query_file, tmp_path)
     folders = lambda: list(tmp_path.glob("*_sig"))  # noqa: E731
     try:
@@ -192,6 +193,8 @@ def test_signal_keeps_finished_runs_never_half_writes_the_db_and_resume_complete
     else:
         assert not db.exists()
     assert main(["--resume", str(directory), "--workers", "1", "--no-progress"]) == 0
+    printed = capsys.readouterr().out  # the headline tables and a count; the other tables are in report.md
+    assert "runs: " in printed and f"results: {directory}" in printed and "## Success counts" not in printed
     logs = {p.name: p.read_bytes() for p in (directory / "logs").glob("*.log")}
     assert len(logs) == meta["expected_experiments"]
     assert all(logs[name] == data for name, data in kept.items())  # finished logs untouched
