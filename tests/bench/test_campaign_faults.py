@@ -128,6 +128,19 @@ def test_a_valid_log_of_another_experiment_is_left_out_of_the_database_and_a_res
     assert meta["wall_time_s"] > before
 
 
+def test_a_resume_with_another_worker_count_records_it_and_keeps_the_campaigns_own(query_file, tmp_path):
+    """``--resume --workers N`` rewrote ``config.workers`` (and the executor): the record then said every run was
+    made with the resume's set-up."""
+    res = run_campaign(tiny_config(query_file, tmp_path, sample_caps=(20,), anytime_budgets=(), max_queries=1),
+                       report=False, progress_bar=False)
+    meta = json.loads((res.directory / "campaign.json").read_text())
+    assert meta["config"]["workers"] == 0 and "resumes" not in meta
+    resume_campaign(res.directory, workers=1, report=False, progress_bar=False)
+    again = json.loads((res.directory / "campaign.json").read_text())
+    assert again["config"]["workers"] == 0 and again["executor"] == meta["executor"]
+    assert [r["workers"] for r in again["resumes"]] == [1] and "1 worker" in again["resumes"][0]["executor"]
+
+
 def test_database_build_skips_a_corrupt_log_by_name(query_file, tmp_path, caplog):
     cfg = tiny_config(query_file, tmp_path, sample_caps=(20, 40), anytime_budgets=(), max_queries=1)
     res = run_campaign(cfg, report=False, progress_bar=False)

@@ -226,7 +226,7 @@ def _run_campaign(plan: CampaignPlan, on_task_done, report: bool, progress_bar: 
     except BaseException:  # a folder without campaign.json could not be resumed: leave none
         shutil.rmtree(directory, ignore_errors=True)
         raise
-    return _execute(directory, meta, executor, on_task_done, report, progress_bar)
+    return _execute(directory, meta, executor, on_task_done, report, progress_bar, int(config.workers))
 
 
 def resume_campaign(
@@ -242,20 +242,23 @@ def resume_campaign(
 
     Finished logs are kept; a log that OMPL's reader cannot read (truncated, corrupt) is moved to
     ``logs/broken/`` and its experiment runs again.  The database and report are rebuilt from all logs.  The
-    configuration and queries come from the folder's ``campaign.json``; ``workers`` overrides the
-    pool size.  A query resumed part-way runs its missing experiments in a fresh process seeded
+    configuration and queries come from the folder's ``campaign.json``; ``workers`` sets this resume's
+    pool size (default: the campaign's; ``campaign.json``'s ``resumes`` records each resume's count and executor,
+    its ``config`` keeps the campaign's own).  A query resumed part-way runs its missing experiments in a fresh process seeded
     as before, so they are valid runs but (OMPL's RNG stream being shared by the experiments of a
     query) not bit-identical to an uninterrupted campaign.
     """
     directory = Path(directory)
     meta = load_campaign(directory)
-    if workers is not None:
+    if workers is not None:  # this resume's; the configuration keeps the count the campaign ran with
         from ..validation import check_int
 
-        meta["config"]["workers"] = check_int("workers", workers, minimum=0)
-    meta.setdefault("resumed_utc", []).append(utc_now())
+        workers = check_int("workers", workers, minimum=0)
+    else:
+        workers = int(meta["config"]["workers"])
+    meta.setdefault("resumes", []).append({"utc": utc_now(), "workers": workers})
     (directory / "logs").mkdir(exist_ok=True)
-    return _execute(directory, meta, executor, on_task_done, report, progress_bar)
+    return _execute(directory, meta, executor, on_task_done, report, progress_bar, workers)
 
 
 def task_time_limit(cfg: dict, specs: list[dict]) -> float:
@@ -286,12 +289,14 @@ def _tasks(meta: dict, log_dir: Path, done_names: set[str], n_threads, shared_fs
     return tasks
 
 
-def _execute(directory: Path, meta: dict, executor, on_task_done, report: bool, progress_bar: bool) -> CampaignResult:
+def _execute(directory: Path, meta: dict, executor, on_task_done, report: bool, progress_bar: bool,
+             workers: int) -> CampaignResult:
     with _campaign_lock(directory):
-        return _execute_locked(directory, meta, executor, on_task_done, report, progress_bar)
+        return _execute_locked(directory, meta, executor, on_task_done, report, progress_bar, workers)
 
 
-def _execute_locked(directory: Path, meta: dict, executor, on_task_done, report: bool, progress_bar: bool) -> CampaignResult:
+def _execute_locked(directory: Path, meta: dict, executor, on_task_done, report: bool, progress_bar: bool,
+                    workers: int) -> CampaignResult:
     cfg = meta["config"]
     log_dir = directory / "logs"
     interrupted = False
@@ -312,13 +317,16 @@ def _execute_locked(directory: Path, meta: dict, executor, on_task_done, report:
                     {"log": p.name, "moved_to": str(p.relative_to(directory)), "reason": r, "utc": utc_now()}
                     for p, r in broken)
             done_names = {p.name for p in log_dir.glob("*.log")}
-            executor = executor if executor is not None else make_executor(int(cfg["workers"]))
+            executor = executor if executor is not None else make_executor(workers)
             in_process = not getattr(executor, "fresh_process_per_task", True)
             shared_fs = getattr(executor, "shares_filesystem", True)
-            n_threads = None if in_process or int(cfg["workers"]) == 1 and shared_fs else 1
+            n_threads = None if in_process or workers == 1 and shared_fs else 1
             tasks = _tasks(meta, log_dir, done_names, n_threads, shared_fs)
             fn = run_query_task if shared_fs else run_task_in_subprocess
-            meta["executor"] = executor.description
+            if meta.get("resumes") and "executor" in meta:  # the campaign's own executor stays on record
+                meta["resumes"][-1]["executor"] = executor.description
+            else:
+                meta["executor"] = executor.description
             log.info("campaign %s: %d queries, %d experiments (%d to run) on %s", directory, len(meta["query_data"]),
                      meta["expected_experiments"], sum(len(t["specs"]) for t in tasks), executor.description)
             with tqdm(total=len(tasks), desc=f"{cfg['name']} queries", unit="query", disable=not progress_bar) as bar:
