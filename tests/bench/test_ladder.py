@@ -153,6 +153,28 @@ def test_one_run_ladders_give_the_database_of_separate_runs(tmp_path, robot):
     assert largest[0] == largest[1]  # the ladder's one run is the separate run at its largest cap: the same seeds
 
 
+@pytest.mark.slow
+def test_a_resumed_ladder_member_holds_the_rows_of_the_uninterrupted_campaign(tmp_path, robot):
+    """A resume ran the missing cap alone, seeded by its own cap: RRT*'s N=60 row became another run (7.97 -> 6.11
+    in a helper's arm4 campaign).  The ladder runs whole now, and only the missing log is written."""
+    from tpee_ompl.bench.campaign import resume_campaign
+
+    qfile = write_query_file(tmp_path / "q.json", robot, n=1)
+    cfg = CampaignConfig(name="rs", queries=str(qfile), sample_caps=(60, 120), iteration_planners=("DimensionRRT", "RRTstar"),
+                         checkers=("batched",), anytime_budgets=(), workers=0, seed=3, out=str(tmp_path / "out"))
+    res = run_campaign(cfg, progress_bar=False, report=False)
+    query = ("SELECT e.sample_cap, p.name, " + ", ".join(f"r.{c}" for c in EXACT_COLUMNS) + " FROM runs r JOIN "
+             "experiments e ON r.experimentid = e.id JOIN plannerConfigs p ON r.plannerid = p.id ORDER BY e.sample_cap, p.name")
+    before = sqlite3.connect(res.database).execute(query).fetchall()
+    (small,) = [p for p in res.logs if p.name.endswith("_N60.log")]
+    (large,) = [p for p in res.logs if p.name.endswith("_N120.log")]
+    kept = large.read_bytes()
+    small.unlink()
+    again = resume_campaign(res.directory, progress_bar=False, report=False)
+    assert sqlite3.connect(again.database).execute(query).fetchall() == before
+    assert large.read_bytes() == kept  # the member that had a log is left as it was
+
+
 def test_checkpoint_columns_write_waypoints_of_a_compound_so2_space():
     from tpee_ompl.bench.ladder import Ladder
 

@@ -244,9 +244,9 @@ def resume_campaign(
     ``logs/broken/`` and its experiment runs again.  The database and report are rebuilt from all logs.  The
     configuration and queries come from the folder's ``campaign.json``; ``workers`` sets this resume's
     pool size (default: the campaign's; ``campaign.json``'s ``resumes`` records each resume's count and executor,
-    its ``config`` keeps the campaign's own).  A query resumed part-way runs its missing experiments in a fresh process seeded
-    as before, so they are valid runs but (OMPL's RNG stream being shared by the experiments of a
-    query) not bit-identical to an uninterrupted campaign.
+    its ``config`` keeps the campaign's own).  A query resumed part-way runs its missing experiments in a fresh process with the
+    planners' own seeds (a ladder with a missing member runs whole), so iteration-capped rows are those of an
+    uninterrupted campaign.
     """
     directory = Path(directory)
     meta = load_campaign(directory)

@@ -128,16 +128,23 @@ def run_query_task(task: dict) -> dict:
     seed_ompl(task["seed"])  # (each planner is seeded again before it is made)
     ou.setLogLevel(ou.LOG_WARN)
     log_dir = Path(task["log_dir"]) if task.get("log_dir") else None
-    specs = task.get("specs") or experiment_specs(cfg, qpos)
+    given = {log_name(query, qpos, s): s for s in (task.get("specs") or experiment_specs(cfg, qpos))}
+    wanted = set(given)
     out: dict = {"qpos": qpos, "query_id": query["id"], "logs": {}, "extras": {}, "errors": {},
                  "pid": os.getpid(), "host": socket.gethostname()}
     from .anytime_ladder import AnytimeLadder, group_anytime_ladders
     from .ladder import Ladder, group_ladders
 
-    # written by an earlier attempt of this task whose worker died
-    specs = [s for s in specs if log_dir is None or not (log_dir / log_name(query, qpos, s)).is_file()]
-    groups = group_ladders(specs, cfg.get("one_run_per_ladder", True), cfg["iteration_planners"])
+    # not those written by an earlier attempt of this task whose worker died
+    wanted = {n for n in wanted if log_dir is None or not (log_dir / n).is_file()}
+    # Ladders are grouped from all the query's experiments: a ladder with a missing member runs whole, with the
+    # seeds of its largest cap (budget), so the missing log holds the rows of an uninterrupted campaign.
+    specs = {log_name(query, qpos, s): s for s in experiment_specs(cfg, qpos)}
+    specs.update(given)  # a task's own spec (a test's seed_tag) stands for the configuration's
+    groups = group_ladders(list(specs.values()), cfg.get("one_run_per_ladder", True), cfg["iteration_planners"])
     for group in group_anytime_ladders(groups, cfg.get("one_run_per_anytime_ladder", True)):
+        if not any(log_name(query, qpos, s) in wanted for s in group):
+            continue
         ladder = None  # one run at the largest cap (longest budget) gives every cap's (budget's) log
         if len(group) > 1:
             ladder = (Ladder(group) if group[0]["comparison"] == "iterations"
@@ -147,6 +154,8 @@ def run_query_task(task: dict) -> dict:
             results = (ladder.derived or [_run_experiment(cfg, task, s) for s in group[:-1]]) + results
         for spec, (text, extras, error) in zip(group, results):
             fname = log_name(query, qpos, spec)
+            if fname not in wanted:  # a member whose log exists: it stays as it is
+                continue
             out["logs"][fname], out["extras"][fname] = text, extras
             if error:
                 out["errors"][fname] = error
