@@ -146,6 +146,22 @@ def test_the_robot_problems_groups_are_the_robot_modules_groups():
     assert get_problem("kinova-posts").groups == KINOVA_GROUPS
 
 
+@needs_panda
+@pytest.mark.slow
+def test_the_recorded_seed_is_the_experiments_process_seed_on_a_setup_that_draws_nothing(tmp_path):
+    """The kinova set-up draws no random number, so OMPL recorded the seed set last, RRT*'s own (4184217888 for
+    process seed 1): Planner Arena's ``seed`` column named a seed that made none of the runs."""
+    import sqlite3
+
+    from tpee_ompl.bench.campaign import run_campaign
+
+    cfg = CampaignConfig.for_problem("kinova-posts", name="k", sample_caps=(20,), anytime_budgets=(),
+                                     checkers=("batched",), max_queries=2, workers=0, seed=7, out=str(tmp_path))
+    res = run_campaign(cfg, progress_bar=False, report=False)
+    rows = sqlite3.connect(res.database).execute("SELECT seed, process_seed FROM experiments").fetchall()
+    assert sorted(rows) == [("7", 7), ("8", 8)]
+
+
 def test_the_continuous_joint_arm_leaves_out_what_an_so2_compound_cannot_take():
     p = get_problem("kinova-posts")
     assert "certified" not in p.checkers and p.checkers[0] == "batched"

@@ -82,14 +82,21 @@ SOLUTION_KEYS = ("approximate solution", "solution ", "correct solution", "simpl
 """Prefixes of OMPL's run columns written only when the run has a path."""
 
 
-def patch_recorded_data(bench: ot.Benchmark, wrappers: dict, records: dict, cap: int | None) -> None:
+def patch_recorded_data(bench: ot.Benchmark, wrappers: dict, records: dict, cap: int | None,
+                        seed: int | None = None) -> None:
     """Write the post-run records into the recorded experiment data (in place, before saving).
+
+    ``seed``: the experiment's process seed, written as OMPL's recorded ``seed`` (OMPL keeps the seed set last
+    before its first random draw: with a set-up that draws nothing, a planner's own seed, set as it was made).
 
     ``wrappers``: planner name -> its :class:`~tpee_ompl.bench.planners.RecordingPlanner`;
     ``records``: planner name -> one ``{"props": {column: value}, "progress": [(t, cost, n)]}`` per run.
     A run OMPL counts as solved whose path stops short of the goal (``reaches_goal`` 0) is written unsolved.
     """
-    for pl in bench.getRecordedExperimentData().planners:
+    data = bench.getRecordedExperimentData()
+    if seed is not None:
+        data.seed = int(seed)
+    for pl in data.planners:
         name = planner_name(pl.name)
         recs = records.get(name, [])
         runs = list(pl.runs)

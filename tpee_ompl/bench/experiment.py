@@ -290,7 +290,7 @@ def _run_experiment(cfg: dict, task: dict, spec: dict, ladder=None, only: list[s
     error = _benchmark(bench, _request(cfg, spec), name)
     if error is not None:
         pad_aborted_runs(bench, records, int(cfg["runs"]), error)
-    patch_recorded_data(bench, wrappers, records, spec["cap"])
+    patch_recorded_data(bench, wrappers, records, spec["cap"], int(task["seed"]))
     text = log_text(bench)
     if sink is not None:
         from .anytime_ladder import copy_planner
