@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import logging
 import math
+import sys
 from typing import Any
 
 from ompl import base as ob
@@ -50,6 +51,8 @@ def validator_mismatch(si: ob.SpaceInformation) -> str | None:
     :func:`~tpee_ompl.planning.setup.make_simple_setup` check with the robot (or the checker their setup was given),
     and a checker set on ``si`` itself (which :class:`~tpee_ompl.planning.setup.RobotSimpleSetup` cannot follow) is
     not the one they consult."""
+    if f"{__package__}.motion_validator" not in sys.modules:  # none can exist; importing it loads Pinocchio (0.4 s)
+        return None
     from .motion_validator import BatchedMotionValidator
     from .setup import checks_as_robot
 
