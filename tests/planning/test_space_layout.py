@@ -48,22 +48,25 @@ def test_other_space_types_are_refused_by_name(make) -> None:
         RealVectorLayout(cs)
 
 
-def test_layout_tells_when_the_space_bounds_changed() -> None:
+def test_layout_tells_when_the_space_bounds_or_weights_changed() -> None:
     space = _space(3, bound=1.0)
     lay = RealVectorLayout(space)
-    assert not lay.bounds_changed(space)
+    assert not lay.layout_changed(space)
     space.setBounds(-1.0, 1.5)
-    assert lay.bounds_changed(space)
+    assert lay.layout_changed(space)
     space.setBounds(-1.0, 1.0)
-    assert not lay.bounds_changed(space)
+    assert not lay.layout_changed(space)
     cs = ob.CompoundStateSpace()
     cs.addSubspace(ob.SO2StateSpace(), 1.0)
     r = _space(2, bound=1.0)
     cs.addSubspace(r, 1.0)
     lay = RealVectorLayout(cs)
-    assert not lay.bounds_changed(cs)
+    assert not lay.layout_changed(cs)
     r.setBounds(-0.5, 1.0)
-    assert lay.bounds_changed(cs)
+    assert lay.layout_changed(cs)
+    lay = RealVectorLayout(cs)
+    cs.setSubspaceWeight(0, 10.0)  # a reused planner kept the old metric: best cost 5.07 for a path 35.49 long
+    assert lay.layout_changed(cs)
 
 
 def test_real_vector_space_without_bounds_is_refused() -> None:

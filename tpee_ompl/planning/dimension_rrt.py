@@ -262,9 +262,9 @@ class DimensionRRT(PythonPlanner):
         return None
 
     def _regrouped(self) -> GroupedSpace | None:
-        """The grouped space for the space's bounds as they are now, or None when they have not changed."""
+        """The grouped space for the space's bounds and weights as they are now, or None when they have not changed."""
         space, old = self.getSpaceInformation().getStateSpace(), self.grouped
-        if not old.layout.bounds_changed(space):
+        if not old.layout.layout_changed(space):
             return None
         return GroupedSpace(space, old.groups, old.h, old.prescribed)
 

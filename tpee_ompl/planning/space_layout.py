@@ -68,14 +68,16 @@ class RealVectorLayout:
                          and not self.has_circular)
         """A single RealVector space: the metric is the plain Euclidean norm."""
 
-    def bounds_changed(self, space: ob.StateSpace) -> bool:
-        """Whether ``space``'s bounds differ from those this layout was built with (OMPL's planners read them at
-        each solve).  For a single RealVector space a read of its bounds; otherwise a new layout compared."""
+    def layout_changed(self, space: ob.StateSpace) -> bool:
+        """Whether ``space``'s bounds, subspace weights or subspaces differ from those this layout was built with
+        (OMPL's planners read them at each solve).  For a single RealVector space a read of its bounds; otherwise
+        a new layout compared."""
         if self.is_plain and isinstance(space, ob.RealVectorStateSpace):
             b = space.getBounds()
             return list(b.low) != self.lower.tolist() or list(b.high) != self.upper.tolist()
         layout = RealVectorLayout(space)
-        return not (np.array_equal(layout.lower, self.lower) and np.array_equal(layout.upper, self.upper))
+        return not (layout._leaves == self._leaves and np.array_equal(layout.lower, self.lower)
+                    and np.array_equal(layout.upper, self.upper))
 
     def _collect(self, space: ob.StateSpace, path: tuple[int, ...], weight: float, lows: list, highs: list) -> None:
         if isinstance(space, ob.RealVectorStateSpace):
