@@ -43,3 +43,14 @@ def test_a_log_of_the_earlier_format_read_first_joins_todays_names_and_integer_q
         assert {r[0] for r in con.execute("SELECT typeof(query_id) FROM progress")} <= {"integer"}
     finally:
         con.close()
+
+
+def test_a_query_set_named_like_an_old_query_suffix_keeps_its_experiment_name():
+    """``_q001`` in a query set's own name was taken for the query number of the earlier format and cut: the
+    database said ``iterations_pn_N300_batched`` where the log said ``iterations_pn_q001_N300_batched``."""
+    from tpee_ompl.bench.database import _without_query_in_name
+
+    today = "Experiment iterations_pn_q001_N300_batched\nquery_set TEXT = pn_q001\n"
+    assert _without_query_in_name(today) == today
+    earlier = "Experiment iterations_pn_q001_q007_T0.5s_batched\nquery_set TEXT = pn_q001\n"
+    assert _without_query_in_name(earlier).startswith("Experiment iterations_pn_q001_T0.5s_batched\n")

@@ -224,8 +224,18 @@ def build_database(logs: Sequence[os.PathLike], db_path: os.PathLike) -> tuple[P
     return db_path, bad
 
 
-_OLD_NAME = re.compile(r"^(Experiment \S+)_q\d{3}(_(?:N\d+|T\S+s)_\S+)$", re.MULTILINE)
+_QUERY_SET = re.compile(r"^query_set TEXT = (.*)$", re.MULTILINE)
 _OLD_QUERY_ID = re.compile(r"^query_id TEXT = ", re.MULTILINE)
+
+
+def _without_query_in_name(text: str) -> str:
+    """``text`` with an experiment name of the earlier format (``<comparison>_<query set>_qNNN_<setting>_...``) in
+    today's; a query set whose own name ends in ``_qNNN`` is told apart by the log's ``query_set`` parameter."""
+    qs = _QUERY_SET.search(text)
+    if qs is None:
+        return text
+    old = re.compile(rf"^(Experiment [a-z]+_{re.escape(qs.group(1))})_q\d{{3}}(_(?:N\d+|T\S+s)_\S+)$", re.MULTILINE)
+    return old.sub(r"\1\2", text, count=1)
 
 
 def _in_current_format(path: Path, folder: Path) -> Path:
@@ -235,7 +245,7 @@ def _in_current_format(path: Path, folder: Path) -> Path:
     OMPL's reader types a parameter's column by the first log that has it, so one such log first would make
     ``query_id`` text for the whole database, and Planner Arena fails on a numeric-looking text parameter."""
     text = path.read_text()
-    new = _OLD_QUERY_ID.sub("query_id INTEGER = ", _OLD_NAME.sub(r"\1\2", text, count=1), count=1)
+    new = _OLD_QUERY_ID.sub("query_id INTEGER = ", _without_query_in_name(text), count=1)
     if new == text:
         return path
     copy = folder / f"{len(list(folder.iterdir()))}_{path.name}"
