@@ -240,3 +240,17 @@ def test_a_campaign_without_the_reference_at_sample_caps_says_why_it_has_no_tabl
     assert "## Table 4" not in out["markdown_text"] and not (tmp_path / "table4.csv").exists()
     assert not (tmp_path / "anytime.csv").exists() and not (tmp_path / "anytime_quality.csv").exists()
     assert (tmp_path / "success.csv").read_text().startswith("comparison,")
+
+
+def test_table4_marks_a_metric_with_fewer_ratios_than_the_row_count():
+    """A start = goal query's reference length is 0: no length ratio, yet the row said n = 2 for every column."""
+    import math
+
+    from tpee_ompl.bench.report import RATIO_METRICS, _ratio_markdown
+
+    ratios = [{"checker": "batched", "sample_cap": 500, "metric": key, "n": 2 if key == "time" else 1, "queries": 2,
+               "mean": 0.5, "median": 0.5, "q1": 0.5, "q3": 0.5, "paper": math.nan, "label": key, "tpee": False}
+              for key in RATIO_METRICS]
+    (row,) = [line for line in _ratio_markdown(ratios, "A", "B", "batched") if line.startswith("| 500 |")]
+    cells = row.split(" | ")
+    assert cells[1] == "2/2" and "(n=1)" not in cells[2] and all("(n=1)" in c for c in cells[3:])

@@ -332,7 +332,8 @@ def _ratio_markdown(ratios: list[dict], planner: str, reference: str, headline: 
     lines = [f"## Table 4: {planner} / {reference} at equal sample counts", ""]
     has_paper = any(not math.isnan(r["paper"]) for r in ratios)
     lines.append(f"Mean of per-query ratios{' (paper in brackets)' if has_paper else ''}, then median [Q1, Q3]; "
-                 "n = queries where both succeeded. Lengths are raw planner output in the space's metric (rad for "
+                 "n = queries where both succeeded (a cell marked n=k had fewer: a reference value of 0, as for a query whose "
+                 "start is its goal, gives no ratio). Lengths are raw planner output in the space's metric (rad for "
                  "joint angles).")
     if planner in OUR_PLANNER_NOTES:
         wearer = WEARER_PLANNER_NOTES.get(planner) if any(r.get("tpee") for r in ratios) else None
@@ -345,13 +346,15 @@ def _ratio_markdown(ratios: list[dict], planner: str, reference: str, headline: 
         lines.append("| N | n | " + " | ".join(labels[k] for k in RATIO_METRICS) + " |")
         lines.append("|---|---|" + "---|" * len(RATIO_METRICS))
         for cap in sorted({r["sample_cap"] for r in ratios if r["checker"] == chk}):
-            cells, n = [], 0
-            for key in RATIO_METRICS:
-                r = next(x for x in ratios if x["checker"] == chk and x["sample_cap"] == cap and x["metric"] == key)
-                n = max(n, r["n"])
+            row = [next(x for x in ratios if x["checker"] == chk and x["sample_cap"] == cap and x["metric"] == key)
+                   for key in RATIO_METRICS]
+            n = max(r["n"] for r in row)
+            cells = []
+            for r in row:
                 paper = f" ({_f(r['paper'])})" if has_paper else ""
-                cells.append(f"{_f(r['mean'])}{paper} med {_f(r['median'])} [{_f(r['q1'])}, {_f(r['q3'])}]")
-            lines.append(f"| {cap} | {n}/{r['queries']} | " + " | ".join(cells) + " |")
+                fewer = f" (n={r['n']})" if r["n"] < n else ""  # a reference value of 0 (start = goal) has no ratio
+                cells.append(f"{_f(r['mean'])}{paper} med {_f(r['median'])} [{_f(r['q1'])}, {_f(r['q3'])}]{fewer}")
+            lines.append(f"| {cap} | {n}/{row[0]['queries']} | " + " | ".join(cells) + " |")
     return lines + [""]
 
 
