@@ -127,6 +127,18 @@ def test_a_first_path_time_recorded_at_the_end_of_the_run_is_marked():
     assert row["first_time_median"] == pytest.approx(0.498)
 
 
+def test_successful_anytime_runs_far_over_their_budget_are_counted_and_marked():
+    """A simplifier pass that does not poll the termination condition ran 0.49 s at a 0.2-s budget, unmarked."""
+    from tpee_ompl.bench.report import _anytime_quality_markdown
+
+    runs = [anytime("S", 0, 2.0, first=0.02, time=0.49, budget=0.2), anytime("S", 1, 2.0, first=0.02, time=0.29,
+                                                                          budget=0.2),
+            anytime("S", 2, None, time=0.9, budget=0.2)]
+    (row,) = anytime_quality_table(runs)
+    assert row["over_budget"] == 1  # 0.29 s is within 1.5 x; the failed run is not a success to mark
+    assert "| 2/3 (1 over 1.5x budget) |" in _anytime_quality_markdown([row])
+
+
 def test_within_share_averages_a_querys_runs_and_is_per_budget():
     runs = [anytime("A", 0, 2.0), anytime("A", 0, 3.0), anytime("A", 1, 1.0),
             anytime("A", 0, 2.0, budget=0.1), anytime("A", 1, None, budget=0.1)]
