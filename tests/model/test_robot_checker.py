@@ -119,6 +119,23 @@ def test_a_prismatic_chain_gets_unit_lever_arm_and_its_travel_below(tmp_path):
     assert c.are_valid(np.array([[0.0, 0.4]])).all()
 
 
+def test_pruning_two_out_of_reach_obstacles_keeps_the_one_in_reach(tmp_path):
+    """The pairs to remove were read as views into Pinocchio's pair vector: each removal shifted them, so the
+    second removal took the in-reach pair and the arm passed 12.5 cm into its obstacle as valid (a helper's probe)."""
+    urdf = tmp_path / "arm1.urdf"
+    urdf.write_text("""<robot name="arm1"><link name="world"/><link name="arm">
+      <collision><origin xyz="0.4 0 0"/><geometry><box size="0.4 0.05 0.05"/></geometry></collision></link>
+      <joint name="j" type="revolute"><parent link="world"/><child link="arm"/><axis xyz="0 0 1"/>
+        <limit lower="-2" upper="2" effort="1" velocity="1"/></joint></robot>""")
+    c = RobotChecker(urdf, obstacles=[box("far1", (0.2, 0.2, 0.2), (5.0, 0, 0)), box("far2", (0.2, 0.2, 0.2), (0, 5.0, 0)),
+                                      box("near", (0.2, 0.2, 0.2), (0, 0.4, 0))])
+    G = c.gmodel.geometryObjects
+    assert c.pruned_pairs == 2
+    assert [(G[p.first].name, G[p.second].name) for p in c.gmodel.collisionPairs] == [("arm_0", "near")]
+    q = np.array([np.pi / 2])  # the arm along +y, through the near box
+    assert not c.is_valid(q) and not c.are_valid(q[None]).any() and c.clearance(q) < 0
+
+
 def test_bad_input_gives_one_line_errors(tmp_path):
     urdf = WearerArm().files.urdf
     with pytest.raises(FileNotFoundError, match="URDF file not found"):

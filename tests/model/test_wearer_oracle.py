@@ -2,6 +2,10 @@
 
 The oracle (tests/model/data/wearer_oracle.npz) was written by experiments/record_wearer_oracle.py
 on the code before :class:`~tpee_ompl.model.robot_checker.RobotChecker`; rerun it only on purpose.
+
+Its pair lists (``*_pairs``) alone were written again on 2026-11-27, when the pruning was found to remove the wrong
+pairs (views into Pinocchio's pair vector, shifted by each removal): five forearm-arm pairs are checked now and
+five foot-arm pairs (out of reach) are not; every verdict, clearance and closest pair of the oracle is unchanged.
 """
 
 from __future__ import annotations

@@ -186,7 +186,8 @@ class RobotChecker:
         margin = max([self.security_margin, *self.link_margins.values()])
         parents = self.model.parents
         removed = []
-        for cp in list(self.gmodel.collisionPairs):
+        # copies: items are views into the C++ vector, shifted by each removal (the wrong pairs went, collisions missed)
+        for cp in [pin.CollisionPair(c.first, c.second) for c in self.gmodel.collisionPairs]:
             a, b = self.gmodel.geometryObjects[cp.first], self.gmodel.geometryObjects[cp.second]
             if a.parentJoint == 0 and b.parentJoint == 0:
                 removed.append(cp)
