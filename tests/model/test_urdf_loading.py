@@ -58,3 +58,48 @@ def test_an_srdf_floating_base_is_said_to_be_fixed_here(tmp_path, caplog):
     with caplog.at_level("WARNING"):
         WearerArm(urdf, floating)
     assert "declares the floating virtual joint 'root_joint': its base is fixed to the world here" in caplog.text
+
+
+GAZEBO_URDF = """<?xml version="1.0"?>
+<robot name="r"><link name="world"/>
+<link name="arm"><collision><origin xyz="0.5 0 0"/><geometry><box size="0.2 0.1 0.1"/></geometry></collision></link>
+<joint name="j" type="revolute"><parent link="world"/><child link="arm"/><axis xyz="0 0 1"/>
+  <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+<gazebo reference="arm">{extra}</gazebo></robot>"""
+
+
+def test_collision_and_capsule_tags_outside_links_are_not_taken_for_the_links_shapes(tmp_path):
+    """A Gazebo <collision> (contact settings) was counted as a shape Pinocchio had dropped, and a <capsule> outside
+    any link refused the file: valid URDFs (example-robot-data's HyQ, simple_humanoid) would not load."""
+    import pytest
+
+    from tpee_ompl.model.robot_checker import RobotChecker
+
+    for name, extra in (("friction", "<collision><surface><friction/></surface></collision>"),
+                        ("capsule", "<collision><geometry><capsule><radius>0.1</radius><length>0.2</length></capsule>"
+                                    "</geometry></collision>")):
+        (tmp_path / f"{name}.urdf").write_text(GAZEBO_URDF.format(extra=extra), encoding="utf-8")
+        assert RobotChecker(tmp_path / f"{name}.urdf").gmodel.ngeoms == 1
+    link_capsule = GAZEBO_URDF.format(extra="").replace("<box size=\"0.2 0.1 0.1\"/>",
+                                                        "<capsule radius=\"0.05\" length=\"0.2\"/>")
+    (tmp_path / "link_capsule.urdf").write_text(link_capsule, encoding="utf-8")
+    with pytest.raises(ValueError, match="<capsule>"):  # a link's capsule is still dropped by urdfdom: refused
+        RobotChecker(tmp_path / "link_capsule.urdf")
+
+
+def test_a_nearly_flat_mesh_is_not_given_a_convex_hull():
+    """A float32 plate 1e-8 of its size thick passed the flatness test (1e-9) and Coal's hull crashed the process."""
+    import numpy as np
+
+    from tpee_ompl.model.urdf_loading import _solid
+
+    class Mesh:
+        def __init__(self, V):
+            self.V = V
+
+        def vertices(self):
+            return self.V
+
+    rng = np.random.default_rng(0)
+    plate = np.c_[rng.uniform(-1, 1, (9, 2)), 1e-8 * rng.uniform(-1, 1, 9)].astype(np.float32)
+    assert not _solid(Mesh(plate)) and _solid(Mesh(rng.uniform(-1, 1, (9, 3))))

@@ -147,7 +147,9 @@ _NUMBERS = {"sphere": ("radius",), "cylinder": ("radius", "length"), "box": ("si
 
 def _parse_urdf(urdf: Path) -> ET.Element:
     root = _read_robot_xml(urdf, "URDF")
-    if any(c.tag == "capsule" for c in root.iter()):
+    # a link's shapes only: <collision> / <capsule> elsewhere (Gazebo sensors, Pinocchio's <collision_checking>)
+    # are not urdfdom's to drop
+    if root.findall("link/collision/geometry/capsule") or root.findall("link/visual/geometry/capsule"):
         raise ValueError(f"URDF {urdf} uses <capsule>, which urdfdom drops silently; use <cylinder> (loaded as capsules)")
     for joint in root.iter("joint"):
         axis = joint.find("axis")
@@ -219,7 +221,7 @@ def load_urdf_model(
         raise ValueError(f"srdf_unknown_links must be 'error' or 'skip', got {srdf_unknown_links!r}")
     root = _parse_urdf(urdf)
     text = _read_text(urdf, "URDF")
-    n_collision_elements = sum(1 for _ in root.iter("collision"))
+    n_collision_elements = len(root.findall("link/collision"))
     digest = hashlib.sha256(text.encode())
     if srdf is not None and srdf.is_file():
         digest.update(srdf.read_bytes())
@@ -306,7 +308,7 @@ def _solid(mesh: coal.BVHModelBase) -> bool:
     if len(V) < 4:
         return False
     s = np.linalg.svd(V - V.mean(axis=0), compute_uv=False)
-    return bool(s[2] > 1e-9 * max(s[0], 1e-12))
+    return bool(s[2] > 1e-5 * max(s[0], 1e-12))  # 1e-9 let a float32 plate through: Coal crashed on it (~1e-8)
 
 
 def _drop_contained_spheres(gmodel: pin.GeometryModel) -> list[str]:
