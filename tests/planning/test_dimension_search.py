@@ -242,6 +242,25 @@ def test_released_search_draws_its_narrowed_samples_around_one_waypoint_at_a_tim
         assert near.mean() < 0.2
 
 
+def test_narrowed_samples_of_a_path_across_pi_stay_around_the_angles_it_sweeps() -> None:
+    """The narrowed box of an angle was the path values' min and max: for a path across +-pi, the whole circle (a
+    helper's probe: 47 % of the narrowed samples more than 1 rad from the path, 4 % away from the seam)."""
+    from helpers.planning_spaces import free_so2_space
+
+    si = free_so2_space(2)
+    grouped = GroupedSpace(si, [[0, 1]], 7)
+    search = Search(grouped, Checker(si, grouped.layout, False), np.random.default_rng(0), np.array([3.0, -0.5]),
+                    np.array([-3.0, 0.5]), settings=SearchSettings(narrow_after=0, narrowing=1e-3),
+                    range_={0: np.full(2, 0.02)})
+    U = np.random.default_rng(1).random((3000, 3))
+    C, _ = search._group_draws(0, U)
+    narrowed = C[(np.arange(len(U)) >= 400) & (U[:, 0] >= 0.1)]  # padding range_ from sample 400 on
+    assert len(narrowed) > 1000 and (narrowed >= -np.pi).all() and (narrowed < np.pi).all()
+    assert (np.abs(narrowed[:, 0]) >= 3.0 - 0.02 - 1e-12).all()  # the short way from 3 to -3, through pi
+    assert (narrowed[:, 0] > 0).any() and (narrowed[:, 0] < 0).any()  # on both sides of the seam
+    assert (np.abs(narrowed[:, 1]) <= 0.5 + 0.02 + 1e-12).all()  # the other joint's box as before
+
+
 @pytest.mark.parametrize("narrowing", [0.5, 0.3, 0.97, 1.0])
 def test_narrowing_paddings_are_those_of_pythons_power_bit_for_bit(narrowing: float) -> None:
     """The memoised narrowing factor gives the paddings ``max(range_, span * narrowing ** (k / 100))`` the

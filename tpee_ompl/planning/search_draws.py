@@ -13,6 +13,7 @@ one by one.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from typing import NamedTuple
 
@@ -68,6 +69,8 @@ class SampleDraws:
         self.narrow_start: dict[int, int | None] = {gi: None for gi in grouped.planned}
         self._dims = {gi: grouped.group_dims(gi) for gi in grouped.planned}
         self._bounds = {gi: grouped.group_bounds(gi) for gi in grouped.planned}
+        circular = grouped.layout.circular
+        self._circular = {gi: circular[d] if circular[d].any() else None for gi, d in self._dims.items()}
         self._uniform = np.empty((0, 0))
         self._ui = 0
         self._buffers = 0  # buffers drawn so far (identifies the current one)
@@ -131,14 +134,25 @@ class SampleDraws:
                 else:
                     pad = np.maximum(self.range_[gi], span * self._scale(g0 - n0 + narrow)[:, None])
                 vals = self.W[:, self._dims[gi]]
+                circ = self._circular[gi]
                 if self._local:
                     m = len(vals) - 2
                     t = 1 + np.minimum((U[narrow, 0] - _UNIFORM_FRACTION) / (1 - _UNIFORM_FRACTION) * m, m - 1).astype(int)
                     vlo = vhi = vals[t]
                 else:
+                    if circ is not None:  # the angles the path sweeps: across +-pi, not the values' min and max
+                        vals = np.where(circ, np.unwrap(vals, axis=0, period=2 * math.pi), vals)
                     vlo, vhi = vals.min(axis=0), vals.max(axis=0)
                 nlo, nhi = np.maximum(lo, vlo - pad), np.minimum(hi, vhi + pad)
+                if circ is not None:  # an angle's box wraps round +-pi instead of stopping there
+                    arc = circ & (vhi - vlo + 2 * pad < span)
+                    nlo, nhi = np.where(arc, vlo - pad, nlo), np.where(arc, vhi + pad, nhi)
                 C[narrow] = nlo + U[narrow, 1:] * (nhi - nlo)
+                if circ is not None:  # back into [lo, hi): +-pi are one angle
+                    rows, cols = np.ix_(narrow, np.flatnonzero(circ))
+                    X, a, b = C[rows, cols], lo[cols], hi[cols]
+                    X = np.where(X < a, X + (b - a), np.where(X >= b, X - (b - a), X))
+                    C[rows, cols] = np.where(X >= b, a, X)
         return C, n0
 
     def _scale(self, k: np.ndarray) -> np.ndarray:
