@@ -185,3 +185,20 @@ def test_a_demo_or_rollout_too_large_for_the_arithmetic_is_refused_not_turned_in
         dmp = learn_dmp(demo)
         with pytest.raises(ValueError, match="overflow"):
             generate(dmp, np.array([1e308, 0.0]), np.array([-1e308, 1.0]))
+
+
+def test_a_complex_or_dimensionless_demo_and_complex_ends_are_refused():
+    """A complex demo was learned with its imaginary part dropped (a ComplexWarning only); a (P, 0) demo failed in
+    numpy's stack ("need at least one array to stack")."""
+    import pytest
+
+    from tpee_ompl.library.dmp import generate, learn_dmp
+
+    t = np.linspace(0.0, 1.0, 60)
+    with pytest.raises(ValueError, match="demo"):
+        learn_dmp(np.c_[t, t] + 1j)
+    with pytest.raises(ValueError, match="D >= 1"):
+        learn_dmp(np.zeros((60, 0)))
+    dmp = learn_dmp(np.c_[t, t])
+    with pytest.raises(ValueError, match="start"):
+        generate(dmp, np.array([0.0, 0.0]) + 1j, np.array([1.0, 1.0]))

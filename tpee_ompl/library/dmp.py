@@ -44,7 +44,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..validation import check_int, check_number
+from ..validation import as_float_array, check_int, check_number
 
 __all__ = [
     "DMP",
@@ -303,11 +303,11 @@ def learn_dmp(demo: np.ndarray, options: DMPOptions | None = None) -> DMP:
     linear equality per DOF: r(T) = a(T) S_demo / S); (iv) the response profiles.
     """
     options = options or DMPOptions()
-    demo = np.asarray(demo, dtype=float)
+    demo = as_float_array(demo, "demo")  # a complex demo lost its imaginary part with a warning
     if demo.ndim == 1:
         demo = demo[:, None]
-    if demo.ndim != 2 or demo.shape[0] < 3:
-        raise ValueError(f"demo must have shape (P >= 3, D); got {demo.shape}")
+    if demo.ndim != 2 or demo.shape[0] < 3 or demo.shape[1] < 1:
+        raise ValueError(f"demo must have shape (P >= 3, D >= 1); got {demo.shape}")
     if not np.all(np.isfinite(demo)):
         raise ValueError("demo contains NaN or inf")
     P, D = demo.shape
@@ -356,7 +356,7 @@ def generate(dmp: DMP, start: np.ndarray, goal: np.ndarray) -> np.ndarray:
     goal == start is well defined: scaled DOFs stay put (eq. 13's forcing vanishes), absolute DOFs
     replay the demo's excursion and return.
     """
-    start, goal = np.asarray(start, dtype=float), np.asarray(goal, dtype=float)
+    start, goal = as_float_array(start, "start"), as_float_array(goal, "goal")
     if start.shape[-1:] != (dmp.n_dims,) or goal.shape[-1:] != (dmp.n_dims,) or start.ndim > 2 or goal.ndim > 2:
         raise ValueError(f"start and goal must have shape ({dmp.n_dims},) or (B, {dmp.n_dims}); got {start.shape}, {goal.shape}")
     if not (np.all(np.isfinite(start)) and np.all(np.isfinite(goal))):

@@ -43,6 +43,8 @@ FAN_RADIUS = 1.15
 
 
 def draw_pointing_range(ax: Axes, dirs: np.ndarray, reachable: np.ndarray, color: str, label: str) -> None:
+    """Draw unit pointing directions ``dirs`` (m, 3) on the chest sphere (:data:`FAN_CENTRE`, :data:`FAN_RADIUS`):
+    the ``reachable`` ones as dots in ``color``, the others (blind) as grey crosses."""
     pts = FAN_CENTRE + FAN_RADIUS * dirs
     ax.scatter(*pts[reachable].T, s=4, color=color, alpha=0.6, depthshade=False, label=label)
     if (~reachable).any():
