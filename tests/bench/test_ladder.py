@@ -160,11 +160,13 @@ def test_a_resumed_ladder_member_holds_the_rows_of_the_uninterrupted_campaign(tm
     from tpee_ompl.bench.campaign import resume_campaign
 
     qfile = write_query_file(tmp_path / "q.json", robot, n=1)
-    cfg = CampaignConfig(name="rs", queries=str(qfile), sample_caps=(60, 120), iteration_planners=("DimensionRRT", "RRTstar"),
-                         checkers=("batched",), anytime_budgets=(), workers=0, seed=3, out=str(tmp_path / "out"))
+    cfg = CampaignConfig(name="rs", queries=str(qfile), sample_caps=(60, 120),
+                         iteration_planners=("DimensionRRT", "RRTstar"), checkers=("batched",), anytime_budgets=(),
+                         workers=0, seed=3, out=str(tmp_path / "out"))
     res = run_campaign(cfg, progress_bar=False, report=False)
     query = ("SELECT e.sample_cap, p.name, " + ", ".join(f"r.{c}" for c in EXACT_COLUMNS) + " FROM runs r JOIN "
-             "experiments e ON r.experimentid = e.id JOIN plannerConfigs p ON r.plannerid = p.id ORDER BY e.sample_cap, p.name")
+             "experiments e ON r.experimentid = e.id JOIN plannerConfigs p ON r.plannerid = p.id "
+             "ORDER BY e.sample_cap, p.name")
     before = sqlite3.connect(res.database).execute(query).fetchall()
     (small,) = [p for p in res.logs if p.name.endswith("_N60.log")]
     (large,) = [p for p in res.logs if p.name.endswith("_N120.log")]

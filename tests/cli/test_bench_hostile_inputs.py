@@ -141,7 +141,8 @@ CASES = [
     ("alt-checker-queries-with-one-validator", ["--checkers", "discrete", "--alt-checker-queries", "1"], 2,
      ["--alt-checker-queries", "has one (discrete)"]),
     ("alt-checker-samples-without-samples", ["--checkers", "batched", "discrete", "--samples", "--anytime", "1",
-                                             "--alt-checker-samples", "20"], 2, ["--alt-checker-samples", "give --samples"]),
+                                             "--alt-checker-samples", "20"], 2,
+     ["--alt-checker-samples", "give --samples"]),
 ]
 
 

@@ -127,7 +127,8 @@ def test_pruning_two_out_of_reach_obstacles_keeps_the_one_in_reach(tmp_path):
       <collision><origin xyz="0.4 0 0"/><geometry><box size="0.4 0.05 0.05"/></geometry></collision></link>
       <joint name="j" type="revolute"><parent link="world"/><child link="arm"/><axis xyz="0 0 1"/>
         <limit lower="-2" upper="2" effort="1" velocity="1"/></joint></robot>""")
-    c = RobotChecker(urdf, obstacles=[box("far1", (0.2, 0.2, 0.2), (5.0, 0, 0)), box("far2", (0.2, 0.2, 0.2), (0, 5.0, 0)),
+    c = RobotChecker(urdf, obstacles=[box("far1", (0.2, 0.2, 0.2), (5.0, 0, 0)),
+                                      box("far2", (0.2, 0.2, 0.2), (0, 5.0, 0)),
                                       box("near", (0.2, 0.2, 0.2), (0, 0.4, 0))])
     G = c.gmodel.geometryObjects
     assert c.pruned_pairs == 2

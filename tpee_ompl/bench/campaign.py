@@ -244,9 +244,9 @@ def resume_campaign(
     ``logs/broken/`` and its experiment runs again.  The database and report are rebuilt from all logs.  The
     configuration and queries come from the folder's ``campaign.json``; ``workers`` sets this resume's
     pool size (default: the campaign's; ``campaign.json``'s ``resumes`` records each resume's count and executor,
-    its ``config`` keeps the campaign's own).  A query resumed part-way runs its missing experiments in a fresh process with the
-    planners' own seeds (a ladder with a missing member runs whole), so iteration-capped rows are those of an
-    uninterrupted campaign.
+    its ``config`` keeps the campaign's own).  A query resumed part-way runs its missing experiments in a fresh
+    process with the planners' own seeds (a ladder with a missing member runs whole), so iteration-capped rows are
+    those of an uninterrupted campaign.
     """
     directory = Path(directory)
     meta = load_campaign(directory)
@@ -255,7 +255,7 @@ def resume_campaign(
 
         workers = check_int("workers", workers, minimum=0)
     else:
-        workers = int(meta["config"]["workers"])
+        workers = int(meta["config"].get("workers", CampaignConfig().workers))  # older campaign.json: the default
     meta.setdefault("resumes", []).append({"utc": utc_now(), "workers": workers})
     (directory / "logs").mkdir(exist_ok=True)
     return _execute(directory, meta, executor, on_task_done, report, progress_bar, workers)

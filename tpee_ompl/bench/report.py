@@ -326,9 +326,9 @@ def _ratio_markdown(ratios: list[dict], planner: str, reference: str, headline: 
     lines = [f"## Table 4: {planner} / {reference} at equal sample counts", ""]
     has_paper = any(not math.isnan(r["paper"]) for r in ratios)
     lines.append(f"Mean of per-query ratios{' (paper in brackets)' if has_paper else ''}, then median [Q1, Q3]; "
-                 "n = queries where both succeeded (a cell marked n=k had fewer: a reference value of 0, as for a query whose "
-                 "start is its goal, gives no ratio). Lengths are raw planner output in the space's metric (rad for "
-                 "joint angles).")
+                 "n = queries where both succeeded (a cell marked n=k had fewer: a reference value of 0, as for a "
+                 "query whose start is its goal, gives no ratio). Lengths are raw planner output in the space's "
+                 "metric (rad for joint angles).")
     if planner in OUR_PLANNER_NOTES:
         wearer = WEARER_PLANNER_NOTES.get(planner) if any(r.get("tpee") for r in ratios) else None
         lines += ["", f"`{planner}`: {OUR_PLANNER_NOTES[planner]}{'; ' + wearer if wearer else ''}."]

@@ -23,8 +23,8 @@ from ..bench.problems import DEFAULT_PROBLEM, get_problem
 from ..signals import interrupts
 from ._common import Parser, count, nonempty, positive_int, seconds, seed
 
-__all__ = ["DESCRIPTION", "EXAMPLE", "add_arguments", "build_parser", "config_from_args", "headline", "list_problems", "main",
-           "register", "run"]
+__all__ = ["DESCRIPTION", "EXAMPLE", "add_arguments", "build_parser", "config_from_args", "headline", "list_problems",
+           "main", "register", "run"]
 
 DESCRIPTION = "Benchmark dimension-RRT against OMPL planners (ompl.tools.Benchmark)."
 EXAMPLE = ("example:\n  tpee-ompl bench --max-queries 24 --samples 500 2500 --anytime 0.1 0.5 --workers 2\n"

@@ -49,7 +49,8 @@ layered trees start again; a prescribed row keeps its polyline, sampled at more 
 Narrowing: once a valid path exists and the group has drawn ``narrow_after`` samples, 90 % of the
 samples come from the bounding box of the current path's group values (released: of one waypoint's),
 padded by ``max(range_, span * narrowing ** (m / 100))`` (``m``: samples since narrowing started), clipped
-to the bounds (an SO2 angle's box is the arc the path sweeps, wrapping round +-pi); 10 % stay uniform.  The paper gives no numbers; the defaults (200, 0.5): ``docs/dimension_rrt.md``.
+to the bounds (an SO2 angle's box is the arc the path sweeps, wrapping round +-pi); 10 % stay uniform.  The paper
+gives no numbers; the defaults (200, 0.5): ``docs/dimension_rrt.md``.
 
 Releasing the prescribed rows (``release_after``; off by default, as in the paper, which fixes
 DOF1/DOF2 on Table 3's rows "to simplify the calculation"): a converged path along a row can be
