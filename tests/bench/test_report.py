@@ -266,3 +266,11 @@ def test_table4_marks_a_metric_with_fewer_ratios_than_the_row_count():
     (row,) = [line for line in _ratio_markdown(ratios, "A", "B", "batched") if line.startswith("| 500 |")]
     cells = row.split(" | ")
     assert cells[1] == "2/2" and "(n=1)" not in cells[2] and all("(n=1)" in c for c in cells[3:])
+
+
+def test_the_anytime_cost_table_has_a_row_per_budget_and_planner():
+    rows = [{"budget": b, "planner": pl, "runs": 2, "success": 2, "cost_median": 1.0, "cost_q1": 1.0, "cost_q3": 1.0}
+            for b in (0.1, 1.0) for pl in ("A", "B")]
+    text = report._markdown([], [], [], rows, "D", "R", "batched")
+    assert [line for line in text.splitlines() if line.startswith(("| 0.1 |", "| 1 |"))] == [
+        f"| {b} | {pl} | 2/2 | 1.000 [1.000, 1.000] |" for b in ("0.1", "1") for pl in ("A", "B")]

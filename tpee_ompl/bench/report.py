@@ -377,8 +377,7 @@ def _markdown(ratios: list[dict], succ: list[dict], quality: list[dict], anytime
         lines += ["", "## Anytime comparison: median raw cost (path length in the space's metric) of successful runs", "",
                   "| budget (s) | planner | success / runs | cost median [Q1, Q3] |", "|---|---|---|---|"]
         for r in anytime:
-            over = f" ({r['over_budget']} over {OVER_BUDGET:g}x budget)" if r.get("over_budget") else ""
-        lines.append(f"| {r['budget']:g} | {r['planner']} | {r['success']}/{r['runs']}{over} "
+            lines.append(f"| {r['budget']:g} | {r['planner']} | {r['success']}/{r['runs']} "
                          f"| {_f(r['cost_median'])} [{_f(r['cost_q1'])}, {_f(r['cost_q3'])}] |")
     return "\n".join(lines) + "\n"
 
