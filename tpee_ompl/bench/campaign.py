@@ -34,7 +34,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from .config import CampaignConfig, CampaignResult, load_campaign
+from .config import CampaignConfig, CampaignResult, default_workers, load_campaign
 from .database import build_database, set_aside_broken_logs
 from .experiment import experiment_specs, log_name, run_query_task
 from ..files import check_writable_folder, write_new_file
@@ -255,7 +255,7 @@ def resume_campaign(
 
         workers = check_int("workers", workers, minimum=0)
     else:
-        workers = int(meta["config"].get("workers", CampaignConfig().workers))  # older campaign.json: the default
+        workers = int(meta["config"].get("workers", default_workers()))  # older campaign.json: the default
     meta.setdefault("resumes", []).append({"utc": utc_now(), "workers": workers})
     (directory / "logs").mkdir(exist_ok=True)
     return _execute(directory, meta, executor, on_task_done, report, progress_bar, workers)

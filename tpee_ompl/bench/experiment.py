@@ -129,14 +129,13 @@ def run_query_task(task: dict) -> dict:
     ou.setLogLevel(ou.LOG_WARN)
     log_dir = Path(task["log_dir"]) if task.get("log_dir") else None
     given = {log_name(query, qpos, s): s for s in (task.get("specs") or experiment_specs(cfg, qpos))}
-    wanted = set(given)
     out: dict = {"qpos": qpos, "query_id": query["id"], "logs": {}, "extras": {}, "errors": {},
                  "pid": os.getpid(), "host": socket.gethostname()}
     from .anytime_ladder import AnytimeLadder, group_anytime_ladders
     from .ladder import Ladder, group_ladders
 
     # not those written by an earlier attempt of this task whose worker died
-    wanted = {n for n in wanted if log_dir is None or not (log_dir / n).is_file()}
+    wanted = {n for n in given if log_dir is None or not (log_dir / n).is_file()}
     # Ladders are grouped from all the query's experiments: a ladder with a missing member runs whole, with the
     # seeds of its largest cap (budget), so the missing log holds the rows of an uninterrupted campaign.
     specs = {log_name(query, qpos, s): s for s in experiment_specs(cfg, qpos)}

@@ -444,7 +444,7 @@ def write_report(db_path: str | Path, directory: str | Path, expected: dict | No
     those of ``success.csv``, ``length_quality.csv``, ``anytime.csv``, ``anytime_quality.csv`` that have rows.
 
     ``planner``/``reference`` default to the campaign's first two iteration planners (or
-    DimensionRRT / RRTstar).  Returns the paths and the Markdown text.
+    DimensionRRT / RRTstar).  Returns the paths, the Markdown text and the number of runs and successful runs.
     """
     directory = Path(directory)
     runs = load_runs(db_path)
@@ -476,7 +476,8 @@ def write_report(db_path: str | Path, directory: str | Path, expected: dict | No
         if rows:  # a table the campaign has no runs for (no budgets: no anytime rows) is not written empty
             paths[name] = directory / f"{name}.csv"
             _write_csv(paths[name], rows)
-    return {**paths, "markdown_text": text, "planner": planner, "reference": reference}
+    return {**paths, "markdown_text": text, "planner": planner, "reference": reference, "runs": len(runs),
+            "successes": sum(bool(r["success"]) for r in runs)}
 
 
 def resolve_planner_name(name: str, seen: Sequence[str]) -> str:

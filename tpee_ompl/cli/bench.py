@@ -338,11 +338,8 @@ def _print_result(result) -> None:
     """Where the campaign's files are, the report's headline tables and how many runs succeeded."""
     if result.report.get("markdown_text"):
         print(headline(result.report["markdown_text"]))
-    if result.database is not None:
-        from ..bench.report import load_runs
-
-        runs = load_runs(result.database)
-        print(f"runs: {sum(bool(r['success']) for r in runs)} of {len(runs)} succeeded (per planner and setting in "
+    if "runs" in result.report:
+        print(f"runs: {result.report['successes']} of {result.report['runs']} succeeded (per planner and setting in "
               "report.md: success counts, lengths against the best found, anytime costs)")
     print(f"results: {result.directory}")
     print(f"database: {result.database}  (open in Planner Arena: plannerarena.org)" if result.database is not None

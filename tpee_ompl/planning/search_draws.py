@@ -148,11 +148,8 @@ class SampleDraws:
                     arc = circ & (vhi - vlo + 2 * pad < span)
                     nlo, nhi = np.where(arc, vlo - pad, nlo), np.where(arc, vhi + pad, nhi)
                 C[narrow] = nlo + U[narrow, 1:] * (nhi - nlo)
-                if circ is not None:  # back into [lo, hi): +-pi are one angle
-                    rows, cols = np.ix_(narrow, np.flatnonzero(circ))
-                    X, a, b = C[rows, cols], lo[cols], hi[cols]
-                    X = np.where(X < a, X + (b - a), np.where(X >= b, X - (b - a), X))
-                    C[rows, cols] = np.where(X >= b, a, X)
+                if circ is not None:  # back into [-pi, pi)
+                    C[narrow] = self.g.layout.wrap(C[narrow], self._dims[gi])
         return C, n0
 
     def _scale(self, k: np.ndarray) -> np.ndarray:

@@ -146,14 +146,16 @@ class RealVectorLayout:
                 self._leaf(state, path)[0:d] = [float(v) for v in values[sl]]
         return state
 
-    def wrap(self, X: np.ndarray) -> np.ndarray:
-        """X (..., n) with its SO2 entries brought into [-pi, pi) (unchanged without SO2 leaves)."""
+    def wrap(self, X: np.ndarray, dims: np.ndarray | None = None) -> np.ndarray:
+        """X (..., n) with its SO2 entries brought into [-pi, pi) (unchanged without SO2 leaves).  ``dims``: X holds
+        only these entries of the flat vector, in this order (default: all of them)."""
         if not self.has_circular:
             return X
+        circular = self.circular if dims is None else self.circular[dims]
         X = np.array(X, dtype=float, copy=True)
-        C = np.mod(X[..., self.circular] + math.pi, 2.0 * math.pi) - math.pi
+        C = np.mod(X[..., circular] + math.pi, 2.0 * math.pi) - math.pi
         C[C >= math.pi] -= 2.0 * math.pi  # rounding can give +pi, outside SO2's bounds
-        X[..., self.circular] = C
+        X[..., circular] = C
         return X
 
     def delta(self, A: np.ndarray, B: np.ndarray, dims: np.ndarray | None = None) -> np.ndarray:
