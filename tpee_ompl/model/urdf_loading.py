@@ -24,6 +24,7 @@ import pinocchio as pin
 
 from ..validation import MAX_JOINT_VALUE
 from .obstacles import Obstacle
+from .urdf_xml import parse_urdf, read_robot_xml, read_text
 
 __all__ = [
     "ARM_JOINTS",
@@ -61,13 +62,6 @@ class LoadedModel:
     model_hash: str
     continuous: tuple[str, ...] = ()
     """The planned joints that are continuous in the URDF (loaded as revolute joints limited to [-pi, pi])."""
-
-
-def _read_text(path: Path, kind: str) -> str:
-    try:
-        return path.read_text(encoding="utf-8")
-    except UnicodeDecodeError as exc:
-        raise ValueError(f"malformed {kind} {path}: not UTF-8 text ({exc})") from exc
 
 
 def _check_shape_sizes(geom: coal.CollisionGeometry, name: str, urdf: Path) -> None:
@@ -110,7 +104,7 @@ def load_wearer_model(urdf: Path, srdf: Path | None) -> LoadedModel:
     ValueError
         A malformed file, ``<capsule>``, missing joints or frame, unsupported shapes, bad sizes or limits.
     """
-    root = _parse_urdf(urdf)
+    root = parse_urdf(urdf)
     joints = {j.get("name"): j.get("type") for j in root.iter("joint")}
     for name in ARM_JOINTS:
         if joints.get(name) != "revolute":
@@ -124,65 +118,6 @@ def load_wearer_model(urdf: Path, srdf: Path | None) -> LoadedModel:
     if tuple(loaded.model.names[1:]) != ARM_JOINTS:
         raise ValueError(f"URDF {urdf}: moving joints must be exactly {ARM_JOINTS}, got {tuple(loaded.model.names[1:])}")
     return loaded
-
-
-def _read_robot_xml(path: Path, kind: str) -> ET.Element:
-    """The ``<robot>`` root of a URDF or SRDF file, or FileNotFoundError / ValueError naming the file."""
-    if not path.is_file():
-        raise FileNotFoundError(f"{kind} file not found: {path}")
-    try:
-        root = ET.fromstring(_read_text(path, kind))
-    except ET.ParseError as exc:
-        raise ValueError(f"malformed {kind} {path}: {exc}") from exc
-    if root.tag != "robot":
-        raise ValueError(f"malformed {kind} {path}: root element is <{root.tag}>, expected <robot>")
-    return root
-
-
-_NUMBERS = {"sphere": ("radius",), "cylinder": ("radius", "length"), "box": ("size",), "origin": ("xyz", "rpy"),
-            "axis": ("xyz",), "limit": ("lower", "upper", "effort", "velocity"), "mass": ("value",),
-            "inertia": ("ixx", "ixy", "ixz", "iyy", "iyz", "izz"), "mesh": ("scale",)}
-"""Numeric attributes of URDF elements, checked before urdfdom reads them (it prints a C++ error per bad one)."""
-
-
-def _parse_urdf(urdf: Path) -> ET.Element:
-    root = _read_robot_xml(urdf, "URDF")
-    # a link's shapes only: <collision> / <capsule> elsewhere (Gazebo sensors, Pinocchio's <collision_checking>)
-    # are not urdfdom's to drop
-    if root.findall("link/collision/geometry/capsule") or root.findall("link/visual/geometry/capsule"):
-        raise ValueError(f"URDF {urdf} uses <capsule>, which urdfdom drops silently; use <cylinder> (loaded as capsules)")
-    for joint in root.iter("joint"):
-        axis = joint.find("axis")
-        if joint.get("type") in ("revolute", "prismatic", "continuous") and axis is not None \
-                and _finite_numbers(axis.get("xyz", "1 0 0")) and not any(float(v) for v in axis.get("xyz", "1 0 0").split()):
-            raise ValueError(f"URDF {urdf}: joint {joint.get('name')!r} has <axis xyz=\"{axis.get('xyz')}\">: a zero axis "
-                             "moves nothing (a revolute joint would scale its child instead of turning it)")
-    links = {link.get("name") for link in root.findall("link")}
-    for joint in root.findall("joint"):  # (not a <transmission>'s) urdfdom prints "Failed to build tree" and says only
-        # "not a valid URDF model"
-        for end in ("parent", "child"):
-            el = joint.find(end)
-            name = None if el is None else el.get("link")
-            if name not in links:
-                raise ValueError(f"URDF {urdf}: joint {joint.get('name')!r} has {end} link {name!r}, which is not a "
-                                 "<link> of the file")
-    for owner in (*root.iter("link"), *root.iter("joint")):
-        for el in owner.iter():
-            for attr in _NUMBERS.get(el.tag, ()):
-                text = el.get(attr)
-                if text is not None and not _finite_numbers(text):
-                    raise ValueError(f"URDF {urdf}: {owner.tag} {owner.get('name')!r}: <{el.tag} {attr}=\"{text}\"> "
-                                     "is not a list of finite numbers")
-    return root
-
-
-def _finite_numbers(text: str) -> bool:
-    """Whether ``text`` is one or more whitespace-separated finite numbers."""
-    try:
-        values = [float(v) for v in text.split()]
-    except ValueError:
-        return False
-    return bool(values) and all(math.isfinite(v) for v in values)
 
 
 def load_urdf_model(
@@ -219,8 +154,8 @@ def load_urdf_model(
     """
     if srdf_unknown_links not in ("error", "skip"):
         raise ValueError(f"srdf_unknown_links must be 'error' or 'skip', got {srdf_unknown_links!r}")
-    root = _parse_urdf(urdf)
-    text = _read_text(urdf, "URDF")
+    root = parse_urdf(urdf)
+    text = read_text(urdf, "URDF")
     n_collision_elements = len(root.findall("link/collision"))
     digest = hashlib.sha256(text.encode())
     if srdf is not None and srdf.is_file():
@@ -415,7 +350,7 @@ def is_prismatic(joint: pin.JointModel) -> bool:
 def _apply_srdf(model: pin.Model, gmodel: pin.GeometryModel, srdf: Path, unknown_links: str = "error") -> None:
     """Remove the SRDF's disabled pairs, after checking that it names only links of the model (``unknown_links``
     "error"), or passing over the pairs that name other links ("skip"; Pinocchio applies the rest)."""
-    root = _read_robot_xml(srdf, "SRDF")
+    root = read_robot_xml(srdf, "SRDF")
     for vj in root.iter("virtual_joint"):  # a mobile or legged robot's base: the URDF's root stays fixed here
         if vj.get("type") in ("floating", "planar"):
             log.warning("SRDF %s declares the %s virtual joint %r: its base is fixed to the world here (only the "
