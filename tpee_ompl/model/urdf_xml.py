@@ -23,6 +23,8 @@ def read_text(path: Path, kind: str) -> str:
 
 def read_robot_xml(path: Path, kind: str) -> ET.Element:
     """The ``<robot>`` root of a URDF or SRDF file, or FileNotFoundError / ValueError naming the file."""
+    if path.is_dir():
+        raise ValueError(f"{kind} path {path} is a folder: {'an' if kind == 'SRDF' else 'a'} {kind} file is expected")
     if not path.is_file():
         raise FileNotFoundError(f"{kind} file not found: {path}")
     try:
