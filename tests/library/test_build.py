@@ -67,3 +67,26 @@ def test_build_default_refuses_options_of_another_type(robot: WearerArm) -> None
     with pytest.raises(ValueError, match="LibraryBuildOptions"):
         PathLibrary.build_default(robot, LIBRARY_DMP_OPTIONS)  # type: ignore[arg-type]
 
+
+
+def test_a_per_step_too_coarse_for_the_dmps_is_refused_naming_per_step_and_the_smallest_that_works() -> None:
+    """LibraryBuildOptions(per_step=5) was accepted; the build then failed after planning every demonstration."""
+    with pytest.raises(ValueError, match=r"^per_step 5 gives DMPs of 31 samples; .* at least 50: per_step must be "
+                                         r"at least 9$"):
+        LibraryBuildOptions(per_step=5)
+    with pytest.raises(ValueError, match="per_step must be at least 9"):
+        LibraryBuildOptions(per_step=8)
+    assert LibraryBuildOptions(per_step=9).per_step == 9
+
+
+def test_the_smallest_per_step_accepted_learns_its_dmps() -> None:
+    from collections import Counter
+
+    from tpee_ompl.library.build import learn_demos
+    from tpee_ompl.model.sectors import cross_sector_trajectory
+
+    W = np.hstack([cross_sector_trajectory(1, 4), np.linspace([0.0, 0.0], [0.3, -0.6], 7)])
+    opts = LibraryBuildOptions(per_step=9)
+    collected = {(1, 4): (W[:1], W[-1:], W[None], np.zeros(1), Counter())}
+    pd = learn_demos(collected, opts.per_step, opts.dmp_options)[(1, 4)]
+    assert pd.forward[0].n_steps == pd.reverse[0].n_steps == 55

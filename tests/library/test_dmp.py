@@ -202,3 +202,47 @@ def test_a_complex_or_dimensionless_demo_and_complex_ends_are_refused():
     dmp = learn_dmp(np.c_[t, t])
     with pytest.raises(ValueError, match="start"):
         generate(dmp, np.array([0.0, 0.0]) + 1j, np.array([1.0, 1.0]))
+
+
+def test_a_demo_shorter_than_the_options_need_is_refused_up_front_naming_demo_and_the_minimum() -> None:
+    """learn_dmp took P >= 3 but failed below 50 samples with the defaults, advising a larger alpha_y."""
+    from tpee_ompl.library.dmp import min_samples
+
+    assert min_samples() == min_samples(DMPOptions()) == 50
+    t = np.linspace(0.0, 1.0, 20)
+    with pytest.raises(ValueError, match=r"^demo has 20 samples; .* needs at least 50 .*diverges.*resample") as err:
+        learn_dmp(np.c_[t, t**2])
+    assert "\n" not in str(err.value) and "increase alpha_y" not in str(err.value)
+    t = np.linspace(0.0, 1.0, 50)
+    assert learn_dmp(np.c_[t, t**2]).n_steps == 50
+
+
+@pytest.mark.parametrize("alpha_y", [36.0, 48.0, 56.0, 200.0])
+def test_min_samples_is_exactly_where_the_rollout_first_settles(alpha_y: float) -> None:
+    from tpee_ompl.library.dmp import DMP, min_samples
+
+    options = DMPOptions(alpha_y=alpha_y)
+    need = min_samples(options)
+    DMP.from_weights(np.zeros((1, options.basis_count(need))), [0.0], [1.0], [True], need, options)
+    with pytest.raises(ValueError, match=f"use at least {need} samples"):
+        DMP.from_weights(np.zeros((1, options.basis_count(need - 1))), [0.0], [1.0], [True], need - 1, options)
+
+
+def test_the_unsettled_error_advises_what_fixes_it_more_samples_not_a_larger_alpha_y() -> None:
+    """The old advice, "increase alpha_y", made a coarse grid's unstable rollout worse; more samples fix it."""
+    from tpee_ompl.library.dmp import DMP
+
+    def fails(n_steps: int, options: DMPOptions) -> bool:
+        try:
+            DMP.from_weights(np.zeros((1, options.basis_count(n_steps))), [0.0], [1.0], [True], n_steps, options)
+        except ValueError:
+            return True
+        return False
+
+    with pytest.raises(ValueError, match="diverges on 20 samples: use at least 50 samples") as err:
+        DMP.from_weights(np.zeros((1, 9)), [0.0], [1.0], [True], 20, DMPOptions())
+    assert "alpha_y or" not in str(err.value)
+    assert all(fails(20, DMPOptions(alpha_y=a)) for a in (48.0, 96.0, 480.0))  # a larger alpha_y does not help
+    assert not fails(50, DMPOptions())  # the advice does
+    with pytest.raises(ValueError, match="increase alpha_y"):  # too soft for any grid: then alpha_y is the fix
+        DMP.from_weights(np.zeros((1, 24)), [0.0], [1.0], [True], 50, DMPOptions(alpha_y=5.0))

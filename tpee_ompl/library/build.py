@@ -31,6 +31,7 @@ from ..validation import check_bool, check_int, check_number, resolve_options
 from .demos import (
     DEMO_MARGINS,
     MAX_PER_STEP,
+    N_FAKE_TIME_STEPS,
     POINTING_LINKS,
     DemoPlanner,
     PairDemos,
@@ -38,7 +39,7 @@ from .demos import (
     collect_pair,
     query_sampler,
 )
-from .dmp import DMPOptions, learn_dmp
+from .dmp import DMPOptions, learn_dmp, min_samples
 
 __all__ = ["LIBRARY_DMP_OPTIONS", "LibraryBuildOptions", "collect_default_demos", "default_build_params", "learn_demos"]
 
@@ -71,8 +72,10 @@ class LibraryBuildOptions:
     max_attempts : int >= 1, optional
         Draws per pair before giving up on ``per_pair``; None: 3 x ``per_pair`` (planning-necessary
         draws of the shoulder pairs 3 <-> 4 cost seconds each and cluster within ~0.3 rad).
-    per_step : int >= 1
-        Samples per fake-time step of the resampled demos the DMPs learn (default 100).
+    per_step : int
+        Samples per fake-time step of the resampled demos the DMPs learn (default 100): at least the number that
+        gives the DMPs :func:`~tpee_ompl.library.dmp.min_samples` samples (6 per_step + 1; 9 with the default
+        ``dmp_options``).
     max_samples : int >= 1
         Dimension-RRT samples per demonstration (default planner only). Default 2500.
     timeout : float > 0, seconds
@@ -122,6 +125,7 @@ class LibraryBuildOptions:
         set_("progress", check_bool("progress", self.progress))
         if not isinstance(self.dmp_options, DMPOptions):
             raise ValueError(f"dmp_options must be a DMPOptions, got {self.dmp_options!r}")
+        _check_dmp_grid(self.per_step, self.dmp_options)
 
     @property
     def draws_per_pair(self) -> int:
@@ -132,6 +136,23 @@ class LibraryBuildOptions:
     def resolve(cls, options: LibraryBuildOptions | None, overrides: Mapping[str, Any]) -> LibraryBuildOptions:
         """``options`` (defaults if None) with keyword overrides applied; an unknown name raises TypeError."""
         return resolve_options(cls, options, overrides)
+
+
+def _check_dmp_grid(per_step: int, options: DMPOptions) -> None:
+    """The DMPs' grid of 6 ``per_step`` + 1 samples is fine enough for ``options`` (:func:`min_samples`); ValueError
+    naming ``per_step`` and the smallest value that works (a build would otherwise fail after all its planning)."""
+    need = min_samples(options)
+    gains = f"alpha_y = {options.alpha_y:g}, beta_y = {options.beta:g}"
+    if need is None:
+        raise ValueError(f"dmp_options: the spring-damper ({gains}) settles on no grid of DMP samples; change alpha_y")
+    steps = N_FAKE_TIME_STEPS - 1
+    if steps * per_step + 1 < need:
+        smallest = -(-(need - 1) // steps)
+        if smallest > MAX_PER_STEP:
+            raise ValueError(f"dmp_options: the spring-damper ({gains}) needs DMPs of {need} samples, more than "
+                             f"per_step {MAX_PER_STEP} gives; change alpha_y")
+        raise ValueError(f"per_step {per_step} gives DMPs of {steps * per_step + 1} samples; with dmp_options {gains} "
+                         f"they need at least {need}: per_step must be at least {smallest}")
 
 
 def _check_pairs(pairs: Sequence[tuple[int, int]]) -> tuple[tuple[int, int], ...]:

@@ -57,6 +57,7 @@ __all__ = [
     "generate_blended",
     "integrate",
     "learn_dmp",
+    "min_samples",
 ]
 
 MAX_N_BASIS = 10_000
@@ -66,6 +67,8 @@ MAX_GRID_ENTRIES = 20_000_000
 not allocated (a library file asking for 60001 x 30000 would take 13 GiB).  The packaged library: 601 x 300."""
 _MAX_FREE_RESPONSE_AT_END = 1e-6
 """Largest allowed a(T): the spring-damper must have settled by the end of the path."""
+MAX_SETTLE_SEARCH = 20_000
+"""Most samples :func:`min_samples` tries (a grid of more is refused anyway with the default basis count)."""
 
 
 @dataclass(frozen=True)
@@ -274,17 +277,69 @@ def integrate(y0: np.ndarray, g: np.ndarray, forcing: np.ndarray, options: DMPOp
 
 
 def _free_response(n_steps: int, options: DMPOptions) -> np.ndarray:
-    with np.errstate(over="ignore", invalid="ignore"):  # a stiff spring-damper diverges: said below, not warned
-        a = integrate(np.ones(1), np.zeros(1), np.zeros((n_steps, 1)), options)[:, 0]
-    if not np.isfinite(a).all():
-        raise ValueError(f"the spring-damper's integration diverges on {n_steps} samples (alpha_y = {options.alpha_y}, "
-                         f"beta_y = {options.beta}): lower alpha_y / beta_y or use more samples")
-    if abs(a[-1]) > _MAX_FREE_RESPONSE_AT_END:
-        raise ValueError(
-            f"the spring-damper has not settled by the end of the path (a(T) = {a[-1]:.1e} > "
-            f"{_MAX_FREE_RESPONSE_AT_END:g}): increase alpha_y (now {options.alpha_y}) or the number of samples"
-        )
+    a = _free_rollout(n_steps, options)
+    if not np.isfinite(a).all() or abs(a[-1]) > _MAX_FREE_RESPONSE_AT_END:
+        raise ValueError(f"{_gains(options)}: {_failure(a[-1])} on {n_steps} samples{_settle_advice(n_steps, options)}")
     return a
+
+
+def _free_rollout(n_steps: int, options: DMPOptions) -> np.ndarray:
+    """a(t), shape (P,): eq. 12 rolled out by :func:`integrate` from y0 = 1 to g = 0 without forcing."""
+    with np.errstate(over="ignore", invalid="ignore"):  # a stiff spring-damper diverges: said by the callers
+        return integrate(np.ones(1), np.zeros(1), np.zeros((n_steps, 1)), options)[:, 0]
+
+
+def _gains(options: DMPOptions) -> str:
+    return f"the spring-damper (alpha_y = {options.alpha_y:g}, beta_y = {options.beta:g})"
+
+
+def _failure(end: float) -> str:
+    """What is wrong with a free response ending at ``end`` = a(T): it diverges (grew past its start) or it has not
+    settled."""
+    if not np.isfinite(end) or abs(end) > 1.0:
+        return "its semi-implicit Euler rollout diverges"
+    return f"it has not settled by the end of the path (a(T) = {end:.1e} > {_MAX_FREE_RESPONSE_AT_END:g})"
+
+
+def _settle_advice(n_steps: int, options: DMPOptions) -> str:
+    """The fix that works: more samples (a smaller step dt), or a stiffer spring when no number of samples settles."""
+    need = min_samples(options)
+    if need is None:
+        if _failure(_free_rollout(MAX_SETTLE_SEARCH, options)[-1]).endswith("diverges"):  # too stiff for any grid
+            return f": lower alpha_y or beta_y (no grid of up to {MAX_SETTLE_SEARCH} samples is fine enough for them)"
+        return f": increase alpha_y (it is still moving at t = 1, on any grid of up to {MAX_SETTLE_SEARCH} samples)"
+    if n_steps < need:
+        return f": use at least {need} samples (a smaller step dt = 1 / (P - 1))"
+    return f": change alpha_y or beta_y (these gains settle on {need} samples but not on {n_steps})"
+
+
+@functools.lru_cache(maxsize=32)
+def min_samples(options: DMPOptions | None = None) -> int | None:
+    """Fewest samples P a demonstration needs with ``options``: the smallest grid (dt = 1 / (P - 1)) on which the
+    spring-damper of eq. 12, rolled out by :func:`integrate` from y0 = 1 to g = 0 without forcing, has settled by
+    the end of the path (|a(T)| <= 1e-6); None if no P up to :data:`MAX_SETTLE_SEARCH` does (alpha_y too small).
+
+    50 with the defaults (alpha_y = 48, beta_y = 12): on fewer than 30 samples the semi-implicit Euler step is
+    unstable (4 - 2 dt alpha_y - dt^2 alpha_y beta_y <= 0) and the rollout diverges; on 30-49 it has not settled.
+    The search replays :func:`integrate`'s arithmetic for every P at once, so the answer agrees with it exactly.
+    """
+    options = options or DMPOptions()
+    ay, by = options.alpha_y, options.beta
+    for lo, hi in ((3, 256), (256, 2048), (2048, MAX_SETTLE_SEARCH + 1)):
+        P = np.arange(lo, hi)
+        dt = 1.0 / (P - 1)
+        y, v, end = np.ones(len(P)), np.zeros(len(P)), np.empty(len(P))
+        with np.errstate(over="ignore", invalid="ignore"):
+            for k in range(hi - 2):  # the same operations as integrate's loop, g = 0 and no forcing
+                acc = ay * (by * (0.0 - y) - v) + 0.0
+                v = v + dt * acc
+                y = y + dt * v
+                if k + 2 >= lo:
+                    end[k + 2 - lo] = y[k + 2 - lo]  # P = k + 2 samples end after step k
+        settled = np.isfinite(end) & (np.abs(end) <= _MAX_FREE_RESPONSE_AT_END)
+        if settled.any():
+            return int(P[np.argmax(settled)])
+    return None
 
 
 def learn_dmp(demo: np.ndarray, options: DMPOptions | None = None) -> DMP:
@@ -293,7 +348,8 @@ def learn_dmp(demo: np.ndarray, options: DMPOptions | None = None) -> DMP:
     Parameters
     ----------
     demo : ndarray, shape (P, D), radians
-        Samples evenly spaced in fake time over [0, 1], P >= 3.
+        Samples evenly spaced in fake time over [0, 1], P >= :func:`min_samples` (50 with the default options;
+        resample a shorter demo more finely, e.g. :func:`tpee_ompl.planning.paths.resample_waypoints`).
     options : DMPOptions, optional
 
     Steps: (i) the target forcing of eq. 16, inverted for the semi-implicit Euler step of
@@ -311,6 +367,10 @@ def learn_dmp(demo: np.ndarray, options: DMPOptions | None = None) -> DMP:
     if not np.all(np.isfinite(demo)):
         raise ValueError("demo contains NaN or inf")
     P, D = demo.shape
+    need = min_samples(options)
+    if need is not None and P < need:  # before any work: the rollout on this grid cannot end at the goal
+        raise ValueError(f"demo has {P} samples; {_gains(options)} needs at least {need} (on {P} "
+                         f"{_failure(_free_rollout(P, options)[-1])}): resample the demo more finely")
     N = options.basis_count(P)
     dt = 1.0 / (P - 1)
     ay, by = options.alpha_y, options.beta
