@@ -62,3 +62,18 @@ def test_animate_reads_a_path_file_and_writes_the_gif(tmp_path, capsys):
     assert main(["animate", "--path", str(path), "--frames", "3", "-o", str(out)]) == 0
     assert_image(out, GIF_SIGNATURE, 1)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["m.gif", "p.json"]  # no temporary file left
+
+
+def test_show_with_a_target_at_the_muzzle_is_a_usage_error_naming_the_target(tmp_path, capsys):
+    """``show --target`` at the muzzle drew the scene with "aim error 90.0 deg" (the direction was noise)."""
+    import numpy as np
+
+    from tpee_ompl.model.wearer_arm import default_robot
+
+    q = [0.87, 0.35, 0.3, -0.6]
+    p, _ = default_robot().muzzle(np.array(q))
+    out = tmp_path / "new" / "s.png"
+    assert main(["show", "--q", *map(repr, q), "--target", *map(repr, p.tolist()), "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "--target: target (" in err and "at the muzzle" in err and err.count("\n") == 1
+    assert not (tmp_path / "new").exists()

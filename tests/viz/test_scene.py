@@ -87,3 +87,13 @@ def test_a_postscript_figure_is_written_without_matplotlibs_transparency_warning
         save_scene(robot, np.radians([50, 20, 17, -37]), tmp_path / "scene.eps", dpi=20)
     assert (tmp_path / "scene.eps").stat().st_size > 0
     assert not [r for r in caplog.records if "transparency" in r.getMessage()]
+
+
+@pytest.mark.parametrize("offset", [0.0, 1e-12])
+def test_a_target_at_the_muzzle_is_refused_naming_the_target_not_drawn_with_aim_error_90(robot, aimed, offset):
+    """A target at the muzzle has no direction; the title said "aim error 90.0°"."""
+    q, _ = aimed
+    p, _ = robot.muzzle(q)
+    with pytest.raises(ValueError, match=r"^target \(.*\) m is at the muzzle .*no direction"):
+        render_scene(robot, q, target=p + offset)
+    assert "aim error" in render_scene(robot, q, target=p + 0.05).axes[0].get_title()  # 5 cm off: a direction

@@ -47,7 +47,7 @@ DEFAULT_SCENE_TARGET = (4.0, 1.5, 1.9)
 
 def cmd_show(args: argparse.Namespace) -> int:
     """Draw the wearer, the arm at q and the line of sight to the target into a PNG."""
-    from ..viz._common import image_suffixes, optional_target
+    from ..viz._common import check_target_off_muzzle, image_suffixes, optional_target
     from ..viz.scene import save_scene
 
     check_output(args.output, "--output", args.force, image_suffixes())
@@ -60,6 +60,8 @@ def cmd_show(args: argparse.Namespace) -> int:
             target = optional_target(args.target)
     else:
         target = np.array(DEFAULT_SCENE_TARGET) if args.q is None else None
+    with argument("--target"):
+        check_target_off_muzzle(robot, q, target)
     out = save_scene(robot, q, args.output, target=target, sectors=args.sectors, force=args.force)
     print(f"wrote {out} (q = {np.round(q, 4).tolist()} rad, valid: {robot.is_valid(q)})")
     return 0

@@ -90,6 +90,20 @@ def optional_target(target: Any) -> np.ndarray | None:
     return None if target is None else check_target_point(target)
 
 
+def check_target_off_muzzle(robot: WearerArm, q: np.ndarray, target: np.ndarray | None) -> None:
+    """ValueError naming ``target`` (3,), metres, when it lies at the muzzle of ``robot`` at ``q`` (within the model's
+    ``BLIND_TOLERANCE``, 1e-9 m): from there it has no direction, so neither an aim error nor a line of sight."""
+    from ..model.pointing import BLIND_TOLERANCE
+
+    if target is None:
+        return
+    gap = float(np.linalg.norm(target - robot.muzzle(q)[0]))
+    if gap <= BLIND_TOLERANCE:
+        where = ", ".join(f"{v:.6g}" for v in target)
+        raise ValueError(f"target ({where}) m is at the muzzle ({gap:g} m from it): it has no direction to aim at; "
+                         "give a target away from the muzzle")
+
+
 def check_waypoints(robot: WearerArm, waypoints: Any) -> np.ndarray:
     """The waypoints as a finite (K >= 1, robot.nq) float array of joint values within +/-``MAX_JOINT_VALUE``;
     ValueError otherwise (strings and complex numbers refused, not coerced: ``as_float_array``)."""

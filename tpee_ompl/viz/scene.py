@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..model.sectors import SECTORS, posture_preset
-from ._common import (check_view, check_waypoints, clip_segment, draw_floor, image_suffixes, new_axes, optional_target,
+from ._common import (check_target_off_muzzle, check_view, check_waypoints, clip_segment, draw_floor, image_suffixes, new_axes, optional_target,
                       output_path, set_view, write_figure)
 from .animation import muzzle_trace, resample_path
 from .meshes import arm_polygons, scene_mesh
@@ -76,7 +76,8 @@ def render_scene(
         (DOF1, DOF2, pan, tilt).  Drawn red if invalid (outside limits or colliding).
     target : array_like, shape (3,), metres, optional
         Drawn as a star; the segment muzzle -> target is dashed green if the line of sight is
-        clear (:meth:`WearerArm.line_of_sight_clear`), red if blocked.  A target further than
+        clear (:meth:`WearerArm.line_of_sight_clear`), red if blocked.  A target at the muzzle has no
+        direction: ValueError.  A target further than
         ``max_extent`` m from the scene centre is not zoomed to: the line is clipped at the view box.
     sectors : bool
         Overlay the four posture sectors (paper Table 1, Fig. 8): a ghost of the boom at each
@@ -105,6 +106,7 @@ def render_scene(
     q = robot.check_config(q)
     tgt = optional_target(target)
     W = check_waypoints(robot, path) if path is not None else None
+    check_target_off_muzzle(robot, q, tgt)
     if ax is None:
         ax = new_axes()
     mesh = scene_mesh(robot)
