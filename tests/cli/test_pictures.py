@@ -77,3 +77,22 @@ def test_show_with_a_target_at_the_muzzle_is_a_usage_error_naming_the_target(tmp
     err = capsys.readouterr().err
     assert "--target: target (" in err and "at the muzzle" in err and err.count("\n") == 1
     assert not (tmp_path / "new").exists()
+
+
+def test_the_default_scene_is_aimed_by_the_packages_ik_from_the_sector_select_sector_picks(tmp_path, capsys):
+    """The default scene was hand-rounded: sector 4 where select_sector picks 3, aim error 1.2 deg."""
+    import numpy as np
+
+    from tpee_ompl.cli.pictures import DEFAULT_SCENE_TARGET, default_scene
+    from tpee_ompl.model.pointing import aim_errors
+    from tpee_ompl.model.sectors import posture_preset, select_sector
+    from tpee_ompl.model.wearer_arm import default_robot
+
+    robot = default_robot()
+    q, target = default_scene(robot)
+    assert np.array_equal(target, DEFAULT_SCENE_TARGET)
+    assert np.allclose(q[:2], posture_preset(select_sector(target)))
+    assert abs(aim_errors(robot, q, target)[2]) < 1e-9
+    assert robot.is_valid(q) and robot.line_of_sight_clear(q, target)
+    assert main(["show", "-o", str(tmp_path / "s.png")]) == 0
+    assert f"q = {np.round(q, 4).tolist()} rad, valid: True" in capsys.readouterr().out

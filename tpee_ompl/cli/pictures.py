@@ -31,18 +31,33 @@ from .plan import add_plan_args, check_plan_args, plan_motion
 if TYPE_CHECKING:
     from ..model.wearer_arm import WearerArm
 
-__all__ = ["ANIMATION_SUFFIXES", "DEFAULT_SCENE_Q", "DEFAULT_SCENE_TARGET", "MAX_FRAMES", "cmd_animate", "cmd_show",
-           "cmd_view", "cmd_workspace", "register"]
+__all__ = ["ANIMATION_SUFFIXES", "DEFAULT_SCENE_TARGET", "MAX_FRAMES", "cmd_animate", "cmd_show", "cmd_view",
+           "cmd_workspace", "default_scene", "register"]
 
 ANIMATION_SUFFIXES = (".gif", ".mp4")
 """What ``animate -o`` writes: a GIF (Pillow) or an MP4 (ffmpeg)."""
 _LIMIT_TOL = 1e-6
 """Radians a ``--path`` waypoint may lie beyond a joint limit (the decimals ``plan --json`` prints)."""
 
-DEFAULT_SCENE_Q = (50.0, 20.0, 17.0, -37.0)
-"""Degrees: the sector 4 preset aiming forward-left-up (``show`` and ``view`` without ``--q``)."""
 DEFAULT_SCENE_TARGET = (4.0, 1.5, 1.9)
-"""Metres: the target ``show`` draws without ``--q`` and ``--target``."""
+"""Metres: the target of the default scene (``show`` and ``view`` without ``--q``; :func:`default_scene`)."""
+
+
+def default_scene(robot: WearerArm) -> tuple[np.ndarray, np.ndarray]:
+    """The default scene's configuration (4,), radians, and target (3,), metres: :data:`DEFAULT_SCENE_TARGET` aimed at
+    by the aiming IK from the posture sector :func:`~tpee_ompl.model.sectors.select_sector` picks for it (sector 3,
+    q = (-50, 20, 7.4, -8.0) deg with the packaged model); RuntimeError when ``robot`` cannot aim there."""
+    from ..model.pointing import AimingError, PointingGeometry, aim
+    from ..model.sectors import select_sector
+
+    target = np.array(DEFAULT_SCENE_TARGET)
+    sector = select_sector(target)
+    try:
+        q = aim(target, sector, geometry=PointingGeometry.from_robot(robot))
+    except AimingError as exc:
+        raise RuntimeError(f"the default scene's target {DEFAULT_SCENE_TARGET} m cannot be aimed at from sector "
+                           f"{sector} with this model ({exc}); give --q") from None
+    return q, target
 
 
 def cmd_show(args: argparse.Namespace) -> int:
@@ -52,14 +67,12 @@ def cmd_show(args: argparse.Namespace) -> int:
 
     check_output(args.output, "--output", args.force, image_suffixes())
     robot = load_robot(args)
-    q = np.array(args.q) if args.q is not None else np.radians(DEFAULT_SCENE_Q)
+    q, target = default_scene(robot) if args.q is None else (np.array(args.q), None)
     with argument("--q"):
         q = robot.check_config(q)
     if args.target is not None:
         with argument("--target"):
             target = optional_target(args.target)
-    else:
-        target = np.array(DEFAULT_SCENE_TARGET) if args.q is None else None
     with argument("--target"):
         check_target_off_muzzle(robot, q, target)
     out = save_scene(robot, q, args.output, target=target, sectors=args.sectors, force=args.force)
@@ -146,7 +159,7 @@ def cmd_view(args: argparse.Namespace) -> int:
     from ..viz.meshcat import view_meshcat
 
     robot = load_robot(args)
-    q = np.array(args.q) if args.q is not None else np.radians(DEFAULT_SCENE_Q)
+    q = np.array(args.q) if args.q is not None else default_scene(robot)[0]
     with argument("--q"):
         q = robot.check_config(q)
     # (main() runs every command with SIGTERM as Ctrl-C: a kill ends it and meshcat's server process goes too)
@@ -162,7 +175,8 @@ def register(sub: argparse._SubParsersAction, fmt: type) -> None:
                        description="Draw the wearer, the arm and the line of sight.\n\nexample:\n"
                                    "  tpee-ompl show -o scene.png\n"
                                    "  tpee-ompl show --q 0.87 0.35 0.3 -0.6 --target 4 1.5 1.9 --sectors -o s.png")
-    p.add_argument("--q", type=angle, nargs=4, metavar="Q", help="DOF1..DOF4 in radians (default: a sector-4 scene)")
+    p.add_argument("--q", type=angle, nargs=4, metavar="Q", help="DOF1..DOF4 in radians (default: aimed at the default target 4 1.5 1.9 "
+                   "from the sector select_sector picks, by the aiming IK)")
     p.add_argument("--target", type=finite, nargs=3, metavar=("X", "Y", "Z"), help="target point (m, world frame)")
     p.add_argument("--sectors", action="store_true", help="overlay the posture sectors")
     p.add_argument("-o", "--output", type=nonempty, default="scene.png", help="image file (.png, .pdf, .svg, ...; default scene.png)")
