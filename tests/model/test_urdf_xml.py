@@ -22,3 +22,40 @@ def test_a_folder_given_as_the_urdf_or_srdf_is_said_to_be_a_folder(tmp_path):
         RobotChecker(urdf, tmp_path)
     with pytest.raises(FileNotFoundError, match="URDF file not found"):  # a missing file still is one
         RobotChecker(tmp_path / "missing.urdf")
+
+
+_LIMIT = '<limit lower="-1" upper="1" effort="1" velocity="1"/>'
+
+
+@pytest.mark.parametrize("old, new, match", [
+    ('<robot name="t">', "<robot>", "<robot> has no name attribute"),
+    ('<robot name="t">', '<robot name="t" version="2.0">', '<robot version="2.0">: urdfdom reads versions 1.0, 1.1 and 1.2'),
+    (_LIMIT, "", "joint 'j1' is revolute without a <limit>"),
+    ('type="revolute"', 'type="revolutee"', "joint 'j1' has type 'revolutee'"),
+    ('effort="1" ', "", r"joint 'j1': <limit> needs the attribute\(s\) effort"),
+    ('effort="1"', 'effort="-1"', "joint 'j1': <limit effort=\"-1\"> is negative"),
+    ('<axis xyz="0 0 1"/>', '<axis xyz="0 1"/>', "joint 'j1': <axis xyz=\"0 1\"> needs 3 numbers"),
+    ('<sphere radius="0.05"/>', "<sphere/>", r"link 'a': <sphere> needs the attribute\(s\) radius"),
+    ('<sphere radius="0.05"/>', '<cone radius="1"/>', "link 'a': <collision> shape <cone>"),
+    ('<sphere radius="0.05"/>', "", "link 'a': a <collision> has no <geometry> shape"),
+    ('<sphere radius="0.05"/>', '<mesh filename="x.stl" scale="1 1"/>', "link 'a': <mesh scale=\"1 1\"> needs 3"),
+    ('<link name="base"/>', '<link name="base"/><link name="a"/>', "link 'a' appears twice"),
+    ('<link name="base"/>', '<link name="base"/><link name="z"/>', r"2 root links \['base', 'z'\]"),
+    ("</robot>", '<joint name="j9" type="fixed"><parent link="a"/><child link="base"/></joint></robot>',
+     "no root link: the joints form a loop"),
+    ("</robot>", '<link name="c"/><joint name="j9" type="fixed"><parent link="c"/><child link="a"/></joint></robot>',
+     "link 'a' is the child of two joints, 'j1' and 'j9'"),
+    ("</joint>", '<dynamics/></joint>', "joint 'j1': <dynamics> needs damping or friction"),
+    ("</joint>", '<mimic multiplier="2"/></joint>', "joint 'j1': <mimic> needs joint"),
+    ('<link name="a">', '<link name="a"><inertial><mass value="1"/></inertial>', "link 'a': <inertial> needs <inertia>"),
+])
+def test_a_malformed_urdf_is_refused_in_one_line_before_urdfdom_prints_its_errors(tmp_path, capfd, old, new, match):
+    """urdfdom printed its C++ errors on stderr (several lines, twice: Pinocchio parses the file for the model and again
+    for the geometry), then the error said only "The XML stream does not contain a valid URDF model"."""
+    assert old in ONE_JOINT
+    urdf = tmp_path / "bad.urdf"
+    urdf.write_text(ONE_JOINT.replace(old, new, 1))
+    capfd.readouterr()
+    with pytest.raises(ValueError, match=f"URDF {urdf}: {match}") as info:
+        RobotChecker(urdf)
+    assert "\n" not in str(info.value) and capfd.readouterr().err == ""

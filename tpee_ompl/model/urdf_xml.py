@@ -38,31 +38,25 @@ def read_robot_xml(path: Path, kind: str) -> ET.Element:
 
 _NUMBERS = {"sphere": ("radius",), "cylinder": ("radius", "length"), "box": ("size",), "origin": ("xyz", "rpy"),
             "axis": ("xyz",), "limit": ("lower", "upper", "effort", "velocity"), "mass": ("value",),
-            "inertia": ("ixx", "ixy", "ixz", "iyy", "iyz", "izz"), "mesh": ("scale",)}
+            "inertia": ("ixx", "ixy", "ixz", "iyy", "iyz", "izz"), "mesh": ("scale",), "mimic": ("multiplier", "offset"),
+            "safety_controller": ("soft_lower_limit", "soft_upper_limit", "k_position", "k_velocity"),
+            "calibration": ("rising", "falling"), "dynamics": ("damping", "friction")}
 """Numeric attributes of URDF elements, checked before urdfdom reads them (it prints a C++ error per bad one)."""
+_VECTORS = {("origin", "xyz"), ("origin", "rpy"), ("axis", "xyz"), ("box", "size"), ("mesh", "scale")}
+"""The attributes among them that urdfdom reads as three numbers."""
+_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
+_SHAPES = {"sphere": ("radius",), "box": ("size",), "cylinder": ("radius", "length"), "mesh": ("filename",)}
+"""urdfdom's shapes (``<capsule>`` is refused before) and their required attributes."""
 
 
 def parse_urdf(urdf: Path) -> ET.Element:
+    """The URDF's ``<robot>`` root, after refusing what urdfdom would refuse or drop (each with a C++ error on
+    stderr and no name in Pinocchio's exception) and what it would read wrongly; ValueError naming the element."""
     root = read_robot_xml(urdf, "URDF")
     # a link's shapes only: <collision> / <capsule> elsewhere (Gazebo sensors, Pinocchio's <collision_checking>)
     # are not urdfdom's to drop
     if root.findall("link/collision/geometry/capsule") or root.findall("link/visual/geometry/capsule"):
         raise ValueError(f"URDF {urdf} uses <capsule>, which urdfdom drops silently; use <cylinder> (loaded as capsules)")
-    for joint in root.iter("joint"):
-        axis = joint.find("axis")
-        if joint.get("type") in ("revolute", "prismatic", "continuous") and axis is not None \
-                and finite_numbers(axis.get("xyz", "1 0 0")) and not any(float(v) for v in axis.get("xyz", "1 0 0").split()):
-            raise ValueError(f"URDF {urdf}: joint {joint.get('name')!r} has <axis xyz=\"{axis.get('xyz')}\">: a zero axis "
-                             "moves nothing (a revolute joint would scale its child instead of turning it)")
-    links = {link.get("name") for link in root.findall("link")}
-    for joint in root.findall("joint"):  # (not a <transmission>'s) urdfdom prints "Failed to build tree" and says only
-        # "not a valid URDF model"
-        for end in ("parent", "child"):
-            el = joint.find(end)
-            name = None if el is None else el.get("link")
-            if name not in links:
-                raise ValueError(f"URDF {urdf}: joint {joint.get('name')!r} has {end} link {name!r}, which is not a "
-                                 "<link> of the file")
     for owner in (*root.iter("link"), *root.iter("joint")):
         for el in owner.iter():
             for attr in _NUMBERS.get(el.tag, ()):
@@ -70,7 +64,131 @@ def parse_urdf(urdf: Path) -> ET.Element:
                 if text is not None and not finite_numbers(text):
                     raise ValueError(f"URDF {urdf}: {owner.tag} {owner.get('name')!r}: <{el.tag} {attr}=\"{text}\"> "
                                      "is not a list of finite numbers")
+                if text is not None and (el.tag, attr) in _VECTORS and len(text.split()) != 3:
+                    raise ValueError(f"URDF {urdf}: {owner.tag} {owner.get('name')!r}: <{el.tag} {attr}=\"{text}\"> "
+                                     "needs 3 numbers")
+    _check_robot(root, urdf)
+    links = [_check_link(link, urdf) for link in root.findall("link")]
+    joints = [_check_joint(joint, urdf, root.get("version", "1.0")) for joint in root.findall("joint")]
+    for kind, names in (("link", links), ("joint", joints)):
+        twice = next((n for k, n in enumerate(names) if n in names[:k]), None)
+        if twice is not None:
+            raise ValueError(f"URDF {urdf}: {kind} {twice!r} appears twice")
+    for joint in root.iter("joint"):
+        axis = joint.find("axis")
+        if joint.get("type") in ("revolute", "prismatic", "continuous") and axis is not None \
+                and not any(float(v) for v in axis.get("xyz", "1 0 0").split()):
+            raise ValueError(f"URDF {urdf}: joint {joint.get('name')!r} has <axis xyz=\"{axis.get('xyz')}\">: a zero axis "
+                             "moves nothing (a revolute joint would scale its child instead of turning it)")
+    _check_tree(root, set(links), urdf)
     return root
+
+
+def _check_robot(root: ET.Element, urdf: Path) -> None:
+    """The ``<robot>`` element's name, version, materials and links, as urdfdom requires them."""
+    if root.get("name") is None:
+        raise ValueError(f"URDF {urdf}: <robot> has no name attribute")
+    version = root.get("version", "1.0")
+    if version not in ("1.0", "1.1", "1.2"):
+        raise ValueError(f"URDF {urdf}: <robot version=\"{version}\">: urdfdom reads versions 1.0, 1.1 and 1.2")
+    materials = [m.get("name") for m in root.findall("material") if m.get("name") is not None]
+    twice = next((n for k, n in enumerate(materials) if n in materials[:k]), None)
+    if twice is not None:
+        raise ValueError(f"URDF {urdf}: material {twice!r} is defined twice")
+    if root.find("link") is None:
+        raise ValueError(f"URDF {urdf} has no <link>")
+
+
+def _check_link(link: ET.Element, urdf: Path) -> str:
+    """A ``<link>``'s name, inertial and collision shapes as urdfdom reads them (it drops a collision it cannot read,
+    printing an error); returns the name."""
+    name = link.get("name")
+    if name is None:
+        raise ValueError(f"URDF {urdf}: a <link> has no name attribute")
+    where = f"URDF {urdf}: link {name!r}"
+    inertial = link.find("inertial")
+    if inertial is not None:
+        mass, inertia = inertial.find("mass"), inertial.find("inertia")
+        if mass is None or mass.get("value") is None:
+            raise ValueError(f"{where}: <inertial> needs <mass value=...>")
+        missing = [a for a in _NUMBERS["inertia"] if inertia is None or inertia.get(a) is None]
+        if missing:
+            raise ValueError(f"{where}: <inertial> needs <inertia> with {', '.join(missing)}")
+    for collision in link.findall("collision"):
+        geometry = collision.find("geometry")
+        shape = None if geometry is None or len(geometry) == 0 else geometry[0]
+        if shape is None:
+            raise ValueError(f"{where}: a <collision> has no <geometry> shape")
+        if shape.tag not in _SHAPES:
+            raise ValueError(f"{where}: <collision> shape <{shape.tag}> is none of urdfdom's {', '.join(_SHAPES)}")
+        missing = [a for a in _SHAPES[shape.tag] if shape.get(a) is None]
+        if missing:
+            raise ValueError(f"{where}: <{shape.tag}> needs the attribute(s) {', '.join(missing)}")
+        for attr in _SHAPES[shape.tag]:
+            small = [v for v in shape.get(attr).split() if shape.tag != "mesh" and float(v) <= 0]
+            if small:
+                raise ValueError(f"{where}: <{shape.tag} {attr}=\"{shape.get(attr)}\"> has a size of {small[0]} "
+                                 "(must be > 0)")
+    return name
+
+
+def _check_joint(joint: ET.Element, urdf: Path, version: str) -> str:
+    """A ``<joint>``'s name, type and the elements urdfdom requires of it; returns the name."""
+    name = joint.get("name")
+    if name is None:
+        raise ValueError(f"URDF {urdf}: a <joint> has no name attribute")
+    where = f"URDF {urdf}: joint {name!r}"
+    kind = joint.get("type")
+    if kind not in _JOINT_TYPES:
+        raise ValueError(f"{where} has type {kind!r}, none of {', '.join(_JOINT_TYPES)}")
+    limit = joint.find("limit")
+    if limit is None and kind in ("revolute", "prismatic"):
+        raise ValueError(f"{where} is {kind} without a <limit>")
+    if limit is not None:
+        needed = ["effort", "velocity"] if version != "1.2" else []
+        needed += ["lower", "upper"] if version == "1.2" and kind in ("revolute", "prismatic") else []
+        missing = [a for a in needed if limit.get(a) is None]
+        if missing:
+            raise ValueError(f"{where}: <limit> needs the attribute(s) {', '.join(missing)}")
+        negative = [a for a in ("effort", "velocity") if limit.get(a) is not None and float(limit.get(a)) < 0]
+        if negative:
+            raise ValueError(f"{where}: <limit {negative[0]}=\"{limit.get(negative[0])}\"> is negative")
+    for tag, attrs, what in (("safety_controller", ("k_velocity",), "k_velocity"), ("mimic", ("joint",), "joint"),
+                             ("dynamics", ("damping", "friction"), "damping or friction")):
+        el = joint.find(tag)
+        if el is not None and all(el.get(a) is None for a in attrs):
+            raise ValueError(f"{where}: <{tag}> needs {what}")
+    return name
+
+
+def _check_tree(root: ET.Element, links: set[str], urdf: Path) -> None:
+    """Every joint joins two links of the file, no link has two parents, and all links hang from one root."""
+    parent: dict[str, tuple[str, str]] = {}
+    for joint in root.findall("joint"):  # (not a <transmission>'s) urdfdom prints "Failed to build tree" and says only
+        # "not a valid URDF model"
+        ends = []
+        for end in ("parent", "child"):
+            el = joint.find(end)
+            name = None if el is None else el.get("link")
+            if name not in links:
+                raise ValueError(f"URDF {urdf}: joint {joint.get('name')!r} has {end} link {name!r}, which is not a "
+                                 "<link> of the file")
+            ends.append(name)
+        if ends[1] in parent:
+            raise ValueError(f"URDF {urdf}: link {ends[1]!r} is the child of two joints, {parent[ends[1]][1]!r} and "
+                             f"{joint.get('name')!r}")
+        parent[ends[1]] = (ends[0], joint.get("name"))
+    roots = sorted(links - set(parent))
+    if len(roots) != 1:
+        raise ValueError(f"URDF {urdf}: " + ("no root link: the joints form a loop" if not roots else
+                         f"{len(roots)} root links {roots[:4]}: every link but one must be a joint's child"))
+    for link in links:
+        seen = {link}
+        while link in parent:
+            link = parent[link][0]
+            if link in seen:
+                raise ValueError(f"URDF {urdf}: the joints form a loop through link {link!r}")
+            seen.add(link)
 
 
 def finite_numbers(text: str) -> bool:
