@@ -59,3 +59,17 @@ def test_a_malformed_urdf_is_refused_in_one_line_before_urdfdom_prints_its_error
     with pytest.raises(ValueError, match=f"URDF {urdf}: {match}") as info:
         RobotChecker(urdf)
     assert "\n" not in str(info.value) and capfd.readouterr().err == ""
+
+
+def test_a_collision_mesh_scaled_by_zero_is_refused_naming_the_link_and_the_file(tmp_path, write_cube_stl):
+    """A mesh with scale="0 1 1" loaded flat, with no volume: nothing could collide with it, and no error said so."""
+    write_cube_stl(tmp_path / "meshes/x.stl", 0.1)
+    urdf = tmp_path / "flat.urdf"
+    urdf.write_text(ONE_JOINT.replace('<sphere radius="0.05"/>', f'<mesh filename="{tmp_path}/meshes/x.stl" '
+                                                                 'scale="0 1 1"/>'))
+    with pytest.raises(ValueError, match=f"URDF {urdf}: link 'a': <mesh filename=\"{tmp_path}/meshes/x.stl\" "
+                                         "scale=\"0 1 1\"> has a zero scale"):
+        RobotChecker(urdf)
+    whole = tmp_path / "whole.urdf"  # the same mesh at its own scale loads
+    whole.write_text(ONE_JOINT.replace('<sphere radius="0.05"/>', f'<mesh filename="{tmp_path}/meshes/x.stl"/>'))
+    assert RobotChecker(whole).gmodel.ngeoms == 1

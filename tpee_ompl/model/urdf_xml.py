@@ -129,6 +129,9 @@ def _check_link(link: ET.Element, urdf: Path) -> str:
             if small:
                 raise ValueError(f"{where}: <{shape.tag} {attr}=\"{shape.get(attr)}\"> has a size of {small[0]} "
                                  "(must be > 0)")
+        if shape.tag == "mesh" and any(float(v) == 0 for v in shape.get("scale", "1 1 1").split()):
+            raise ValueError(f"{where}: <mesh filename=\"{shape.get('filename')}\" scale=\"{shape.get('scale')}\"> has a "
+                             "zero scale: the mesh would be flat, with no volume for anything to collide with")
     return name
 
 
