@@ -96,3 +96,16 @@ def test_the_default_scene_is_aimed_by_the_packages_ik_from_the_sector_select_se
     assert robot.is_valid(q) and robot.line_of_sight_clear(q, target)
     assert main(["show", "-o", str(tmp_path / "s.png")]) == 0
     assert f"q = {np.round(q, 4).tolist()} rad, valid: True" in capsys.readouterr().out
+
+
+def test_an_interrupted_show_exits_130_and_removes_the_folders_it_made_for_the_output(tmp_path, capsys, monkeypatch):
+    """Ctrl-C while ``show -o new/dir/s.png`` wrote left new/dir behind, empty."""
+    from matplotlib.figure import Figure
+
+    def interrupted(self, *args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(Figure, "savefig", interrupted)
+    assert main(["show", "-o", str(tmp_path / "new" / "dir" / "s.png")]) == 130
+    assert "interrupted" in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []

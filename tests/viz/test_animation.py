@@ -106,3 +106,48 @@ def test_an_animation_whose_frames_and_resolution_together_would_take_gigabytes_
 
     with pytest.raises(ValueError, match="frames x dpi"):
         animate_path(robot, [[0.87, 0.35, 0, 0], [0.87, 0.35, 0.1, 0]], tmp_path / "x.gif", frames=500, dpi=200)
+
+
+def test_an_interrupted_animation_leaves_no_file_and_removes_only_the_empty_folders_it_made(robot, tmp_path,
+                                                                                              monkeypatch):
+    """Ctrl-C during animate left the folders made for -o (new/dir) behind, empty."""
+    from matplotlib import animation
+
+    def interrupted(self, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(animation.PillowWriter, "grab_frame", interrupted)
+    W = np.hstack([cross_sector_trajectory(1, 4), np.zeros((7, 2))])
+    (tmp_path / "kept").mkdir()
+    with pytest.raises(KeyboardInterrupt):
+        animate_path(robot, W, tmp_path / "kept" / "new" / "dir" / "m.gif", frames=3)
+    assert [p.name for p in tmp_path.iterdir()] == ["kept"] and not any((tmp_path / "kept").iterdir())
+
+    def someone_else_writes(self, **kwargs):
+        (tmp_path / "new" / "theirs.txt").write_text("x")
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(animation.PillowWriter, "grab_frame", someone_else_writes)
+    with pytest.raises(KeyboardInterrupt):
+        animate_path(robot, W, tmp_path / "new" / "dir" / "m.gif", frames=3)
+    assert [p.name for p in (tmp_path / "new").iterdir()] == ["theirs.txt"]  # not empty: kept
+
+
+def test_an_interrupted_gif_is_not_encoded_from_the_frames_so_far(robot, tmp_path, monkeypatch):
+    """writer.saving encoded the frames grabbed before a Ctrl-C (7 s after one at frame 300 of 500) into a file
+    then deleted, and before the first frame its IndexError replaced the KeyboardInterrupt."""
+    from matplotlib import animation
+
+    grab, finished = animation.PillowWriter.grab_frame, []
+
+    def interrupted_at_the_second(self, **kwargs):
+        if len(self._frames) == 1:
+            raise KeyboardInterrupt
+        grab(self, **kwargs)
+
+    monkeypatch.setattr(animation.PillowWriter, "grab_frame", interrupted_at_the_second)
+    monkeypatch.setattr(animation.PillowWriter, "finish", lambda self: finished.append(1))
+    W = np.hstack([cross_sector_trajectory(1, 4), np.zeros((7, 2))])
+    with pytest.raises(KeyboardInterrupt):
+        animate_path(robot, W, tmp_path / "m.gif", frames=3)
+    assert finished == [] and list(tmp_path.iterdir()) == []

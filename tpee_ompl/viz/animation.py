@@ -17,7 +17,8 @@ import numpy as np
 
 from ..files import atomic_path
 from ..validation import MAX_COUNT, MAX_JOINT_VALUE, as_float_array, check_int
-from ._common import check_view, check_waypoints, clip_segment, draw_floor, new_axes, optional_target, output_path, set_view
+from ._common import (check_view, check_waypoints, clip_segment, draw_floor, folders_removed_on_failure, new_axes,
+                      optional_target, output_path, set_view)
 from .meshes import arm_polygons, scene_mesh
 from .style import DEFAULT_AZIM, DEFAULT_ELEV, LOS_BLOCKED, LOS_CLEAR
 
@@ -71,6 +72,16 @@ def muzzle_trace(robot: WearerArm, Q: np.ndarray) -> np.ndarray:
     return np.array([robot.muzzle(q)[0] for q in Q])
 
 
+def _abandon(writer: Any) -> None:
+    """Stop a movie writer whose frames will not be used: no GIF encoded from the frames so far (Pillow's ``finish``
+    took 7 s after a Ctrl-C at frame 300, and raised IndexError, hiding the Ctrl-C, before the first frame); an
+    ffmpeg process is ended."""
+    proc = getattr(writer, "_proc", None)  # matplotlib's MovieWriter (ffmpeg); PillowWriter holds frames only
+    if proc is not None and proc.poll() is None:
+        proc.kill()
+        proc.communicate()
+
+
 def animate_path(
     robot: WearerArm,
     waypoints: Any,
@@ -96,7 +107,8 @@ def animate_path(
         spaced in joint-space arc length (:func:`resample_path`), so the file size is bounded.
     out_path : path
         ``.gif`` (Pillow, always available) or ``.mp4`` (needs ffmpeg on PATH); ``force=False`` refuses an existing
-        file (also one written while the animation was drawn).
+        file (also one written while the animation was drawn).  Folders made for it are removed again (when empty)
+        if the animation is interrupted.
     target_a, target_b : array_like, shape (3,), metres, optional
         The start and goal targets.  The line of sight is drawn to ``target_a`` during the first half
         of the motion and to ``target_b`` during the second (green clear / red blocked).
@@ -112,7 +124,7 @@ def animate_path(
     -------
     Path of the written file.  Frames whose configuration is invalid show the arm in red.
     """
-    from matplotlib import animation
+    from matplotlib import animation, rc_context
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
     t0 = time.perf_counter()
@@ -179,10 +191,18 @@ def animate_path(
         txt.set_text(f"{head}  frame {i + 1}/{frames}  {state}")
         txt.set_color("k" if valid[i] else LOS_BLOCKED)
 
-    with atomic_path(out, suffix_last=True, force=force) as tmp, writer.saving(fig, str(tmp), dpi):
-        for i in range(frames):
-            draw(i)
-            writer.grab_frame()
+    # interrupted (Ctrl-C), no file and none of the folders made for it are left
+    with folders_removed_on_failure(out), atomic_path(out, suffix_last=True, force=force) as tmp, \
+            rc_context({"savefig.bbox": None}):  # as writer.saving, which finishes the file also on an error
+        writer.setup(fig, str(tmp), dpi)
+        try:
+            for i in range(frames):
+                draw(i)
+                writer.grab_frame()
+        except BaseException:
+            _abandon(writer)
+            raise
+        writer.finish()
     n_bad = int((~valid).sum())
     if n_bad:
         log.warning("animate_path: %d of %d frames are invalid (drawn red)", n_bad, frames)
