@@ -23,6 +23,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..validation import MAX_JOINT_VALUE
+from .mimic_joints import check_mimics
 from .obstacles import Obstacle
 from .urdf_xml import parse_urdf, read_robot_xml, read_text
 
@@ -184,7 +185,8 @@ def load_urdf_model(
         model, gmodel = _lock_joints(model, gmodel, locked, urdf)
         extra.append("locked=" + ",".join(f"{k}={float(v)!r}" for k, v in sorted(locked.items())))
     _check_joints(model, urdf)
-    _check_mimics(root, model, urdf)
+    check_mimics(root, set(model.names[1:]), locked or {}, {j.get("name") for j in root.findall("joint")
+                                                            if j.get("type") == "continuous"}, urdf)
     if model.nq == 0:
         raise ValueError(f"URDF {urdf}: no joint left to plan (every joint is fixed or locked)")
     if not any(go.parentJoint != 0 for go in gmodel.geometryObjects):
@@ -314,27 +316,6 @@ def _check_joints(model: pin.Model, urdf: Path) -> None:
             raise ValueError(f"URDF {urdf}: joint {name!r} has limits [{lo:g}, {hi:g}] beyond +/-{MAX_JOINT_VALUE:g} "
                              "(rad or m): no joint travels that far, and a motion across them could not be checked "
                              "state by state; give its real limits")
-
-
-def _check_mimics(root: ET.Element, model: pin.Model, urdf: Path) -> None:
-    """No planned joint is a URDF mimic joint: Pinocchio's parser loads one as an independent joint, so the
-    planner would give it values the robot cannot take."""
-    planned = set(model.names[1:])
-    followers: dict[str, list[str]] = {}
-    for joint in root.iter("joint"):
-        mimic = joint.find("mimic")
-        if mimic is not None:
-            followers.setdefault(str(mimic.get("joint")), []).append(str(joint.get("name")))
-    for master, names in followers.items():
-        free = [n for n in names if n in planned]
-        locks = ", ".join(f"{n!r}: value" for n in [master, *names])
-        advice = f"lock {master!r} and the joints that mimic it (locked={{{locks}}}, each mimic at multiplier x value + offset)"
-        if free:
-            raise ValueError(f"URDF {urdf}: joint {free[0]!r} mimics {master!r}, which would be planned as an "
-                             f"independent joint: {advice}")
-        if master in planned:  # its mimics locked, it free: the two would part (a gripper's two fingers)
-            raise ValueError(f"URDF {urdf}: joint {master!r} is planned while {names[0]!r}, which mimics it, is locked: "
-                             f"{advice}")
 
 
 def is_continuous(joint: pin.JointModel) -> bool:
