@@ -23,6 +23,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..validation import MAX_JOINT_VALUE
+from .mesh_files import missing_mesh_hint, resolve_relative_meshes
 from .mimic_joints import check_mimics
 from .obstacles import Obstacle
 from .urdf_xml import parse_urdf, read_robot_xml, read_text
@@ -164,16 +165,15 @@ def load_urdf_model(
     dirs = [str(d) for d in package_dirs]
     continuous = tuple(j.get("name") for j in root.findall("joint")
                        if j.get("type") == "continuous" and j.get("name") not in (locked or {}))
+    if resolve_relative_meshes(root, urdf):  # (the hash stays the file's: the same wherever it is)
+        text = ET.tostring(root, encoding="unicode")
     if continuous:
         text = _continuous_as_revolute(root, continuous)
     try:
         model = pin.buildModelFromXML(text)
         gmodel = pin.buildGeomFromUrdfString(model, text, pin.GeometryType.COLLISION, package_dirs=dirs)
     except Exception as exc:  # the bindings raise RuntimeError/ValueError with C++ text
-        hint = ""
-        if "package://" in str(exc) and "could not be found" in str(exc):
-            hint = (" (a package:// mesh is looked up in package_dirs: give the folder that holds the package's "
-                    f"folder, e.g. package_dirs=[...]; given: {dirs or 'none'})")
+        hint = missing_mesh_hint(str(exc), dirs, urdf)
         raise ValueError(f"Pinocchio could not load URDF {urdf}: {' '.join(str(exc).split())}{hint}") from exc
     if gmodel.ngeoms != n_collision_elements:
         raise ValueError(
