@@ -8,7 +8,6 @@ every ``<collision>`` element must become a geometry, every URDF cylinder become
 from __future__ import annotations
 
 import copy
-import logging
 import hashlib
 import math
 import numbers
@@ -26,7 +25,8 @@ from ..validation import MAX_JOINT_VALUE
 from .mesh_files import missing_mesh_hint, resolve_relative_meshes
 from .mimic_joints import check_mimics
 from .obstacles import Obstacle
-from .urdf_xml import parse_urdf, read_robot_xml, read_text
+from .srdf_pairs import apply_srdf
+from .urdf_xml import parse_urdf, read_text
 
 __all__ = [
     "ARM_JOINTS",
@@ -38,8 +38,6 @@ __all__ = [
     "load_urdf_model",
     "load_wearer_model",
 ]
-
-log = logging.getLogger(__name__)
 
 ARM_JOINTS = ("j1", "j2", "j3", "j4")
 """Joint names in configuration order: DOF1 (about x), DOF2 (about -y), pan, tilt."""
@@ -220,7 +218,7 @@ def load_urdf_model(
         digest.update(("\n" + e).encode())
     gmodel.addAllCollisionPairs()
     if srdf is not None:
-        _apply_srdf(model, gmodel, srdf, srdf_unknown_links)
+        apply_srdf(model, gmodel, srdf, srdf_unknown_links)
     return LoadedModel(model, gmodel, digest.hexdigest()[:16], continuous)
 
 
@@ -326,26 +324,3 @@ def is_continuous(joint: pin.JointModel) -> bool:
 def is_prismatic(joint: pin.JointModel) -> bool:
     """True for a prismatic joint (its coordinate is in metres, not radians)."""
     return joint.shortname().startswith("JointModelP")
-
-
-def _apply_srdf(model: pin.Model, gmodel: pin.GeometryModel, srdf: Path, unknown_links: str = "error") -> None:
-    """Remove the SRDF's disabled pairs, after checking that it names only links of the model (``unknown_links``
-    "error"), or passing over the pairs that name other links ("skip"; Pinocchio applies the rest)."""
-    root = read_robot_xml(srdf, "SRDF")
-    for vj in root.iter("virtual_joint"):  # a mobile or legged robot's base: the URDF's root stays fixed here
-        if vj.get("type") in ("floating", "planar"):
-            log.warning("SRDF %s declares the %s virtual joint %r: its base is fixed to the world here (only the "
-                        "URDF's joints are planned)", srdf, vj.get("type"), vj.get("name"))
-    links = {f.name for f in model.frames}
-    pairs = [(dc.get("link1"), dc.get("link2")) for dc in root.iter("disable_collisions")]
-    foreign = [p for p in pairs if p[0] not in links or p[1] not in links]
-    if foreign and unknown_links == "skip":
-        log.info("SRDF %s: %d of its %d disabled pairs name links the URDF lacks; passed over", srdf, len(foreign),
-                 len(pairs))
-    elif foreign:
-        name = next(n for n in foreign[0] if n not in links)
-        raise ValueError(f"SRDF {srdf} names unknown link {name!r} ({len(foreign)} of its {len(pairs)} disabled pairs "
-                         "name links the URDF lacks: an SRDF of another or a larger robot? keep only the pairs of "
-                         "this URDF's links, or pass srdf_unknown_links='skip')")
-    # from the text, not the path: Pinocchio's path reader refuses a file not named *.srdf (an SRDF saved as .xml)
-    pin.removeCollisionPairsFromXML(model, gmodel, srdf.read_text(encoding="utf-8"))
