@@ -47,3 +47,34 @@ def test_an_srdf_entry_naming_a_joint_instead_of_a_link_is_refused_naming_the_en
     with caplog.at_level(logging.WARNING):  # an SRDF of a larger robot: passed over, but said once
         robot = RobotChecker(urdf, srdf, srdf_unknown_links="skip")
     assert "names joint 'j1', not a link" in caplog.text and frozenset(("a", "b")) in _link_pairs(robot)
+
+
+def test_moveits_disable_default_collisions_disables_a_links_pairs_but_those_enabled_again(arm):
+    """<disable_default_collisions link="b"/> was ignored without a word: every pair of b stayed checked.  As in
+    MoveIt's allowed collision matrix, b's default covers the obstacles too, <enable_collisions> re-enables a pair,
+    and <disable_collisions> wins over <enable_collisions>."""
+    from tpee_ompl.model.obstacles import box
+
+    post = box("post", (0.1, 0.1, 0.1), (0.4, 0.0, 0.75))
+    urdf, srdf = arm('<disable_default_collisions link="b"/><enable_collisions link1="base" link2="b"/>')
+    every = _link_pairs(RobotChecker(urdf, obstacles=[post]))
+    assert {frozenset(p) for p in (("a", "b"), ("b", "universe"), ("b", "base"))} <= every
+    robot = RobotChecker(urdf, srdf, obstacles=[post])
+    assert _link_pairs(robot) == every - {frozenset(("a", "b")), frozenset(("b", "universe"))}
+    urdf, srdf = arm('<disable_default_collisions link="b"/><enable_collisions link1="base" link2="b"/>'
+                     '<disable_collisions link1="b" link2="base"/>')
+    assert _link_pairs(RobotChecker(urdf, srdf, obstacles=[post])) == every - {
+        frozenset(p) for p in (("a", "b"), ("b", "universe"), ("b", "base"))}
+
+
+@pytest.mark.parametrize("entries, match", [
+    ('<disable_default_collisions link="j2"/>', "<disable_default_collisions link=\"j2\"> names joint 'j2'"),
+    ('<disable_default_collisions link="c"/>', "unknown link 'c'"),
+    ('<enable_collisions link1="a" link2="c"/>', "unknown link 'c'"),
+    ('<disable_default_collisions/>', "<disable_default_collisions> has no link"),
+    ('<disable_collisions link1="a"/>', "<disable_collisions link1=\"a\"> has no link2"),
+])
+def test_every_srdf_collision_entry_names_links_of_the_urdf(arm, entries, match):
+    urdf, srdf = arm(entries)
+    with pytest.raises(ValueError, match=f"SRDF {srdf}.*{match}"):
+        RobotChecker(urdf, srdf)
