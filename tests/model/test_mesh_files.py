@@ -31,3 +31,19 @@ def test_a_relative_mesh_found_nowhere_says_where_it_was_looked_for(tmp_path):
                                          f"looked up in the URDF's folder {tmp_path}, then in package_dirs; given: "
                                          "none\\)"):
         RobotChecker(urdf)
+
+
+def test_the_model_hash_covers_the_mesh_files_bytes_not_where_they_are(tmp_path, write_cube_stl):
+    """Two checkers of one URDF on different meshes (package_dirs naming two copies of a package) shared a model hash,
+    which the benchmark and the path libraries use to tell models apart."""
+    urdf = tmp_path / "arm.urdf"
+    urdf.write_text(MESH_ARM.format(mesh="package://parts/meshes/x.stl"))
+    small, large, same = (write_cube_stl(tmp_path / f"{d}/parts/meshes/x.stl", side)
+                          for d, side in (("small", 0.1), ("large", 0.3), ("moved", 0.1)))
+    hashes = [RobotChecker(urdf, package_dirs=[p.parents[2]]).model_hash for p in (small, large, same)]
+    assert hashes[0] != hashes[1] and hashes[0] == hashes[2]
+    relative = tmp_path / "small/arm.urdf"  # a relative path: its file's bytes too
+    relative.write_text(MESH_ARM.format(mesh="parts/meshes/x.stl"))
+    before = RobotChecker(relative).model_hash
+    write_cube_stl(small, 0.2)
+    assert RobotChecker(relative).model_hash != before

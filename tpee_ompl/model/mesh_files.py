@@ -1,4 +1,5 @@
-"""A URDF's collision mesh files: relative paths found in the URDF's folder, and a hint where a mesh was looked for.
+"""A URDF's collision mesh files: relative paths found in the URDF's folder, a hint where a mesh was looked for, and
+the files' bytes for the model hash.
 
 Pinocchio looks a relative ``<mesh filename="meshes/x.stl"/>`` up in ``package_dirs`` only (then in
 ``ROS_PACKAGE_PATH``), never beside the URDF; a relative path names a file relative to the URDF's folder, so it
@@ -7,12 +8,16 @@ is resolved there first.
 
 from __future__ import annotations
 
+import hashlib
 import re
 import xml.etree.ElementTree as ET
 from collections.abc import Sequence
 from pathlib import Path
 
-__all__ = ["missing_mesh_hint", "resolve_relative_meshes"]
+import coal
+import pinocchio as pin
+
+__all__ = ["mesh_digests", "missing_mesh_hint", "resolve_relative_meshes"]
 
 _URI = re.compile(r"^[A-Za-z][A-Za-z0-9+.-]*://")
 """``package://``, ``file://``, ...: a mesh filename that is not a plain path."""
@@ -47,3 +52,18 @@ def missing_mesh_hint(message: str, dirs: Sequence[str], urdf: Path) -> str:
     if _URI.match(name):
         return ""
     return f" (a relative mesh path is looked up in the URDF's folder {urdf.parent}, then in package_dirs; {given})"
+
+
+def mesh_digests(gmodel: pin.GeometryModel) -> list[str]:
+    """Per mesh geometry, ``"mesh=<geometry name>:<SHA-256 of its file's bytes>"``, for the model hash.
+
+    The bytes decide the shape (with the URDF's scale, which the URDF's text holds); where the file is does not:
+    the same package found in another folder, or the robot's files moved, keep the hash of the query sets and
+    path libraries made for it."""
+    out, seen = [], {}
+    for go in gmodel.geometryObjects:
+        if isinstance(go.geometry, coal.BVHModelBase) and Path(go.meshPath).is_file():
+            if go.meshPath not in seen:
+                seen[go.meshPath] = hashlib.sha256(Path(go.meshPath).read_bytes()).hexdigest()
+            out.append(f"mesh={go.name}:{seen[go.meshPath]}")
+    return out

@@ -148,7 +148,7 @@ class RobotChecker:
         loaded = self._load_model()
         self.model, self.gmodel = loaded.model, loaded.gmodel
         self.model_hash = loaded.model_hash
-        """Short SHA-256 of the URDF (+ SRDF, locked joints, obstacles): stored with query sets and path libraries."""
+        """Short SHA-256 of the URDF (+ SRDF, mesh files, locked joints, obstacles): kept with query sets, libraries."""
         self.circular = np.array([n in loaded.continuous for n in self.model.names[1:]], dtype=bool)
         """Per planned joint, True for a URDF continuous joint: its coordinate is an angle in [-pi, pi] that wraps
         around (an SO2 subspace in :func:`~tpee_ompl.planning.setup.make_space`)."""

@@ -22,7 +22,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..validation import MAX_JOINT_VALUE
-from .mesh_files import missing_mesh_hint, resolve_relative_meshes
+from .mesh_files import mesh_digests, missing_mesh_hint, resolve_relative_meshes
 from .mimic_joints import check_mimics
 from .obstacles import Obstacle
 from .srdf_pairs import apply_srdf
@@ -145,8 +145,9 @@ def load_urdf_model(
     meshes).  Obstacles go on the universe joint.
     Collision pairs: every pair of geometries on different joints (so never obstacle-obstacle or
     obstacle-base), minus the SRDF's disabled link pairs.  The model hash covers the URDF and SRDF
-    texts and, when given, the locked values, obstacles, a ``cylinders_as_capsules=False`` and the meshes made
-    convex hulls (``convex_meshes``; a flat mesh, which has none, stays a mesh).  An SRDF pair naming a link the
+    texts, the collision mesh files' bytes (not where they are found) and, when given, the locked values,
+    obstacles, a ``cylinders_as_capsules=False`` and the meshes made convex hulls (``convex_meshes``; a flat
+    mesh, which has none, stays a mesh).  An SRDF pair naming a link the
     URDF lacks is refused (a typo would leave that pair checked), or with ``srdf_unknown_links="skip"`` passed
     over (the SRDF of a larger robot, e.g. a whole humanoid's for one arm: its other pairs apply).
 
@@ -178,7 +179,7 @@ def load_urdf_model(
             f"URDF {urdf}: {n_collision_elements} <collision> elements but only "
             f"{gmodel.ngeoms} geometries were loaded (unsupported shape?)"
         )
-    extra = []
+    extra = mesh_digests(gmodel)
     if locked:
         model, gmodel = _lock_joints(model, gmodel, locked, urdf)
         extra.append("locked=" + ",".join(f"{k}={float(v)!r}" for k, v in sorted(locked.items())))
