@@ -78,3 +78,11 @@ def test_every_srdf_collision_entry_names_links_of_the_urdf(arm, entries, match)
     urdf, srdf = arm(entries)
     with pytest.raises(ValueError, match=f"SRDF {srdf}.*{match}"):
         RobotChecker(urdf, srdf)
+
+
+def test_the_clearance_of_a_robot_with_no_pair_left_to_check_is_infinite(arm):
+    """A robot whose every pair is disabled raised IndexError from Pinocchio's empty distance results."""
+    urdf, srdf = arm('<disable_default_collisions link="a"/><disable_default_collisions link="b"/>')
+    robot = RobotChecker(urdf, srdf)
+    assert len(robot.gmodel.collisionPairs) == 0 and robot.is_valid([0.0, 0.0])
+    assert robot.clearance([0.0, 0.0]) == float("inf") == robot.clearance([0.0, 0.0], from_margins=True)

@@ -489,7 +489,7 @@ class RobotChecker:
         if from_margins:
             d = np.fromiter((r.min_distance for r in self._distance_data.distanceResults), float)
             return float((d - self._pair_margins).min()) if len(d) else np.inf
-        return float(self._distance_data.distanceResults[k].min_distance)
+        return float(self._distance_data.distanceResults[k].min_distance) if len(self._pair_margins) else np.inf
 
     def closest_pair(self, q: np.ndarray) -> tuple[str, str, float]:
         """The two geometry names of the closest checked pair at q, and their distance (m)."""
