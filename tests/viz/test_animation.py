@@ -151,3 +151,21 @@ def test_an_interrupted_gif_is_not_encoded_from_the_frames_so_far(robot, tmp_pat
     with pytest.raises(KeyboardInterrupt):
         animate_path(robot, W, tmp_path / "m.gif", frames=3)
     assert finished == [] and list(tmp_path.iterdir()) == []
+
+
+def test_animate_path_shows_a_progress_bar_with_the_time_left_and_writes_the_same_gif(robot, tmp_path, capsys,
+                                                                                       monkeypatch):
+    """500 frames took 45-68 s without a word: the bar counts frames drawn, then encoded."""
+    import tpee_ompl.viz._common as common
+
+    monkeypatch.setattr(common, "PROGRESS_DELAY", 0.0)  # the bar appears after 2 s: now at once
+    W = np.hstack([cross_sector_trajectory(1, 4), np.zeros((7, 2))])
+    quiet = animate_path(robot, W, tmp_path / "quiet.gif", frames=4)
+    assert capsys.readouterr().err == ""
+    shown = animate_path(robot, W, tmp_path / "shown.gif", frames=4, progress=True)
+    lines = capsys.readouterr().err.replace("\r", "\n").split("\n")
+    assert any("frame 4/4" in line for line in lines) and "encoding" in lines[-2]
+    assert lines[-2].startswith("animate: 100%|") and "<00:00" in lines[-2]
+    assert shown.read_bytes() == quiet.read_bytes()
+    with pytest.raises(ValueError, match="progress"):
+        animate_path(robot, W, tmp_path / "x.gif", frames=4, progress="yes")

@@ -135,7 +135,7 @@ def cmd_animate(args: argparse.Namespace) -> int:
         W = np.asarray(result["path"])
     (pa, ua), (pb, ub) = robot.muzzle(W[0]), robot.muzzle(W[-1])
     out = animate_path(robot, W, args.output, target_a=pa + 3 * ua, target_b=pb + 3 * ub, frames=args.frames,
-                       force=args.force)
+                       force=args.force, progress=not args.no_progress)
     print(f"wrote {out} ({len(W)} waypoints, {args.frames} frames)")
     return 0
 
@@ -147,7 +147,8 @@ def cmd_workspace(args: argparse.Namespace) -> int:
 
     check_output(args.output, "--output", args.force, image_suffixes())
     robot = load_robot(args)
-    pointing_workspace(robot, args.samples, np.random.default_rng(args.seed), args.output, force=args.force)
+    pointing_workspace(robot, args.samples, np.random.default_rng(args.seed), args.output, force=args.force,
+                       progress=not args.no_progress)
     print(f"wrote {args.output} ({args.samples} samples, seed {args.seed})")
     return 0
 
@@ -167,6 +168,11 @@ def cmd_view(args: argparse.Namespace) -> int:
     print("meshcat viewer running; press Ctrl-C to stop")
     while True:
         time.sleep(1.0)
+
+
+def _add_no_progress_arg(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--no-progress", action="store_true",
+                   help="no progress bar (shown on stderr, with the time left, when the drawing lasts more than 2 s)")
 
 
 def register(sub: argparse._SubParsersAction, fmt: type) -> None:
@@ -195,6 +201,7 @@ def register(sub: argparse._SubParsersAction, fmt: type) -> None:
                    help=f"frames, 2..{MAX_FRAMES} (default %(default)s)")
     p.add_argument("-o", "--output", type=nonempty, default="motion.gif", help="a .gif or .mp4 file (default motion.gif)")
     add_force_arg(p)
+    _add_no_progress_arg(p)
     p.set_defaults(func=cmd_animate)
 
     p = sub.add_parser("workspace", help="Monte-Carlo pointing workspace (Fig. 4)", formatter_class=fmt,
@@ -205,6 +212,7 @@ def register(sub: argparse._SubParsersAction, fmt: type) -> None:
     p.add_argument("--seed", type=numpy_seed, default=0, help="sampling seed, 0..2^32-1 (default 0)")
     p.add_argument("-o", "--output", type=nonempty, default="workspace.png", help="image file (default workspace.png)")
     add_force_arg(p)
+    _add_no_progress_arg(p)
     add_model_args(p)
     p.set_defaults(func=cmd_workspace)
 

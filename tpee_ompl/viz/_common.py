@@ -85,6 +85,42 @@ def clip_segment(a: np.ndarray, b: np.ndarray, lo: np.ndarray, hi: np.ndarray) -
     return a + max(t, 0.0) * d
 
 
+# ---------------------------------------------------------------------------- progress
+PROGRESS_DELAY = 2.0
+"""Seconds before a drawing's progress bar appears (as ``tpee-ompl track``'s: a quick picture prints none)."""
+
+
+class Progress:
+    """A progress bar on stderr with the time left (tqdm, as ``library build`` and ``track`` show): it counts
+    estimated units of work (e.g. microseconds), so phases of unequal cost share one bar and its time left is even.
+    ``enabled=False``: every call does nothing.  Use it as a context manager (the bar is closed on leaving)."""
+
+    def __init__(self, desc: str, total: float, enabled: bool) -> None:
+        from tqdm import tqdm
+
+        self.enabled = bool(enabled)
+        self._bar = tqdm(total=total, desc=desc, delay=PROGRESS_DELAY, disable=not self.enabled,
+                         bar_format="{desc}: {percentage:3.0f}%|{bar}| {elapsed}<{remaining}{postfix}")
+
+    def __enter__(self) -> Progress:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self._bar.close()
+
+    def add(self, units: float, phase: str | None = None) -> None:
+        """``units`` of work done; ``phase`` (shown after the time left) names what runs now."""
+        if self.enabled:
+            if phase is not None:
+                self._bar.set_postfix_str(phase, refresh=False)
+            self._bar.update(min(units, max(self._bar.total - self._bar.n, 0)))  # past the total: tqdm shows 0%
+
+    def expect(self, remaining: float) -> None:
+        """What is left now, better known than at the start: the total becomes the work done plus ``remaining``."""
+        if self.enabled:
+            self._bar.total = self._bar.n + remaining  # shown at the next add (refresh() would ignore the delay)
+
+
 # ---------------------------------------------------------------------------- argument checks
 def optional_target(target: Any) -> np.ndarray | None:
     """None, or the target as 3 finite floats (metres) within the model's MAX_TARGET_DISTANCE; ValueError otherwise."""
