@@ -29,7 +29,8 @@ _LIMIT = '<limit lower="-1" upper="1" effort="1" velocity="1"/>'
 
 @pytest.mark.parametrize("old, new, match", [
     ('<robot name="t">', "<robot>", "<robot> has no name attribute"),
-    ('<robot name="t">', '<robot name="t" version="2.0">', '<robot version="2.0">: urdfdom reads versions 1.0, 1.1 and 1.2'),
+    ('<robot name="t">', '<robot name="t" version="2.0">',
+     '<robot version="2.0">: urdfdom reads versions 1.0, 1.1 and 1.2'),
     (_LIMIT, "", "joint 'j1' is revolute without a <limit>"),
     ('type="revolute"', 'type="revolutee"', "joint 'j1' has type 'revolutee'"),
     ('effort="1" ', "", r"joint 'j1': <limit> needs the attribute\(s\) effort"),
@@ -47,7 +48,8 @@ _LIMIT = '<limit lower="-1" upper="1" effort="1" velocity="1"/>'
      "link 'a' is the child of two joints, 'j1' and 'j9'"),
     ("</joint>", '<dynamics/></joint>', "joint 'j1': <dynamics> needs damping or friction"),
     ("</joint>", '<mimic multiplier="2"/></joint>', "joint 'j1': <mimic> needs joint"),
-    ('<link name="a">', '<link name="a"><inertial><mass value="1"/></inertial>', "link 'a': <inertial> needs <inertia>"),
+    ('<link name="a">', '<link name="a"><inertial><mass value="1"/></inertial>',
+     "link 'a': <inertial> needs <inertia>"),
 ])
 def test_a_malformed_urdf_is_refused_in_one_line_before_urdfdom_prints_its_errors(tmp_path, capfd, old, new, match):
     """urdfdom printed its C++ errors on stderr (several lines, twice: Pinocchio parses the file for the model and again

@@ -77,7 +77,8 @@ def check_mimics(root: ET.Element, planned: set[str], locked: Mapping[str, float
                                  f"the URDF: lock {m.name!r} (locked={{{m.name!r}: value}}) or remove its <mimic>")
             continue
         followers = [f for f in found if f.master == m.master]
-        locks = ", ".join([f"{m.master!r}: v", *(f"{f.name!r}: {f.multiplier:g} * v + {f.offset:g}" for f in followers)])
+        locks = ", ".join([f"{m.master!r}: v",
+                           *(f"{f.name!r}: {f.multiplier:g} * v + {f.offset:g}" for f in followers)])
         advice = f"lock {m.master!r} and the joints that mimic it (locked={{{locks}}})"
         if m.name in planned:
             raise ValueError(f"URDF {urdf}: joint {m.name!r} mimics {m.master!r}, which would be planned as an "

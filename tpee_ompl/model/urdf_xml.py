@@ -38,7 +38,8 @@ def read_robot_xml(path: Path, kind: str) -> ET.Element:
 
 _NUMBERS = {"sphere": ("radius",), "cylinder": ("radius", "length"), "box": ("size",), "origin": ("xyz", "rpy"),
             "axis": ("xyz",), "limit": ("lower", "upper", "effort", "velocity"), "mass": ("value",),
-            "inertia": ("ixx", "ixy", "ixz", "iyy", "iyz", "izz"), "mesh": ("scale",), "mimic": ("multiplier", "offset"),
+            "inertia": ("ixx", "ixy", "ixz", "iyy", "iyz", "izz"), "mesh": ("scale",),
+            "mimic": ("multiplier", "offset"),
             "safety_controller": ("soft_lower_limit", "soft_upper_limit", "k_position", "k_velocity"),
             "calibration": ("rising", "falling"), "dynamics": ("damping", "friction")}
 """Numeric attributes of URDF elements, checked before urdfdom reads them (it prints a C++ error per bad one)."""
@@ -56,7 +57,8 @@ def parse_urdf(urdf: Path) -> ET.Element:
     # a link's shapes only: <collision> / <capsule> elsewhere (Gazebo sensors, Pinocchio's <collision_checking>)
     # are not urdfdom's to drop
     if root.findall("link/collision/geometry/capsule") or root.findall("link/visual/geometry/capsule"):
-        raise ValueError(f"URDF {urdf} uses <capsule>, which urdfdom drops silently; use <cylinder> (loaded as capsules)")
+        raise ValueError(f"URDF {urdf} uses <capsule>, which urdfdom drops silently; use <cylinder> (loaded as "
+                         "capsules)")
     for owner in (*root.iter("link"), *root.iter("joint")):
         for el in owner.iter():
             for attr in _NUMBERS.get(el.tag, ()):
@@ -78,8 +80,8 @@ def parse_urdf(urdf: Path) -> ET.Element:
         axis = joint.find("axis")
         if joint.get("type") in ("revolute", "prismatic", "continuous") and axis is not None \
                 and not any(float(v) for v in axis.get("xyz", "1 0 0").split()):
-            raise ValueError(f"URDF {urdf}: joint {joint.get('name')!r} has <axis xyz=\"{axis.get('xyz')}\">: a zero axis "
-                             "moves nothing (a revolute joint would scale its child instead of turning it)")
+            raise ValueError(f"URDF {urdf}: joint {joint.get('name')!r} has <axis xyz=\"{axis.get('xyz')}\">: a zero "
+                             "axis moves nothing (a revolute joint would scale its child instead of turning it)")
     _check_tree(root, set(links), urdf)
     return root
 
@@ -130,8 +132,8 @@ def _check_link(link: ET.Element, urdf: Path) -> str:
                 raise ValueError(f"{where}: <{shape.tag} {attr}=\"{shape.get(attr)}\"> has a size of {small[0]} "
                                  "(must be > 0)")
         if shape.tag == "mesh" and any(float(v) == 0 for v in shape.get("scale", "1 1 1").split()):
-            raise ValueError(f"{where}: <mesh filename=\"{shape.get('filename')}\" scale=\"{shape.get('scale')}\"> has a "
-                             "zero scale: the mesh would be flat, with no volume for anything to collide with")
+            raise ValueError(f"{where}: <mesh filename=\"{shape.get('filename')}\" scale=\"{shape.get('scale')}\"> "
+                             "has a zero scale: the mesh would be flat, with no volume for anything to collide with")
     return name
 
 
