@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 from ._version import __version__ as __version__  # (one home, floor 0)
 
 if TYPE_CHECKING:  # what static tools see; at run time the names are imported on first use (below)
-    from .library.dmp import DMP, DMPOptions, generate, generate_blended, learn_dmp
+    from .library.dmp import DMP, DMPOptions, generate, generate_blended, learn_dmp, min_samples
     from .library import (
         LibraryDimensionRRT,
         LibraryFileError,
@@ -110,6 +110,7 @@ _EXPORTS = {
     "DMP": ".library.dmp",
     "DMPOptions": ".library.dmp",
     "learn_dmp": ".library.dmp",
+    "min_samples": ".library.dmp",
     "generate": ".library.dmp",
     "generate_blended": ".library.dmp",
 }

@@ -18,7 +18,7 @@ from .demos import (
     dimension_rrt_planner,
     query_sampler,
 )
-from .dmp import DMP, DMPOptions, generate, generate_blended, learn_dmp
+from .dmp import DMP, DMPOptions, generate, generate_blended, learn_dmp, min_samples
 from .evaluation import benchmark_queries
 from .path_library import PathLibrary, QueryResult
 from .planner import LibraryDimensionRRT, infer_sector
@@ -49,5 +49,6 @@ __all__ = [
     "generate_blended",
     "learn_dmp",
     "make_default_planner",
+    "min_samples",
     "query_sampler",
 ]
