@@ -274,3 +274,29 @@ def test_the_anytime_cost_table_has_a_row_per_budget_and_planner():
     text = report._markdown([], [], [], rows, "D", "R", "batched")
     assert [line for line in text.splitlines() if line.startswith(("| 0.1 |", "| 1 |"))] == [
         f"| {b} | {pl} | 2/2 | 1.000 [1.000, 1.000] |" for b in ("0.1", "1") for pl in ("A", "B")]
+
+
+def test_the_headline_is_table4_and_the_first_path_table_without_the_other_sections(tmp_path, monkeypatch):
+    """What ``tpee-ompl bench`` prints: it was cut from the Markdown by section titles in the command line."""
+    capped = [run(p, q, 500, t, 2.0, 1.0, 1.0) for q in (0, 1) for p, t in (("DimensionRRT", 0.1), ("RRTstar", 1.0))]
+    monkeypatch.setattr(report, "load_runs", lambda db: anytime_campaign() + capped)
+    out = report.write_report(tmp_path / "unused.db", tmp_path)
+    shown = out["headline"]
+    assert shown.startswith("## Table 4") and "## Anytime comparison: time to the first exact path" in shown
+    assert "## Success counts" not in shown and "median raw cost" not in shown
+    assert all(part.strip() in out["markdown_text"] for part in shown.split("\n\n"))
+
+
+def test_the_headline_of_a_campaign_without_table4_says_why(tmp_path, monkeypatch):
+    runs = [run("DimensionRRT", q, 500, 1.0, 2.0, 1.0, 1.0) for q in (0, 1)]
+    monkeypatch.setattr(report, "load_runs", lambda db: runs)
+    out = report.write_report(tmp_path / "unused.db", tmp_path)
+    assert out["headline"].startswith("No Table 4: it compares DimensionRRT with RRTstar") and "##" not in out["headline"]
+
+
+def test_the_headline_of_an_anytime_only_campaign_is_its_first_path_table(tmp_path, monkeypatch):
+    runs = [r for r in anytime_campaign() if r["comparison"] == "anytime"]
+    monkeypatch.setattr(report, "load_runs", lambda db: runs)
+    out = report.write_report(tmp_path / "unused.db", tmp_path, planner="A", reference="B")
+    assert out["headline"].startswith("## Anytime comparison: time to the first exact path")
+    assert "Success counts" not in out["headline"]

@@ -154,13 +154,3 @@ def test_resume_keeps_the_campaigns_worker_count_unless_workers_is_given(tmp_pat
     assert seen == [3, 2]
 
 
-def test_the_terminal_shows_the_report_headline_tables_only():
-    from tpee_ompl.cli.bench import headline
-
-    report = ("## Table 4: A / B\n\n| N |\n\n## Success counts\n\n| x |\n\n"
-              "## Anytime comparison: median raw cost\n\n| c |\n\n"
-              "## Anytime comparison: time to the first exact path and length\n\n| t |\n")
-    shown = headline(report)
-    assert "## Table 4" in shown and "time to the first exact path" in shown and "| t |" in shown
-    assert "Success counts" not in shown and "median raw cost" not in shown
-    assert headline("No Table 4: why.\n\n## Success counts\n\n| x |\n") == "No Table 4: why.\n"

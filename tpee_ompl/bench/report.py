@@ -444,7 +444,8 @@ def write_report(db_path: str | Path, directory: str | Path, expected: dict | No
     those of ``success.csv``, ``length_quality.csv``, ``anytime.csv``, ``anytime_quality.csv`` that have rows.
 
     ``planner``/``reference`` default to the campaign's first two iteration planners (or
-    DimensionRRT / RRTstar).  Returns the paths, the Markdown text and the number of runs and successful runs.
+    DimensionRRT / RRTstar).  Returns the paths, the Markdown text, its ``headline`` (Table 4 and the anytime
+    first-path table, what a terminal shows) and the number of runs and successful runs.
     """
     directory = Path(directory)
     runs = load_runs(db_path)
@@ -464,8 +465,10 @@ def write_report(db_path: str | Path, directory: str | Path, expected: dict | No
     quality = length_quality_table(runs)
     anytime = anytime_table(runs)
     anytime_quality = anytime_quality_table(runs)
-    text = (note + _markdown(ratios, succ, quality, anytime, planner, reference, headline)
-            + _anytime_quality_markdown(anytime_quality) + _lost_queries(expected))
+    table4 = "\n".join(_ratio_markdown(ratios, planner, reference, headline)) + "\n" if ratios else ""
+    rest = _markdown([], succ, quality, anytime, planner, reference, headline)
+    first = _anytime_quality_markdown(anytime_quality)
+    text = note + table4 + rest + first + _lost_queries(expected)
     paths = {"markdown": directory / "report.md"}
     atomic_write_text(paths["markdown"], text)
     if ratios:  # a campaign without sample caps has no Table 4
@@ -476,8 +479,10 @@ def write_report(db_path: str | Path, directory: str | Path, expected: dict | No
         if rows:  # a table the campaign has no runs for (no budgets: no anytime rows) is not written empty
             paths[name] = directory / f"{name}.csv"
             _write_csv(paths[name], rows)
-    return {**paths, "markdown_text": text, "planner": planner, "reference": reference, "runs": len(runs),
-            "successes": sum(bool(r["success"]) for r in runs)}
+    # what a terminal shows: Table 4 and the first-path / within-5 % table, else why there is no Table 4 or the counts
+    summary = "\n\n".join(s.strip("\n") for s in (table4, first) if s) or note.strip("\n") or rest.split("\n\n## ")[0]
+    return {**paths, "markdown_text": text, "headline": summary + "\n", "planner": planner, "reference": reference,
+            "runs": len(runs), "successes": sum(bool(r["success"]) for r in runs)}
 
 
 def resolve_planner_name(name: str, seen: Sequence[str]) -> str:

@@ -23,7 +23,7 @@ from ..bench.problems import DEFAULT_PROBLEM, get_problem
 from ..signals import interrupts
 from ._common import Parser, count, nonempty, positive_int, seconds, seed
 
-__all__ = ["DESCRIPTION", "EXAMPLE", "add_arguments", "build_parser", "config_from_args", "headline", "list_problems",
+__all__ = ["DESCRIPTION", "EXAMPLE", "add_arguments", "build_parser", "config_from_args", "list_problems",
            "main", "register", "run"]
 
 DESCRIPTION = "Benchmark dimension-RRT against OMPL planners (ompl.tools.Benchmark)."
@@ -322,22 +322,10 @@ def _interrupted(prog: str, where: object) -> int:
     return 130
 
 
-_HEADLINE_SECTIONS = ("## Table 4", "## Anytime comparison: time to the first")
-"""The report's sections printed at the end of a campaign (the rest is in ``report.md``)."""
-
-
-def headline(markdown: str) -> str:
-    """The headline sections of a campaign report (Table 4's ratios, the anytime first-path and within-5 %
-    table), or its first section when it has neither; the success counts and the other tables stay in the file."""
-    sections = [part for part in re.split(r"(?m)^(?=## )", markdown) if part.strip()]
-    picked = [sec for sec in sections if sec.startswith(_HEADLINE_SECTIONS)] or sections[:1]
-    return "\n".join(sec.rstrip("\n") + "\n" for sec in picked)
-
-
 def _print_result(result) -> None:
     """Where the campaign's files are, the report's headline tables and how many runs succeeded."""
-    if result.report.get("markdown_text"):
-        print(headline(result.report["markdown_text"]))
+    if result.report.get("headline"):
+        print(result.report["headline"])
     if "runs" in result.report:
         print(f"runs: {result.report['successes']} of {result.report['runs']} succeeded (per planner and setting in "
               "report.md: success counts, lengths against the best found, anytime costs)")
