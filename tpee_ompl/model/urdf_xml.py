@@ -1,7 +1,11 @@
-"""A URDF or SRDF file read as XML, and a URDF checked as urdfdom reads it, before Pinocchio sees it.
+"""A URDF or SRDF file read as XML the way urdfdom reads it, and a URDF checked as urdfdom reads it, before Pinocchio
+sees it.
 
 urdfdom (Pinocchio's URDF parser) prints a C++ error on stderr for each element it cannot read and then says only
 "not a valid URDF model"; what it would refuse is refused here first, with one line naming the file and element.
+What it reads is read: its XML parser, tinyxml2, knows no namespaces, so neither does this reader (a default
+``xmlns`` on ``<robot>``, as Drake's URDFs have, or an undeclared prefix such as ``<sensor:camera>`` in a
+``<gazebo>`` block are names like any other).
 """
 
 from __future__ import annotations
@@ -9,6 +13,7 @@ from __future__ import annotations
 import math
 import xml.etree.ElementTree as ET
 from pathlib import Path
+from xml.parsers import expat
 
 __all__ = ["finite_numbers", "parse_urdf", "read_robot_xml", "read_text"]
 
@@ -28,12 +33,26 @@ def read_robot_xml(path: Path, kind: str) -> ET.Element:
     if not path.is_file():
         raise FileNotFoundError(f"{kind} file not found: {path}")
     try:
-        root = ET.fromstring(read_text(path, kind))
-    except ET.ParseError as exc:
+        root = _parse_xml(read_text(path, kind))
+    except expat.ExpatError as exc:
         raise ValueError(f"malformed {kind} {path}: {exc}") from exc
     if root.tag != "robot":
         raise ValueError(f"malformed {kind} {path}: root element is <{root.tag}>, expected <robot>")
     return root
+
+
+def _parse_xml(text: str) -> ET.Element:
+    """The element tree of an XML text, namespaces ignored as tinyxml2 ignores them: a prefix stays part of its
+    element's or attribute's name, ``xmlns`` and ``xmlns:x`` are attributes, and an undeclared prefix is no error
+    (expat without a namespace separator, feeding ElementTree's builder); ExpatError when it is not XML."""
+    builder = ET.TreeBuilder()
+    parser = expat.ParserCreate()
+    parser.buffer_text = True
+    parser.StartElementHandler = builder.start
+    parser.EndElementHandler = builder.end
+    parser.CharacterDataHandler = builder.data
+    parser.Parse(text, True)
+    return builder.close()
 
 
 _NUMBERS = {"sphere": ("radius",), "cylinder": ("radius", "length"), "box": ("size",), "origin": ("xyz", "rpy"),
