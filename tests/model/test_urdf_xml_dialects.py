@@ -65,3 +65,46 @@ def test_an_srdf_with_a_default_namespace_or_an_undeclared_prefix_disables_its_p
     for head in ('<robot name="t" xmlns="http://drake.mit.edu">', '<robot name="t"><srdf:note text="x"/>'):
         srdf = _write(tmp_path / "pairs.srdf", f'{head}<disable_collisions link1="a" link2="b" reason="x"/></robot>')
         assert len(RobotChecker(urdf, srdf, n_threads=1).gmodel.collisionPairs) == 0
+
+
+LATIN1_COMMENT = "<!-- Author: J\u00fcrgen M\u00fcller -->\n"
+
+
+def test_a_latin1_urdf_loads_in_its_declared_encoding(tmp_path, capfd, caplog):
+    """A Latin-1 comment (``encoding="ISO-8859-1"`` declared) was refused as "not UTF-8 text"; urdfdom reads the
+    bytes as they are.  A name in Latin-1 is read as the letters it is."""
+    head = '<?xml version="1.0" encoding="ISO-8859-1"?>\n'
+    urdf = _write(tmp_path / "latin1.urdf", (head + LATIN1_COMMENT + ONE_JOINT).encode("latin-1"))
+    with caplog.at_level("WARNING"):
+        _loads_as_urdfdom_reads_it(urdf, capfd)
+    assert "Latin-1" not in caplog.text  # its encoding is declared: nothing to say
+    named = _write(tmp_path / "named.urdf", (head + ONE_JOINT.replace('"a"', '"\u00e4rm"')).encode("latin-1"))
+    assert RobotChecker(named, n_threads=1).model.existFrame("\u00e4rm")
+
+
+def test_a_urdf_neither_utf8_nor_declared_loads_as_latin1_with_one_warning(tmp_path, capfd, caplog):
+    """Without an XML declaration a Latin-1 comment was refused too; it is read as Latin-1, said once per file
+    (the file is read twice per load)."""
+    urdf = _write(tmp_path / "undeclared.urdf", (LATIN1_COMMENT + ONE_JOINT).encode("latin-1"))
+    with caplog.at_level("WARNING"):
+        _loads_as_urdfdom_reads_it(urdf, capfd)
+        RobotChecker(urdf, n_threads=1)
+    assert caplog.text.count("is not UTF-8 and declares no encoding: read as Latin-1") == 1
+
+
+def test_a_utf16_urdf_is_refused_naming_its_encoding(tmp_path):
+    """urdfdom cannot read UTF-16 (it refuses the file, printing tinyxml2's error); the message says why."""
+    urdf = _write(tmp_path / "utf16.urdf", ('<?xml version="1.0" encoding="UTF-16"?>\n' + ONE_JOINT).encode("utf-16"))
+    with pytest.raises(ValueError, match=f"malformed URDF {urdf}: UTF-16 .*save it as UTF-8"):
+        RobotChecker(urdf)
+
+
+def test_the_packaged_models_keep_their_hash():
+    """Reading other encodings changed nothing for UTF-8 files: the wearer's and the Panda's query sets still match."""
+    from tpee_ompl.model.wearer_arm import WearerArm
+
+    assert WearerArm().model_hash == "146e69c3f10a0aac"
+    pytest.importorskip("example_robot_data")
+    from tpee_ompl.model.robots import panda_shelf
+
+    assert panda_shelf(n_threads=1).model_hash == "98dc15b6aa845caa"

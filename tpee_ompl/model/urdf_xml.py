@@ -5,25 +5,53 @@ urdfdom (Pinocchio's URDF parser) prints a C++ error on stderr for each element 
 "not a valid URDF model"; what it would refuse is refused here first, with one line naming the file and element.
 What it reads is read: its XML parser, tinyxml2, knows no namespaces, so neither does this reader (a default
 ``xmlns`` on ``<robot>``, as Drake's URDFs have, or an undeclared prefix such as ``<sensor:camera>`` in a
-``<gazebo>`` block are names like any other).
+``<gazebo>`` block are names like any other), and it reads bytes as they are, so a file that is not UTF-8 is
+decoded as its XML declaration says (Latin-1 without one).
 """
 
 from __future__ import annotations
 
+import codecs
+import logging
 import math
+import re
 import xml.etree.ElementTree as ET
 from pathlib import Path
 from xml.parsers import expat
 
 __all__ = ["finite_numbers", "parse_urdf", "read_robot_xml", "read_text"]
 
+log = logging.getLogger(__name__)
+
+_DECLARED_ENCODING = re.compile(rb"""(?:\xef\xbb\xbf)?<\?xml\s[^>]*?\bencoding\s*=\s*["']([A-Za-z][A-Za-z0-9._-]*)["']""")
+"""The encoding an XML declaration names (``<?xml version="1.0" encoding="ISO-8859-1"?>``)."""
+_WARNED_LATIN1: set[Path] = set()
+"""The files already said to be read as Latin-1 (each is read more than once per load)."""
+
 
 def read_text(path: Path, kind: str) -> str:
-    """The file's text, or ValueError naming it when it is not UTF-8."""
+    """The file's text: UTF-8, else in the encoding its XML declaration names, else Latin-1 (with a warning, once per
+    file).  urdfdom reads the bytes as they are, so a Latin-1 comment (``<!-- Jürgen -->``) loads there; UTF-16, which
+    it cannot read, is refused (ValueError naming the file)."""
     try:
-        return path.read_text(encoding="utf-8")
-    except UnicodeDecodeError as exc:
-        raise ValueError(f"malformed {kind} {path}: not UTF-8 text ({exc})") from exc
+        return path.read_text(encoding="utf-8")  # (the text a UTF-8 file's model hash has always covered)
+    except UnicodeDecodeError:
+        pass
+    data = path.read_bytes()
+    if data.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)) or b"\0" in data:
+        raise ValueError(f"malformed {kind} {path}: UTF-16 (or binary) text, which urdfdom cannot read: save it as UTF-8")
+    declared = _DECLARED_ENCODING.match(data)
+    if declared:
+        try:
+            return path.read_text(encoding=declared.group(1).decode("ascii"))
+        except (LookupError, UnicodeDecodeError):
+            pass
+    if path not in _WARNED_LATIN1:
+        _WARNED_LATIN1.add(path)
+        said = f"declares encoding {declared.group(1).decode('ascii')!r} but is not" if declared else "declares no encoding"
+        log.warning("%s %s is not UTF-8 and %s: read as Latin-1 (urdfdom reads its bytes as they are); save it as "
+                    "UTF-8 to be sure of its names", kind, path, said)
+    return path.read_text(encoding="latin-1")
 
 
 def read_robot_xml(path: Path, kind: str) -> ET.Element:
