@@ -108,3 +108,41 @@ def test_the_packaged_models_keep_their_hash():
     from tpee_ompl.model.robots import panda_shelf
 
     assert panda_shelf(n_threads=1).model_hash == "98dc15b6aa845caa"
+
+
+def _urdfdom_accepts(urdf: Path, capfd) -> bool:
+    """Whether urdfdom (Pinocchio's path reader) builds a model from the file (it may print while refusing)."""
+    try:
+        pin.buildModelFromUrdf(str(urdf))
+        return True
+    except (RuntimeError, ValueError):
+        return False
+    finally:
+        capfd.readouterr()
+
+
+@pytest.mark.parametrize("version", [" 1.0", "1.00", "01.0", "1.01", "+1.2", "1.-0", "1. 1",  # read
+                                     "1.0 ", "1", "1.0.0", "1.3", "0.9", "1.", ".1", "1.1e0", "2.0", "1.-1"])  # refused
+def test_a_urdf_version_is_read_as_urdfdom_reads_it(tmp_path, capfd, version):
+    """" 1.0", "1.00", "01.0" and "1.01" (which urdfdom reads as 1.1) were refused: only the strings "1.0", "1.1" and
+    "1.2" were taken.  urdfdom reads two whole numbers, major.minor; a spelling loads here exactly when it loads
+    there."""
+    urdf = _write(tmp_path / "v.urdf", ONE_JOINT.replace('<robot name="t">', f'<robot name="t" version="{version}">'))
+    if _urdfdom_accepts(urdf, capfd):
+        _loads_as_urdfdom_reads_it(urdf, capfd)
+    else:
+        with pytest.raises(ValueError, match=r"urdfdom reads versions 1\.0, 1\.1 and 1\.2"):
+            RobotChecker(urdf)
+
+
+def test_version_1_02_is_compared_as_1_2(tmp_path, capfd):
+    """The version is compared as numbers wherever it decides something: in 1.2 a revolute joint's <limit> needs no
+    effort or velocity, whether it is spelt "1.2" or "1.02" (which was refused)."""
+    text = ONE_JOINT.replace('effort="1" velocity="1"', "")
+    for version in ("1.2", "1.02"):
+        urdf = _write(tmp_path / "v12.urdf", text.replace('<robot name="t">', f'<robot name="t" version="{version}">'))
+        _loads_as_urdfdom_reads_it(urdf, capfd)
+    urdf = _write(tmp_path / "v11.urdf", text.replace('<robot name="t">', '<robot name="t" version="1.01">'))
+    assert not _urdfdom_accepts(urdf, capfd)  # 1.01 is 1.1, where effort and velocity are needed
+    with pytest.raises(ValueError, match=r"<limit> needs the attribute\(s\) effort, velocity"):
+        RobotChecker(urdf)

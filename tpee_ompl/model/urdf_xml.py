@@ -19,12 +19,14 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 from xml.parsers import expat
 
-__all__ = ["finite_numbers", "parse_urdf", "read_robot_xml", "read_text"]
+__all__ = ["finite_numbers", "parse_urdf", "read_robot_xml", "read_text", "urdf_version"]
 
 log = logging.getLogger(__name__)
 
 _DECLARED_ENCODING = re.compile(rb"""(?:\xef\xbb\xbf)?<\?xml\s[^>]*?\bencoding\s*=\s*["']([A-Za-z][A-Za-z0-9._-]*)["']""")
 """The encoding an XML declaration names (``<?xml version="1.0" encoding="ISO-8859-1"?>``)."""
+_VERSION_PART = re.compile(r"[ \t\n\v\f\r]*[+-]?[0-9]+")
+"""One part of a URDF version as urdfdom reads it (``strtol``, base 10, nothing after the digits)."""
 _WARNED_LATIN1: set[Path] = set()
 """The files already said to be read as Latin-1 (each is read more than once per load)."""
 
@@ -118,7 +120,7 @@ def parse_urdf(urdf: Path) -> ET.Element:
                                      "needs 3 numbers")
     _check_robot(root, urdf)
     links = [_check_link(link, urdf) for link in root.findall("link")]
-    joints = [_check_joint(joint, urdf, root.get("version", "1.0")) for joint in root.findall("joint")]
+    joints = [_check_joint(joint, urdf, urdf_version(root, urdf)) for joint in root.findall("joint")]
     for kind, names in (("link", links), ("joint", joints)):
         twice = next((n for k, n in enumerate(names) if n in names[:k]), None)
         if twice is not None:
@@ -133,13 +135,28 @@ def parse_urdf(urdf: Path) -> ET.Element:
     return root
 
 
+def urdf_version(root: ET.Element, urdf: Path) -> tuple[int, int]:
+    """The ``<robot version>`` as urdfdom reads it, (major, minor) in [(1, 0), (1, 2)]; (1, 0) when there is none.
+
+    urdfdom splits it at dots into exactly two parts and reads each as C's ``strtol`` does, whole: blanks before the
+    digits and a sign are read, anything after them is not (" 1.0", "01.0" and "1.00" are 1.0, "1.01" is 1.1; "1.0 ",
+    "1" and "1.0.0" are refused).  ValueError naming the file otherwise."""
+    text = root.get("version")
+    if text is None:
+        return (1, 0)
+    parts = text.split(".")
+    if len(parts) == 2 and all(_VERSION_PART.fullmatch(p) for p in parts):
+        version = (int(parts[0]), int(parts[1]))
+        if (1, 0) <= version <= (1, 2):
+            return version
+    raise ValueError(f"URDF {urdf}: <robot version=\"{text}\">: urdfdom reads versions 1.0, 1.1 and 1.2 (major.minor)")
+
+
 def _check_robot(root: ET.Element, urdf: Path) -> None:
     """The ``<robot>`` element's name, version, materials and links, as urdfdom requires them."""
     if root.get("name") is None:
         raise ValueError(f"URDF {urdf}: <robot> has no name attribute")
-    version = root.get("version", "1.0")
-    if version not in ("1.0", "1.1", "1.2"):
-        raise ValueError(f"URDF {urdf}: <robot version=\"{version}\">: urdfdom reads versions 1.0, 1.1 and 1.2")
+    urdf_version(root, urdf)
     materials = [m.get("name") for m in root.findall("material") if m.get("name") is not None]
     twice = next((n for k, n in enumerate(materials) if n in materials[:k]), None)
     if twice is not None:
@@ -184,7 +201,7 @@ def _check_link(link: ET.Element, urdf: Path) -> str:
     return name
 
 
-def _check_joint(joint: ET.Element, urdf: Path, version: str) -> str:
+def _check_joint(joint: ET.Element, urdf: Path, version: tuple[int, int]) -> str:
     """A ``<joint>``'s name, type and the elements urdfdom requires of it; returns the name."""
     name = joint.get("name")
     if name is None:
@@ -197,8 +214,8 @@ def _check_joint(joint: ET.Element, urdf: Path, version: str) -> str:
     if limit is None and kind in ("revolute", "prismatic"):
         raise ValueError(f"{where} is {kind} without a <limit>")
     if limit is not None:
-        needed = ["effort", "velocity"] if version != "1.2" else []
-        needed += ["lower", "upper"] if version == "1.2" and kind in ("revolute", "prismatic") else []
+        needed = ["effort", "velocity"] if version < (1, 2) else []
+        needed += ["lower", "upper"] if version >= (1, 2) and kind in ("revolute", "prismatic") else []
         missing = [a for a in needed if limit.get(a) is None]
         if missing:
             raise ValueError(f"{where}: <limit> needs the attribute(s) {', '.join(missing)}")
