@@ -75,3 +75,25 @@ def test_a_collision_mesh_scaled_by_zero_is_refused_naming_the_link_and_the_file
     whole = tmp_path / "whole.urdf"  # the same mesh at its own scale loads
     whole.write_text(ONE_JOINT.replace('<sphere radius="0.05"/>', f'<mesh filename="{tmp_path}/meshes/x.stl"/>'))
     assert RobotChecker(whole).gmodel.ngeoms == 1
+
+
+@pytest.mark.parametrize("old, new", [
+    ('<sphere radius="0.05"/>', '<capsule radius="0.05" length="0.2"/>'),
+    ("<collision>", '<visual><geometry><capsule radius="0.05" length="0.2"/></geometry></visual><collision>'),
+], ids=["collision", "visual"])
+def test_a_capsule_in_a_version_1_0_urdf_is_refused_saying_what_urdfdom_does_with_it(tmp_path, capfd, old, new):
+    """The message said "urdfdom drops <capsule> silently": in a version 1.0 URDF urdfdom fails to parse the element
+    (printing errors) and the link loses all its collision geometry, even for a capsule in a <visual>; from
+    version 1.1 on it reads the capsule."""
+    import pinocchio as pin
+
+    urdf = tmp_path / "capsule.urdf"
+    urdf.write_text(ONE_JOINT.replace(old, new, 1))
+    capfd.readouterr()
+    model = pin.buildModelFromUrdf(str(urdf))
+    assert pin.buildGeomFromUrdf(model, str(urdf), pin.GeometryType.COLLISION).ngeoms == 0
+    assert "Could not parse" in capfd.readouterr().err
+    with pytest.raises(ValueError, match=f"URDF {urdf}: link 'a': <capsule> needs <robot version=\"1.1\"> .*in 1.0 it "
+                                         "fails to parse the <(collision|visual)> and link 'a' loses all its collision "
+                                         "geometry"):
+        RobotChecker(urdf)

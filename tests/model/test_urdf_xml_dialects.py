@@ -5,9 +5,12 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import coal
+import numpy as np
 import pinocchio as pin
 import pytest
 
+from tpee_ompl.model.obstacles import Obstacle
 from tpee_ompl.model.robot_checker import RobotChecker
 
 LINK_A = '<link name="a"><collision><origin xyz="0.3 0 0"/><geometry><sphere radius="0.05"/></geometry></collision></link>'
@@ -146,3 +149,43 @@ def test_version_1_02_is_compared_as_1_2(tmp_path, capfd):
     assert not _urdfdom_accepts(urdf, capfd)  # 1.01 is 1.1, where effort and velocity are needed
     with pytest.raises(ValueError, match=r"<limit> needs the attribute\(s\) effort, velocity"):
         RobotChecker(urdf)
+
+
+CAPSULE = '<capsule radius="0.05" length="0.2"/>'
+
+
+@pytest.mark.parametrize("version, old, new", [
+    ("1.1", '<sphere radius="0.05"/>', CAPSULE),
+    ("1.2", '<sphere radius="0.05"/>', CAPSULE),
+    ("1.1", '<sphere radius="0.05"/>', '<capsule radius="0.05" length="0"/>'),  # a sphere
+    ("1.1", "<collision>", f"<visual><geometry>{CAPSULE}</geometry></visual><collision>"),
+], ids=["1.1-collision", "1.2-collision", "1.1-length-0", "1.1-visual"])
+def test_a_capsule_in_a_version_1_1_urdf_loads_as_a_coal_capsule(tmp_path, capfd, version, old, new):
+    """``<capsule>`` was refused ("urdfdom drops <capsule> silently"); urdfdom 6 reads it from version 1.1 on."""
+    text = ONE_JOINT.replace(old, new, 1).replace('<robot name="t">', f'<robot name="t" version="{version}">')
+    robot = _loads_as_urdfdom_reads_it(_write(tmp_path / "capsule.urdf", text), capfd)
+    if "visual" not in new:
+        (go,) = robot.gmodel.geometryObjects
+        assert type(go.geometry) is coal.Capsule and go.geometry.radius == 0.05
+        assert go.geometry.halfLength == pytest.approx(0.1 if "0.2" in new else 0.0)
+
+
+def test_a_version_1_1_capsule_collides_at_its_end_cap_as_coal_measures_it(tmp_path, capfd):
+    """The capsule's end cap counts: a box 1 cm into the cap (4 cm beyond the end of its cylinder part) collides at
+    the angle where it is, and at every other angle the verdict is Coal's distance against the margin."""
+    text = (f'<robot name="t" version="1.1"><link name="base"/><link name="a"><collision><origin xyz="0.3 0 0"/>'
+            f'<geometry>{CAPSULE}</geometry></collision></link><joint name="j1" type="revolute"><parent link="base"/>'
+            '<child link="a"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>')
+    urdf = _write(tmp_path / "capsule.urdf", text)
+    _urdfdom_loads(urdf, capfd)
+    cap_top = 0.1 + 0.05  # half the length, then the radius
+    for bottom, free in ((cap_top - 0.01, False), (cap_top + 0.04, True)):
+        block = Obstacle("block", "box", (0.04, 0.04, 0.04), (0.3, 0.0, bottom + 0.02))
+        robot = RobotChecker(urdf, obstacles=[block], n_threads=1)
+        assert robot.is_valid(np.zeros(1)) == free
+        for q in np.linspace(-1.0, 1.0, 41):
+            rotation = pin.SE3(pin.utils.rotate("z", q), np.zeros(3))
+            distance = coal.distance(coal.Capsule(0.05, 0.2), coal.Transform3s(rotation * pin.SE3(
+                np.eye(3), np.array([0.3, 0.0, 0.0]))), block.geometry(), coal.Transform3s(block.placement),
+                coal.DistanceRequest(), coal.DistanceResult())
+            assert robot.is_valid(np.array([q])) == (distance > robot.security_margin), q

@@ -1,8 +1,8 @@
 """Reading a URDF and SRDF (the wearer's or any robot's) into Pinocchio and Coal models, refusing what would load wrongly.
 
-urdfdom drops ``<capsule>`` silently and Coal gives wrong answers for zero or non-finite sizes, so
-every ``<collision>`` element must become a geometry, every URDF cylinder becomes a Coal capsule
-(``urdf/README.md``), and the SRDF's disabled pairs must name real links.
+urdfdom reads ``<capsule>`` only in a URDF of version 1.1 or later (in 1.0 the link loses its collision geometry)
+and Coal gives wrong answers for zero or non-finite sizes, so every ``<collision>`` element must become a geometry,
+every URDF cylinder becomes a Coal capsule (``urdf/README.md``), and the SRDF's disabled pairs must name real links.
 """
 
 from __future__ import annotations
@@ -102,7 +102,8 @@ def load_wearer_model(urdf: Path, srdf: Path | None) -> LoadedModel:
     FileNotFoundError
         A missing URDF or SRDF.
     ValueError
-        A malformed file, ``<capsule>``, missing joints or frame, unsupported shapes, bad sizes or limits.
+        A malformed file, ``<capsule>`` in a version 1.0 URDF, missing joints or frame, unsupported shapes, bad sizes
+        or limits.
     """
     root = parse_urdf(urdf)
     joints = {j.get("name"): j.get("type") for j in root.iter("joint")}
@@ -139,7 +140,8 @@ def load_urdf_model(
     and named in :attr:`LoadedModel.continuous`; planners treat that coordinate as an SO2 angle that wraps
     around (:func:`~tpee_ompl.planning.setup.make_space`).  With
     ``cylinders_as_capsules`` (default, the wearer's rule in ``urdf/README.md``) every URDF cylinder
-    becomes a Coal capsule of the same radius and length.  With ``convex_meshes`` every collision mesh of the
+    becomes a Coal capsule of the same radius and length (a ``<capsule>``, which urdfdom reads from
+    ``<robot version="1.1">`` on, is one already).  With ``convex_meshes`` every collision mesh of the
     robot becomes its convex hull (Coal's ``buildConvexHull``): a superset of the mesh, so never a collision
     missed, and much cheaper to check near contact at a positive margin (MoveIt users' convex collision
     meshes).  Obstacles go on the universe joint.

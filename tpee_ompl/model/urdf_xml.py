@@ -85,7 +85,8 @@ def _parse_xml(text: str) -> ET.Element:
     return builder.close()
 
 
-_NUMBERS = {"sphere": ("radius",), "cylinder": ("radius", "length"), "box": ("size",), "origin": ("xyz", "rpy"),
+_NUMBERS = {"sphere": ("radius",), "cylinder": ("radius", "length"), "capsule": ("radius", "length"),
+            "box": ("size",), "origin": ("xyz", "rpy"),
             "axis": ("xyz",), "limit": ("lower", "upper", "effort", "velocity"), "mass": ("value",),
             "inertia": ("ixx", "ixy", "ixz", "iyy", "iyz", "izz"), "mesh": ("scale",),
             "mimic": ("multiplier", "offset"),
@@ -95,19 +96,15 @@ _NUMBERS = {"sphere": ("radius",), "cylinder": ("radius", "length"), "box": ("si
 _VECTORS = {("origin", "xyz"), ("origin", "rpy"), ("axis", "xyz"), ("box", "size"), ("mesh", "scale")}
 """The attributes among them that urdfdom reads as three numbers."""
 _JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
-_SHAPES = {"sphere": ("radius",), "box": ("size",), "cylinder": ("radius", "length"), "mesh": ("filename",)}
-"""urdfdom's shapes (``<capsule>`` is refused before) and their required attributes."""
+_SHAPES = {"sphere": ("radius",), "box": ("size",), "cylinder": ("radius", "length"), "mesh": ("filename",),
+           "capsule": ("radius", "length")}
+"""urdfdom's shapes (``<capsule>`` from ``<robot version="1.1">`` on) and their required attributes."""
 
 
 def parse_urdf(urdf: Path) -> ET.Element:
     """The URDF's ``<robot>`` root, after refusing what urdfdom would refuse or drop (each with a C++ error on
     stderr and no name in Pinocchio's exception) and what it would read wrongly; ValueError naming the element."""
     root = read_robot_xml(urdf, "URDF")
-    # a link's shapes only: <collision> / <capsule> elsewhere (Gazebo sensors, Pinocchio's <collision_checking>)
-    # are not urdfdom's to drop
-    if root.findall("link/collision/geometry/capsule") or root.findall("link/visual/geometry/capsule"):
-        raise ValueError(f"URDF {urdf} uses <capsule>, which urdfdom drops silently; use <cylinder> (loaded as "
-                         "capsules)")
     for owner in (*root.iter("link"), *root.iter("joint")):
         for el in owner.iter():
             for attr in _NUMBERS.get(el.tag, ()):
@@ -118,9 +115,9 @@ def parse_urdf(urdf: Path) -> ET.Element:
                 if text is not None and (el.tag, attr) in _VECTORS and len(text.split()) != 3:
                     raise ValueError(f"URDF {urdf}: {owner.tag} {owner.get('name')!r}: <{el.tag} {attr}=\"{text}\"> "
                                      "needs 3 numbers")
-    _check_robot(root, urdf)
-    links = [_check_link(link, urdf) for link in root.findall("link")]
-    joints = [_check_joint(joint, urdf, urdf_version(root, urdf)) for joint in root.findall("joint")]
+    version = _check_robot(root, urdf)
+    links = [_check_link(link, urdf, version) for link in root.findall("link")]
+    joints = [_check_joint(joint, urdf, version) for joint in root.findall("joint")]
     for kind, names in (("link", links), ("joint", joints)):
         twice = next((n for k, n in enumerate(names) if n in names[:k]), None)
         if twice is not None:
@@ -152,20 +149,21 @@ def urdf_version(root: ET.Element, urdf: Path) -> tuple[int, int]:
     raise ValueError(f"URDF {urdf}: <robot version=\"{text}\">: urdfdom reads versions 1.0, 1.1 and 1.2 (major.minor)")
 
 
-def _check_robot(root: ET.Element, urdf: Path) -> None:
-    """The ``<robot>`` element's name, version, materials and links, as urdfdom requires them."""
+def _check_robot(root: ET.Element, urdf: Path) -> tuple[int, int]:
+    """The ``<robot>`` element's name, version, materials and links, as urdfdom requires them; returns the version."""
     if root.get("name") is None:
         raise ValueError(f"URDF {urdf}: <robot> has no name attribute")
-    urdf_version(root, urdf)
+    version = urdf_version(root, urdf)
     materials = [m.get("name") for m in root.findall("material") if m.get("name") is not None]
     twice = next((n for k, n in enumerate(materials) if n in materials[:k]), None)
     if twice is not None:
         raise ValueError(f"URDF {urdf}: material {twice!r} is defined twice")
     if root.find("link") is None:
         raise ValueError(f"URDF {urdf} has no <link>")
+    return version
 
 
-def _check_link(link: ET.Element, urdf: Path) -> str:
+def _check_link(link: ET.Element, urdf: Path, version: tuple[int, int]) -> str:
     """A ``<link>``'s name, inertial and collision shapes as urdfdom reads them (it drops a collision it cannot read,
     printing an error); returns the name."""
     name = link.get("name")
@@ -180,6 +178,13 @@ def _check_link(link: ET.Element, urdf: Path) -> str:
         missing = [a for a in _NUMBERS["inertia"] if inertia is None or inertia.get(a) is None]
         if missing:
             raise ValueError(f"{where}: <inertial> needs <inertia> with {', '.join(missing)}")
+    for part in (*link.findall("visual"), *link.findall("collision")):
+        geometry = part.find("geometry")
+        if geometry is not None and len(geometry) and geometry[0].tag == "capsule" and version < (1, 1):
+            raise ValueError(f"{where}: <capsule> needs <robot version=\"1.1\"> (or 1.2): urdfdom reads it from version "
+                             f"1.1 on, and in 1.0 it fails to parse the <{part.tag}> and link {name!r} loses all its "
+                             "collision geometry (printing errors); declare version=\"1.1\", or use <cylinder> (loaded "
+                             "as a capsule)")
     for collision in link.findall("collision"):
         geometry = collision.find("geometry")
         shape = None if geometry is None or len(geometry) == 0 else geometry[0]
@@ -191,10 +196,12 @@ def _check_link(link: ET.Element, urdf: Path) -> str:
         if missing:
             raise ValueError(f"{where}: <{shape.tag}> needs the attribute(s) {', '.join(missing)}")
         for attr in _SHAPES[shape.tag]:
-            small = [v for v in shape.get(attr).split() if shape.tag != "mesh" and float(v) <= 0]
+            point = (shape.tag, attr) == ("capsule", "length")  # a capsule of length 0 is a sphere
+            small = [v for v in shape.get(attr).split() if shape.tag != "mesh" and (float(v) < 0 or float(v) == 0
+                                                                                     and not point)]
             if small:
                 raise ValueError(f"{where}: <{shape.tag} {attr}=\"{shape.get(attr)}\"> has a size of {small[0]} "
-                                 "(must be > 0)")
+                                 f"(must be {'>=' if point else '>'} 0)")
         if shape.tag == "mesh" and any(float(v) == 0 for v in shape.get("scale", "1 1 1").split()):
             raise ValueError(f"{where}: <mesh filename=\"{shape.get('filename')}\" scale=\"{shape.get('scale')}\"> "
                              "has a zero scale: the mesh would be flat, with no volume for anything to collide with")
