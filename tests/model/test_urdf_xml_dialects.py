@@ -189,3 +189,42 @@ def test_a_version_1_1_capsule_collides_at_its_end_cap_as_coal_measures_it(tmp_p
                 np.eye(3), np.array([0.3, 0.0, 0.0]))), block.geometry(), coal.Transform3s(block.placement),
                 coal.DistanceRequest(), coal.DistanceResult())
             assert robot.is_valid(np.array([q])) == (distance > robot.security_margin), q
+
+
+@pytest.mark.parametrize("old, new", [
+    ("</robot>", '<ros2_control name="hw" type="system"><joint name="j1"><command_interface name="position">'
+                 '<param name="min">-1</param></command_interface><axis xyz="0 0"/><limit effort="x"/></joint>'
+                 '</ros2_control></robot>'),
+    ("</robot>", '<transmission name="t1"><type>transmission_interface/SimpleTransmission</type><joint name="j1">'
+                 '<hardwareInterface>PositionJointInterface</hardwareInterface><limit effort="x"/></joint>'
+                 '<actuator name="m1"><mechanicalReduction>1</mechanicalReduction></actuator></transmission></robot>'),
+    ("</robot>", '<gazebo><joint name="loop" type="revolute"><parent>a</parent><child>base</child><origin xyz="0 0"/>'
+                 '<axis><xyz>0 0 1</xyz></axis></joint></gazebo></robot>'),
+    ('<origin xyz="0 0 0.1" rpy="0 0 0"/>', '<origin xyz="0 0 0.1" rpy="0 0 0"/><origin xyz="0 0"/>'),
+    ('<axis xyz="0 0 1"/>', '<axis xyz="0 0 1"/><axis xyz="nan 0 0"/>'),
+    ('<limit lower="-1" upper="1" effort="1" velocity="1"/>',
+     '<limit lower="-1" upper="1" effort="1" velocity="1"/><limit effort="-1 x"/>'),
+    ('<geometry><sphere radius="0.05"/>', '<geometry><sphere radius="0.05"/><box size="0 0"/>'),
+    ("</robot>", '<link name="c"/><joint name="jc" type="fixed"><parent link="a"/><child link="c"/>'
+                 '<axis xyz="0 0"/></joint></robot>'),
+], ids=["ros2_control-joint", "transmission-joint", "gazebo-sdf-joint", "second-origin", "second-axis", "second-limit",
+        "second-shape", "fixed-joint-axis"])
+def test_numbers_urdfdom_never_reads_are_not_checked(tmp_path, capfd, old, new):
+    """The number checks went through every <joint> (a <transmission>'s, a <ros2_control>'s, an SDF joint in a
+    <gazebo> block) and every <origin> or <axis> of an element, and refused files urdfdom loads: it reads the robot's
+    own links and joints, the first <origin>, <axis>, <limit>, shape of each, and no axis of a fixed joint."""
+    urdf = _write(tmp_path / "unread.urdf", ONE_JOINT.replace(old, new, 1))
+    _loads_as_urdfdom_reads_it(urdf, capfd)
+
+
+def test_a_wearer_urdf_with_transmissions_is_loaded_as_the_wearer(tmp_path):
+    """A <transmission>'s ``<joint name="j1">`` (no type) was taken for the arm's joint: "lacks revolute joint 'j1'"."""
+    from tpee_ompl.model.wearer_arm import WearerArm
+    from tpee_ompl.resources import model_file
+
+    text = model_file("wearer_arm.urdf").read_text(encoding="utf-8")
+    transmissions = "".join(f'<transmission name="t_{j}"><type>transmission_interface/SimpleTransmission</type>'
+                            f'<joint name="{j}"><hardwareInterface>EffortJointInterface</hardwareInterface></joint>'
+                            f'<actuator name="m_{j}"/></transmission>' for j in ("j1", "j2", "j3", "j4"))
+    urdf = _write(tmp_path / "wearer.urdf", text.replace("</robot>", transmissions + "</robot>"))
+    assert WearerArm(urdf).model.names[1:].tolist() == ["j1", "j2", "j3", "j4"]

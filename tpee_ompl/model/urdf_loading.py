@@ -106,14 +106,14 @@ def load_wearer_model(urdf: Path, srdf: Path | None) -> LoadedModel:
         or limits.
     """
     root = parse_urdf(urdf)
-    joints = {j.get("name"): j.get("type") for j in root.iter("joint")}
+    joints = {j.get("name"): j.get("type") for j in root.findall("joint")}  # (not a <transmission>'s)
     for name in ARM_JOINTS:
         if joints.get(name) != "revolute":
             raise ValueError(f"URDF {urdf} lacks revolute joint {name!r} (found: {sorted(k for k in joints if k)}): a "
                              f"wearer arm has the revolute joints {list(ARM_JOINTS)} and the link {MUZZLE_FRAME!r}; "
                              "another robot is planned with RobotChecker(urdf, srdf) and make_simple_setup, or "
                              "benchmarked as a problem (tpee-ompl bench --list-problems)")
-    if MUZZLE_FRAME not in {link.get("name") for link in root.iter("link")}:
+    if MUZZLE_FRAME not in {link.get("name") for link in root.findall("link")}:
         raise ValueError(f"URDF {urdf} lacks the {MUZZLE_FRAME!r} link")
     loaded = load_urdf_model(urdf, srdf)
     if tuple(loaded.model.names[1:]) != ARM_JOINTS:

@@ -16,6 +16,7 @@ import logging
 import math
 import re
 import xml.etree.ElementTree as ET
+from collections.abc import Iterator
 from pathlib import Path
 from xml.parsers import expat
 
@@ -93,8 +94,8 @@ _NUMBERS = {"sphere": ("radius",), "cylinder": ("radius", "length"), "capsule": 
             "safety_controller": ("soft_lower_limit", "soft_upper_limit", "k_position", "k_velocity"),
             "calibration": ("rising", "falling"), "dynamics": ("damping", "friction")}
 """Numeric attributes of URDF elements, checked before urdfdom reads them (it prints a C++ error per bad one)."""
-_VECTORS = {("origin", "xyz"), ("origin", "rpy"), ("axis", "xyz"), ("box", "size"), ("mesh", "scale")}
-"""The attributes among them that urdfdom reads as three numbers."""
+_VECTORS = {("origin", "xyz"): 3, ("origin", "rpy"): 3, ("axis", "xyz"): 3, ("box", "size"): 3, ("mesh", "scale"): 3}
+"""The attributes among them that urdfdom reads as a vector, and its length (the others are one number)."""
 _JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
 _SHAPES = {"sphere": ("radius",), "box": ("size",), "cylinder": ("radius", "length"), "mesh": ("filename",),
            "capsule": ("radius", "length")}
@@ -105,16 +106,13 @@ def parse_urdf(urdf: Path) -> ET.Element:
     """The URDF's ``<robot>`` root, after refusing what urdfdom would refuse or drop (each with a C++ error on
     stderr and no name in Pinocchio's exception) and what it would read wrongly; ValueError naming the element."""
     root = read_robot_xml(urdf, "URDF")
-    for owner in (*root.iter("link"), *root.iter("joint")):
-        for el in owner.iter():
-            for attr in _NUMBERS.get(el.tag, ()):
-                text = el.get(attr)
-                if text is not None and not finite_numbers(text):
-                    raise ValueError(f"URDF {urdf}: {owner.tag} {owner.get('name')!r}: <{el.tag} {attr}=\"{text}\"> "
-                                     "is not a list of finite numbers")
-                if text is not None and (el.tag, attr) in _VECTORS and len(text.split()) != 3:
-                    raise ValueError(f"URDF {urdf}: {owner.tag} {owner.get('name')!r}: <{el.tag} {attr}=\"{text}\"> "
-                                     "needs 3 numbers")
+    for owner, el in _read_by_urdfdom(root):
+        for attr in _NUMBERS.get(el.tag, ()):
+            text = el.get(attr)
+            problem = None if text is None else _number_problem(text, _VECTORS.get((el.tag, attr), 1))
+            if problem:
+                raise ValueError(f"URDF {urdf}: {owner.tag} {owner.get('name')!r}: <{el.tag} {attr}=\"{text}\"> "
+                                 f"{problem}")
     version = _check_robot(root, urdf)
     links = [_check_link(link, urdf, version) for link in root.findall("link")]
     joints = [_check_joint(joint, urdf, version) for joint in root.findall("joint")]
@@ -122,7 +120,7 @@ def parse_urdf(urdf: Path) -> ET.Element:
         twice = next((n for k, n in enumerate(names) if n in names[:k]), None)
         if twice is not None:
             raise ValueError(f"URDF {urdf}: {kind} {twice!r} appears twice")
-    for joint in root.iter("joint"):
+    for joint in root.findall("joint"):
         axis = joint.find("axis")
         if joint.get("type") in ("revolute", "prismatic", "continuous") and axis is not None \
                 and not any(float(v) for v in axis.get("xyz", "1 0 0").split()):
@@ -130,6 +128,38 @@ def parse_urdf(urdf: Path) -> ET.Element:
                              "axis moves nothing (a revolute joint would scale its child instead of turning it)")
     _check_tree(root, set(links), urdf)
     return root
+
+
+def _read_by_urdfdom(root: ET.Element) -> Iterator[tuple[ET.Element, ET.Element]]:
+    """(link or joint, element) for each element whose numbers urdfdom reads: only the ``<robot>``'s own links and
+    joints (not the ``<joint>`` of a ``<transmission>``, ``<gazebo>`` or ``<ros2_control>`` block), and of each
+    element the first where urdfdom takes the first (its ``FirstChildElement``): one ``<origin>``, one ``<axis>``
+    (not of a fixed or floating joint), one ``<limit>``, one ``<inertial>``, one shape per ``<geometry>``..."""
+    for link in root.findall("link"):
+        inertial = link.find("inertial")
+        found = [] if inertial is None else [inertial.find(tag) for tag in ("origin", "mass", "inertia")]
+        for part in (*link.findall("visual"), *link.findall("collision")):
+            found += [part.find("origin"), _shape(part)]
+        yield from ((link, el) for el in found if el is not None)
+    for joint in root.findall("joint"):
+        tags = ["origin", "limit", "safety_controller", "calibration", "mimic", "dynamics"]
+        tags += ["axis"] if joint.get("type") not in ("fixed", "floating") else []
+        yield from ((joint, el) for el in map(joint.find, tags) if el is not None)
+
+
+def _shape(part: ET.Element) -> ET.Element | None:
+    """The shape urdfdom reads in a ``<visual>`` or ``<collision>``: the first element in its first ``<geometry>``."""
+    geometry = part.find("geometry")
+    return None if geometry is None or len(geometry) == 0 else geometry[0]
+
+
+def _number_problem(text: str, count: int) -> str | None:
+    """What is wrong with an attribute urdfdom reads as ``count`` numbers (for a message), or None."""
+    if not finite_numbers(text):
+        return "is not a list of finite numbers"
+    if count > 1 and len(text.split()) != count:
+        return f"needs {count} numbers"
+    return None
 
 
 def urdf_version(root: ET.Element, urdf: Path) -> tuple[int, int]:
@@ -179,15 +209,13 @@ def _check_link(link: ET.Element, urdf: Path, version: tuple[int, int]) -> str:
         if missing:
             raise ValueError(f"{where}: <inertial> needs <inertia> with {', '.join(missing)}")
     for part in (*link.findall("visual"), *link.findall("collision")):
-        geometry = part.find("geometry")
-        if geometry is not None and len(geometry) and geometry[0].tag == "capsule" and version < (1, 1):
+        if getattr(_shape(part), "tag", None) == "capsule" and version < (1, 1):
             raise ValueError(f"{where}: <capsule> needs <robot version=\"1.1\"> (or 1.2): urdfdom reads it from version "
                              f"1.1 on, and in 1.0 it fails to parse the <{part.tag}> and link {name!r} loses all its "
                              "collision geometry (printing errors); declare version=\"1.1\", or use <cylinder> (loaded "
                              "as a capsule)")
     for collision in link.findall("collision"):
-        geometry = collision.find("geometry")
-        shape = None if geometry is None or len(geometry) == 0 else geometry[0]
+        shape = _shape(collision)
         if shape is None:
             raise ValueError(f"{where}: a <collision> has no <geometry> shape")
         if shape.tag not in _SHAPES:
