@@ -97,3 +97,41 @@ def test_a_capsule_in_a_version_1_0_urdf_is_refused_saying_what_urdfdom_does_wit
                                          "fails to parse the <(collision|visual)> and link 'a' loses all its collision "
                                          "geometry"):
         RobotChecker(urdf)
+
+
+@pytest.mark.parametrize("old, new, match", [
+    ('effort="1"', 'effort="1 2"', "joint 'j1': <limit effort=\"1 2\"> needs 1 number"),
+    ('lower="-1"', 'lower="-1 -2"', "joint 'j1': <limit lower=\"-1 -2\"> needs 1 number"),
+    ('effort="1"', 'effort="1 "', "joint 'j1': <limit effort=\"1 \"> has a blank after its number"),
+    ('<sphere radius="0.05"/>', '<sphere radius="0.05 0.06"/>', "link 'a': <sphere radius=\"0.05 0.06\"> needs 1"),
+    ('<sphere radius="0.05"/>', '<sphere radius="0.05 "/>', "link 'a': <sphere radius=\"0.05 \"> has a blank after"),
+    ('<sphere radius="0.05"/>', '<sphere radius="0.0_5"/>', "link 'a': <sphere radius=\"0.0_5\"> is not a list of"),
+    ('<sphere radius="0.05"/>', '<sphere radius="0x1"/>', "link 'a': <sphere radius=\"0x1\"> is not a list of"),
+    ('<link name="a">', '<link name="a"><inertial><mass value="1 "/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" '
+                        'izz="1"/></inertial>', "link 'a': <mass value=\"1 \"> has a blank after its number"),
+    ("</joint>", '<mimic joint="j0" multiplier="1 2"/></joint>', "joint 'j1': <mimic multiplier=\"1 2\"> needs 1"),
+    ("</joint>", '<calibration rising="0 1"/></joint>', "joint 'j1': <calibration rising=\"0 1\"> needs 1 number"),
+    ("</joint>", '<safety_controller k_velocity="infinity"/></joint>', "joint 'j1': <safety_controller k_velocity=\"infinity\"> is not a list"),
+    ('<axis xyz="0 0 1"/>', '<axis xyz="0&#9;0&#9;1"/>', "joint 'j1': <axis xyz=\"0\t0\t1\"> separates numbers with a "
+                                                       "tab or line break"),
+])
+def test_a_number_urdfdom_cannot_read_is_named_with_its_file_element_and_attribute(tmp_path, capfd, old, new, match):
+    """``effort="1 2"`` raised a bare "could not convert string to float: '1 2'" (no file, no element), and "1 ",
+    "0.0_5" or a radius of two numbers passed (Python's float reads them) until urdfdom refused the file or dropped
+    the link's collision geometry, printing C++ errors: urdfdom reads one number whole (blanks before it, nothing
+    after) and a vector split at spaces."""
+    import pinocchio as pin
+
+    assert old in ONE_JOINT
+    urdf = tmp_path / "bad.urdf"
+    urdf.write_text(ONE_JOINT.replace(old, new, 1))
+    capfd.readouterr()
+    try:  # urdfdom refuses the file, or drops the link's collision geometry, printing why
+        model = pin.buildModelFromUrdf(str(urdf))
+        assert pin.buildGeomFromUrdf(model, str(urdf), pin.GeometryType.COLLISION).ngeoms == 0
+    except ValueError:
+        pass
+    assert "Error" in capfd.readouterr().err
+    with pytest.raises(ValueError, match=f"URDF {urdf}: {match}") as info:
+        RobotChecker(urdf)
+    assert "\n" not in str(info.value) and capfd.readouterr().err == ""

@@ -228,3 +228,11 @@ def test_a_wearer_urdf_with_transmissions_is_loaded_as_the_wearer(tmp_path):
                             f'<actuator name="m_{j}"/></transmission>' for j in ("j1", "j2", "j3", "j4"))
     urdf = _write(tmp_path / "wearer.urdf", text.replace("</robot>", transmissions + "</robot>"))
     assert WearerArm(urdf).model.names[1:].tolist() == ["j1", "j2", "j3", "j4"]
+
+
+@pytest.mark.parametrize("number", [" 1", "+1", "1.", ".5", "1E+0", "1e-400", "0001", " \t1"])
+def test_numbers_urdfdom_reads_are_read(tmp_path, capfd, number):
+    """Every spelling urdfdom reads as a number (a C++ stream: blanks before it, a sign, no digits after the point,
+    an exponent) loads, in a scalar and in a vector."""
+    text = ONE_JOINT.replace('effort="1"', f'effort="{number}"').replace('xyz="0 0 0.1"', f'xyz="0 {number} 0.1"')
+    _loads_as_urdfdom_reads_it(_write(tmp_path / "number.urdf", text), capfd)

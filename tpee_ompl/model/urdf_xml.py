@@ -28,6 +28,9 @@ _DECLARED_ENCODING = re.compile(rb"""(?:\xef\xbb\xbf)?<\?xml\s[^>]*?\bencoding\s
 """The encoding an XML declaration names (``<?xml version="1.0" encoding="ISO-8859-1"?>``)."""
 _VERSION_PART = re.compile(r"[ \t\n\v\f\r]*[+-]?[0-9]+")
 """One part of a URDF version as urdfdom reads it (``strtol``, base 10, nothing after the digits)."""
+_NUMBER = re.compile(r"[ \t\n\v\f\r]*[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
+"""One number as urdfdom's ``strToDouble`` reads it: a C++ stream in the classic locale, blanks before the number and
+nothing after it."""
 _WARNED_LATIN1: set[Path] = set()
 """The files already said to be read as Latin-1 (each is read more than once per load)."""
 
@@ -154,10 +157,20 @@ def _shape(part: ET.Element) -> ET.Element | None:
 
 
 def _number_problem(text: str, count: int) -> str | None:
-    """What is wrong with an attribute urdfdom reads as ``count`` numbers (for a message), or None."""
+    """What is wrong with an attribute urdfdom reads as ``count`` numbers (for a message), or None.
+
+    One number is read whole by ``strToDouble`` (blanks before it, nothing after: "1 2" and "1 " are refused); a
+    vector is split at spaces, and each piece read so (a tab or line break between two numbers is not a space)."""
     if not finite_numbers(text):
         return "is not a list of finite numbers"
-    if count > 1 and len(text.split()) != count:
+    if count == 1 and len(text.split()) > 1:
+        return "needs 1 number"
+    if count == 1 and text != text.rstrip():
+        return "has a blank after its number, which urdfdom does not read as a number"
+    pieces = [p for p in text.split(" ") if p]
+    if count > 1 and not all(_NUMBER.fullmatch(p) for p in pieces):
+        return "separates numbers with a tab or line break: urdfdom splits a vector at spaces only"
+    if count > 1 and len(pieces) != count:
         return f"needs {count} numbers"
     return None
 
@@ -296,9 +309,7 @@ def _check_tree(root: ET.Element, links: set[str], urdf: Path) -> None:
 
 
 def finite_numbers(text: str) -> bool:
-    """Whether ``text`` is one or more whitespace-separated finite numbers."""
-    try:
-        values = [float(v) for v in text.split()]
-    except ValueError:
-        return False
-    return bool(values) and all(math.isfinite(v) for v in values)
+    """Whether ``text`` is one or more whitespace-separated finite numbers, each as urdfdom reads one (C++'s
+    ``operator>>``: "1e5", ".5", "+1." are numbers; "inf", "nan", "1_0", "0x10" and "1,5" are not)."""
+    words = text.split()
+    return bool(words) and all(_NUMBER.fullmatch(w) and math.isfinite(float(w)) for w in words)
