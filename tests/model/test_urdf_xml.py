@@ -135,3 +135,27 @@ def test_a_number_urdfdom_cannot_read_is_named_with_its_file_element_and_attribu
     with pytest.raises(ValueError, match=f"URDF {urdf}: {match}") as info:
         RobotChecker(urdf)
     assert "\n" not in str(info.value) and capfd.readouterr().err == ""
+
+
+@pytest.mark.parametrize("visual, match", [
+    ('<visual><origin xyz="0 0 0"/></visual>', "a <visual> has no <geometry> shape"),
+    ('<visual><geometry><cone radius="1"/></geometry></visual>', "<visual> shape <cone> is none of urdfdom's"),
+    ("<visual><geometry><sphere/></geometry></visual>", r"<sphere> needs the attribute\(s\) radius"),
+    ('<visual><geometry><box size="0.1 0.1 0.1"/></geometry><material><color rgba="1 0 0 1"/></material></visual>',
+     "a <visual>'s <material> has no name"),
+])
+def test_a_visual_urdfdom_cannot_read_is_refused_before_the_link_loses_its_collision_geometry(tmp_path, capfd, visual,
+                                                                                              match):
+    """A malformed <visual> passed: urdfdom then dropped all of its link's collision geometry, printing C++ errors,
+    and the error said only that "1 <collision> elements but only 0 geometries were loaded (unsupported shape?)"."""
+    import pinocchio as pin
+
+    urdf = tmp_path / "visual.urdf"
+    urdf.write_text(ONE_JOINT.replace("<collision>", visual + "<collision>", 1))
+    capfd.readouterr()
+    model = pin.buildModelFromUrdf(str(urdf))
+    assert pin.buildGeomFromUrdf(model, str(urdf), pin.GeometryType.COLLISION).ngeoms == 0
+    assert "Could not parse visual element for Link [a]" in capfd.readouterr().err
+    with pytest.raises(ValueError, match=f"URDF {urdf}: link 'a': {match}.*link 'a' loses all its collision geometry"):
+        RobotChecker(urdf)
+    assert capfd.readouterr().err == ""

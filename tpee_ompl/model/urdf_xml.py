@@ -207,8 +207,8 @@ def _check_robot(root: ET.Element, urdf: Path) -> tuple[int, int]:
 
 
 def _check_link(link: ET.Element, urdf: Path, version: tuple[int, int]) -> str:
-    """A ``<link>``'s name, inertial and collision shapes as urdfdom reads them (it drops a collision it cannot read,
-    printing an error); returns the name."""
+    """A ``<link>``'s name, inertial, visual and collision shapes as urdfdom reads them (a ``<visual>`` or
+    ``<collision>`` it cannot read loses the link all its collision geometry, printing errors); returns the name."""
     name = link.get("name")
     if name is None:
         raise ValueError(f"URDF {urdf}: a <link> has no name attribute")
@@ -222,31 +222,41 @@ def _check_link(link: ET.Element, urdf: Path, version: tuple[int, int]) -> str:
         if missing:
             raise ValueError(f"{where}: <inertial> needs <inertia> with {', '.join(missing)}")
     for part in (*link.findall("visual"), *link.findall("collision")):
-        if getattr(_shape(part), "tag", None) == "capsule" and version < (1, 1):
+        lost = f" (urdfdom fails to parse the <{part.tag}>, and link {name!r} loses all its collision geometry)"
+        shape = _shape(part)
+        if shape is None:
+            raise ValueError(f"{where}: a <{part.tag}> has no <geometry> shape{lost}")
+        if shape.tag == "capsule" and version < (1, 1):
             raise ValueError(f"{where}: <capsule> needs <robot version=\"1.1\"> (or 1.2): urdfdom reads it from version "
                              f"1.1 on, and in 1.0 it fails to parse the <{part.tag}> and link {name!r} loses all its "
                              "collision geometry (printing errors); declare version=\"1.1\", or use <cylinder> (loaded "
                              "as a capsule)")
-    for collision in link.findall("collision"):
-        shape = _shape(collision)
-        if shape is None:
-            raise ValueError(f"{where}: a <collision> has no <geometry> shape")
         if shape.tag not in _SHAPES:
-            raise ValueError(f"{where}: <collision> shape <{shape.tag}> is none of urdfdom's {', '.join(_SHAPES)}")
+            raise ValueError(f"{where}: <{part.tag}> shape <{shape.tag}> is none of urdfdom's {', '.join(_SHAPES)}{lost}")
         missing = [a for a in _SHAPES[shape.tag] if shape.get(a) is None]
         if missing:
-            raise ValueError(f"{where}: <{shape.tag}> needs the attribute(s) {', '.join(missing)}")
-        for attr in _SHAPES[shape.tag]:
-            point = (shape.tag, attr) == ("capsule", "length")  # a capsule of length 0 is a sphere
-            small = [v for v in shape.get(attr).split() if shape.tag != "mesh" and (float(v) < 0 or float(v) == 0
-                                                                                     and not point)]
-            if small:
-                raise ValueError(f"{where}: <{shape.tag} {attr}=\"{shape.get(attr)}\"> has a size of {small[0]} "
-                                 f"(must be {'>=' if point else '>'} 0)")
-        if shape.tag == "mesh" and any(float(v) == 0 for v in shape.get("scale", "1 1 1").split()):
-            raise ValueError(f"{where}: <mesh filename=\"{shape.get('filename')}\" scale=\"{shape.get('scale')}\"> "
-                             "has a zero scale: the mesh would be flat, with no volume for anything to collide with")
+            raise ValueError(f"{where}: <{shape.tag}> needs the attribute(s) {', '.join(missing)}{lost}")
+        material = part.find("material")
+        if part.tag == "visual" and material is not None and material.get("name") is None:
+            raise ValueError(f"{where}: a <visual>'s <material> has no name{lost}")
+        if part.tag == "collision":
+            _check_sizes(shape, where)
     return name
+
+
+def _check_sizes(shape: ET.Element, where: str) -> None:
+    """A collision shape's sizes: > 0 (a capsule's length >= 0: a sphere), a mesh's scale not 0 (Coal would give
+    wrong answers, or nothing would collide with a flat mesh)."""
+    for attr in _SHAPES[shape.tag]:
+        point = (shape.tag, attr) == ("capsule", "length")
+        small = [v for v in shape.get(attr).split() if shape.tag != "mesh" and (float(v) < 0 or float(v) == 0
+                                                                                 and not point)]
+        if small:
+            raise ValueError(f"{where}: <{shape.tag} {attr}=\"{shape.get(attr)}\"> has a size of {small[0]} "
+                             f"(must be {'>=' if point else '>'} 0)")
+    if shape.tag == "mesh" and any(float(v) == 0 for v in shape.get("scale", "1 1 1").split()):
+        raise ValueError(f"{where}: <mesh filename=\"{shape.get('filename')}\" scale=\"{shape.get('scale')}\"> "
+                         "has a zero scale: the mesh would be flat, with no volume for anything to collide with")
 
 
 def _check_joint(joint: ET.Element, urdf: Path, version: tuple[int, int]) -> str:
