@@ -236,3 +236,19 @@ def test_numbers_urdfdom_reads_are_read(tmp_path, capfd, number):
     an exponent) loads, in a scalar and in a vector."""
     text = ONE_JOINT.replace('effort="1"', f'effort="{number}"').replace('xyz="0 0 0.1"', f'xyz="0 {number} 0.1"')
     _loads_as_urdfdom_reads_it(_write(tmp_path / "number.urdf", text), capfd)
+
+
+@pytest.mark.parametrize("edits", [
+    [('xyz="0 0 0.1"', 'xyz="0 \t0 0.1"')],  # a tab after a space: blanks before a number
+    [('xyz="0 0 0.1"', 'xyz="\n0 0 0.1"')],  # ("\n  0" has a piece that is only a line break: refused)
+    [('effort="1"', 'effort="\n1"')],
+    [('<link name="a">', '<link name="a\tb">'), ('<child link="a"/>', '<child link="a\tb"/>')],
+], ids=["tab-before-number", "line-break-first", "scalar-line-break-first", "tab-in-name"])
+def test_tabs_and_line_breaks_urdfdom_reads_are_read(tmp_path, capfd, edits):
+    """Reading attributes as tinyxml2 gets them (tabs and line breaks kept) refuses only what urdfdom refuses, and
+    names are the ones Pinocchio gets."""
+    text = ONE_JOINT
+    for old, new in edits:
+        text = text.replace(old, new, 1)
+    robot = _loads_as_urdfdom_reads_it(_write(tmp_path / "blanks.urdf", text), capfd)
+    assert robot.model.existFrame("a\tb") == (len(edits) == 2)

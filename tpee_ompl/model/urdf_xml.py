@@ -76,17 +76,45 @@ def read_robot_xml(path: Path, kind: str) -> ET.Element:
 
 
 def _parse_xml(text: str) -> ET.Element:
-    """The element tree of an XML text, namespaces ignored as tinyxml2 ignores them: a prefix stays part of its
-    element's or attribute's name, ``xmlns`` and ``xmlns:x`` are attributes, and an undeclared prefix is no error
-    (expat without a namespace separator, feeding ElementTree's builder); ExpatError when it is not XML."""
+    """The element tree of an XML text as tinyxml2 (urdfdom's parser) reads it; ExpatError when it is not XML.
+
+    Namespaces are ignored: a prefix stays part of its element's or attribute's name, ``xmlns`` and ``xmlns:x`` are
+    attributes, and an undeclared prefix is no error (expat without a namespace separator, feeding ElementTree's
+    builder).  Attribute values are tinyxml2's too: a tab or line break in one stays (XML parsers make it a space),
+    and a DOCTYPE's entity stays unexpanded (``radius="&r;"``), as urdfdom gets them."""
+    data = text.encode("utf-8")
     builder = ET.TreeBuilder()
-    parser = expat.ParserCreate()
+    parser = expat.ParserCreate("utf-8")  # (over an XML declaration's encoding: the text is decoded already)
     parser.buffer_text = True
-    parser.StartElementHandler = builder.start
+
+    def start(tag: str, attrs: dict[str, str]) -> None:
+        raw = _START_TAG.match(data, parser.CurrentByteIndex) if attrs else None
+        if raw is not None and any(c in raw.group(1) for c in (b"\t", b"\n", b"\r", b"&")):
+            for name, quoted in _ATTRIBUTE.findall(raw.group(1)):
+                name = name.decode("utf-8")
+                if name in attrs:  # (not one a DTD adds)
+                    attrs[name] = _ENTITY.sub(_entity, quoted[1:-1].decode("utf-8").replace("\r\n", "\n"))
+        builder.start(tag, attrs)
+
+    parser.StartElementHandler = start
     parser.EndElementHandler = builder.end
     parser.CharacterDataHandler = builder.data
-    parser.Parse(text, True)
+    parser.Parse(data, True)
     return builder.close()
+
+
+_START_TAG = re.compile(rb"""<[^\s/>]+((?:\s+[^\s=/>]+\s*=\s*(?:"[^"]*"|'[^']*'))*)\s*/?>""")
+"""A start tag as written; group 1: its attributes."""
+_ATTRIBUTE = re.compile(rb"""([^\s=/>]+)\s*=\s*("[^"]*"|'[^']*')""")
+_ENTITY = re.compile(r"&(#x[0-9A-Fa-f]+|#[0-9]+|lt|gt|amp|quot|apos);")
+"""The references tinyxml2 replaces in an attribute: characters and XML's five entities (none a DOCTYPE declares)."""
+
+
+def _entity(ref: re.Match[str]) -> str:
+    name = ref.group(1)
+    if name.startswith("#"):
+        return chr(int(name[2:], 16) if name[1] == "x" else int(name[1:]))
+    return {"lt": "<", "gt": ">", "amp": "&", "quot": '"', "apos": "'"}[name]
 
 
 _NUMBERS = {"sphere": ("radius",), "cylinder": ("radius", "length"), "capsule": ("radius", "length"),
@@ -114,7 +142,8 @@ def parse_urdf(urdf: Path) -> ET.Element:
             text = el.get(attr)
             problem = None if text is None else _number_problem(text, _VECTORS.get((el.tag, attr), 1))
             if problem:
-                raise ValueError(f"URDF {urdf}: {owner.tag} {owner.get('name')!r}: <{el.tag} {attr}=\"{text}\"> "
+                shown = text.translate({9: "\\t", 10: "\\n", 13: "\\r"})  # (one line)
+                raise ValueError(f"URDF {urdf}: {owner.tag} {owner.get('name')!r}: <{el.tag} {attr}=\"{shown}\"> "
                                  f"{problem}")
     version = _check_robot(root, urdf)
     links = [_check_link(link, urdf, version) for link in root.findall("link")]
@@ -169,7 +198,7 @@ def _number_problem(text: str, count: int) -> str | None:
         return "has a blank after its number, which urdfdom does not read as a number"
     pieces = [p for p in text.split(" ") if p]
     if count > 1 and not all(_NUMBER.fullmatch(p) for p in pieces):
-        return "separates numbers with a tab or line break: urdfdom splits a vector at spaces only"
+        return "has a tab or line break between or after its numbers: urdfdom splits a vector at spaces only"
     if count > 1 and len(pieces) != count:
         return f"needs {count} numbers"
     return None
