@@ -252,3 +252,15 @@ def test_tabs_and_line_breaks_urdfdom_reads_are_read(tmp_path, capfd, edits):
         text = text.replace(old, new, 1)
     robot = _loads_as_urdfdom_reads_it(_write(tmp_path / "blanks.urdf", text), capfd)
     assert robot.model.existFrame("a\tb") == (len(edits) == 2)
+
+
+def test_a_version_1_1_quaternion_turns_the_joint_and_is_ignored_in_1_0(tmp_path, capfd):
+    """urdfdom reads quat_xyzw from version 1.1 on (x, y, z, w: here a quarter turn about z) and ignores it in 1.0,
+    where a malformed one is no error."""
+    origin = '<origin xyz="0 0 0.1" rpy="0 0 0"/>'
+    for version, quaternion, turned in (("1.1", "0 0 0.7071068 0.7071068", True), ("1.0", "x", False)):
+        text = ONE_JOINT.replace('<robot name="t">', f'<robot name="t" version="{version}">').replace(
+            origin, f'<origin xyz="0 0 0.1" quat_xyzw="{quaternion}"/>')
+        robot = _loads_as_urdfdom_reads_it(_write(tmp_path / f"q{version}.urdf", text), capfd)
+        expected = pin.utils.rotate("z", np.pi / 2) if turned else np.eye(3)
+        assert np.allclose(robot.model.jointPlacements[1].rotation, expected, atol=1e-6)

@@ -125,7 +125,8 @@ _NUMBERS = {"sphere": ("radius",), "cylinder": ("radius", "length"), "capsule": 
             "safety_controller": ("soft_lower_limit", "soft_upper_limit", "k_position", "k_velocity"),
             "calibration": ("rising", "falling"), "dynamics": ("damping", "friction")}
 """Numeric attributes of URDF elements, checked before urdfdom reads them (it prints a C++ error per bad one)."""
-_VECTORS = {("origin", "xyz"): 3, ("origin", "rpy"): 3, ("axis", "xyz"): 3, ("box", "size"): 3, ("mesh", "scale"): 3}
+_VECTORS = {("origin", "xyz"): 3, ("origin", "rpy"): 3, ("origin", "quat_xyzw"): 4, ("axis", "xyz"): 3,
+            ("box", "size"): 3, ("mesh", "scale"): 3}
 """The attributes among them that urdfdom reads as a vector, and its length (the others are one number)."""
 _JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
 _SHAPES = {"sphere": ("radius",), "box": ("size",), "cylinder": ("radius", "length"), "mesh": ("filename",),
@@ -137,15 +138,22 @@ def parse_urdf(urdf: Path) -> ET.Element:
     """The URDF's ``<robot>`` root, after refusing what urdfdom would refuse or drop (each with a C++ error on
     stderr and no name in Pinocchio's exception) and what it would read wrongly; ValueError naming the element."""
     root = read_robot_xml(urdf, "URDF")
+    version = _check_robot(root, urdf)
+    quaternion = ("quat_xyzw",) if version >= (1, 1) else ()  # (urdfdom ignores it in 1.0)
     for owner, el in _read_by_urdfdom(root):
-        for attr in _NUMBERS.get(el.tag, ()):
+        where = f"URDF {urdf}: {owner.tag} {owner.get('name')!r}"
+        for attr in _NUMBERS.get(el.tag, ()) + (quaternion if el.tag == "origin" else ()):
             text = el.get(attr)
             problem = None if text is None else _number_problem(text, _VECTORS.get((el.tag, attr), 1))
             if problem:
                 shown = text.translate({9: "\\t", 10: "\\n", 13: "\\r"})  # (one line)
-                raise ValueError(f"URDF {urdf}: {owner.tag} {owner.get('name')!r}: <{el.tag} {attr}=\"{shown}\"> "
-                                 f"{problem}")
-    version = _check_robot(root, urdf)
+                raise ValueError(f"{where}: <{el.tag} {attr}=\"{shown}\"> {problem}")
+        if el.tag == "origin" and quaternion and el.get("quat_xyzw") is not None:
+            if el.get("rpy") is not None:
+                raise ValueError(f"{where}: an <origin> has both rpy and quat_xyzw, which urdfdom refuses")
+            if not any(float(v) for v in el.get("quat_xyzw").split()):
+                raise ValueError(f"{where}: <origin quat_xyzw=\"{el.get('quat_xyzw')}\"> is no rotation (Pinocchio "
+                                 "would read it as none)")
     links = [_check_link(link, urdf, version) for link in root.findall("link")]
     joints = [_check_joint(joint, urdf, version) for joint in root.findall("joint")]
     for kind, names in (("link", links), ("joint", joints)):
