@@ -111,7 +111,8 @@ def test_a_capsule_in_a_version_1_0_urdf_is_refused_saying_what_urdfdom_does_wit
                         'izz="1"/></inertial>', "link 'a': <mass value=\"1 \"> has a blank after its number"),
     ("</joint>", '<mimic joint="j0" multiplier="1 2"/></joint>', "joint 'j1': <mimic multiplier=\"1 2\"> needs 1"),
     ("</joint>", '<calibration rising="0 1"/></joint>', "joint 'j1': <calibration rising=\"0 1\"> needs 1 number"),
-    ("</joint>", '<safety_controller k_velocity="infinity"/></joint>', "joint 'j1': <safety_controller k_velocity=\"infinity\"> is not a list"),
+    ("</joint>", '<safety_controller k_velocity="infinity"/></joint>',
+     "joint 'j1': <safety_controller k_velocity=\"infinity\"> is not a list"),
     ('<axis xyz="0 0 1"/>', '<axis xyz="0&#9;0&#9;1"/>', r"joint 'j1': <axis xyz=\"0\\t0\\t1\"> has a tab or line "
                                                        "break between"),
 ])

@@ -13,7 +13,8 @@ import pytest
 from tpee_ompl.model.obstacles import Obstacle
 from tpee_ompl.model.robot_checker import RobotChecker
 
-LINK_A = '<link name="a"><collision><origin xyz="0.3 0 0"/><geometry><sphere radius="0.05"/></geometry></collision></link>'
+LINK_A = ('<link name="a"><collision><origin xyz="0.3 0 0"/><geometry><sphere radius="0.05"/></geometry></collision>'
+          '</link>')
 JOINT = ('<joint name="j1" type="revolute"><parent link="base"/><child link="a"/><origin xyz="0 0 0.1" rpy="0 0 0"/>'
          '<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>')
 ONE_JOINT = f'<robot name="t">\n<link name="base"/>\n{LINK_A}\n{JOINT}\n</robot>\n'
@@ -45,9 +46,11 @@ def _loads_as_urdfdom_reads_it(urdf: Path, capfd, srdf: Path | None = None) -> R
 
 @pytest.mark.parametrize("old, new", [
     ('<robot name="t">', '<robot name="t" xmlns="http://drake.mit.edu">'),
-    ('<robot name="t">', '<robot name="t" xmlns="http://www.ros.org" xmlns:xsi="http://www.w3.org/2001/XMLSchema-instance"'
-                         ' xsi:schemaLocation="http://www.ros.org urdf.xsd">'),
-    ("</robot>", '<gazebo reference="a"><sensor:camera name="c"><sensor:fov>1</sensor:fov></sensor:camera></gazebo></robot>'),
+    ('<robot name="t">', '<robot name="t" xmlns="http://www.ros.org" '
+                         'xmlns:xsi="http://www.w3.org/2001/XMLSchema-instance" '
+                         'xsi:schemaLocation="http://www.ros.org urdf.xsd">'),
+    ("</robot>", '<gazebo reference="a"><sensor:camera name="c"><sensor:fov>1</sensor:fov></sensor:camera></gazebo>'
+                 '</robot>'),
     ('<robot name="t">', '<robot name="t" xacro:foo="1">'),
 ], ids=["drake-default-namespace", "urdf-xsd-namespace", "undeclared-element-prefix", "undeclared-attribute-prefix"])
 def test_a_urdf_with_a_default_namespace_or_an_undeclared_prefix_loads(tmp_path, capfd, old, new):

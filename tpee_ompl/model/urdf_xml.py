@@ -24,7 +24,8 @@ __all__ = ["finite_numbers", "parse_urdf", "read_robot_xml", "read_text", "urdf_
 
 log = logging.getLogger(__name__)
 
-_DECLARED_ENCODING = re.compile(rb"""(?:\xef\xbb\xbf)?<\?xml\s[^>]*?\bencoding\s*=\s*["']([A-Za-z][A-Za-z0-9._-]*)["']""")
+_DECLARED_ENCODING = re.compile(
+    rb"""(?:\xef\xbb\xbf)?<\?xml\s[^>]*?\bencoding\s*=\s*["']([A-Za-z][A-Za-z0-9._-]*)["']""")
 """The encoding an XML declaration names (``<?xml version="1.0" encoding="ISO-8859-1"?>``)."""
 _VERSION_PART = re.compile(r"[ \t\n\v\f\r]*[+-]?[0-9]+")
 """One part of a URDF version as urdfdom reads it (``strtol``, base 10, nothing after the digits)."""
@@ -45,7 +46,8 @@ def read_text(path: Path, kind: str) -> str:
         pass
     data = path.read_bytes()
     if data.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)) or b"\0" in data:
-        raise ValueError(f"malformed {kind} {path}: UTF-16 (or binary) text, which urdfdom cannot read: save it as UTF-8")
+        raise ValueError(f"malformed {kind} {path}: UTF-16 (or binary) text, which urdfdom cannot read: save it as "
+                         "UTF-8")
     declared = _DECLARED_ENCODING.match(data)
     if declared:
         try:
@@ -54,7 +56,8 @@ def read_text(path: Path, kind: str) -> str:
             pass
     if path not in _WARNED_LATIN1:
         _WARNED_LATIN1.add(path)
-        said = f"declares encoding {declared.group(1).decode('ascii')!r} but is not" if declared else "declares no encoding"
+        said = (f"declares encoding {declared.group(1).decode('ascii')!r} but is not" if declared
+                else "declares no encoding")
         log.warning("%s %s is not UTF-8 and %s: read as Latin-1 (urdfdom reads its bytes as they are); save it as "
                     "UTF-8 to be sure of its names", kind, path, said)
     return path.read_text(encoding="latin-1")
@@ -264,12 +267,13 @@ def _check_link(link: ET.Element, urdf: Path, version: tuple[int, int]) -> str:
         if shape is None:
             raise ValueError(f"{where}: a <{part.tag}> has no <geometry> shape{lost}")
         if shape.tag == "capsule" and version < (1, 1):
-            raise ValueError(f"{where}: <capsule> needs <robot version=\"1.1\"> (or 1.2): urdfdom reads it from version "
-                             f"1.1 on, and in 1.0 it fails to parse the <{part.tag}> and link {name!r} loses all its "
-                             "collision geometry (printing errors); declare version=\"1.1\", or use <cylinder> (loaded "
-                             "as a capsule)")
+            raise ValueError(f"{where}: <capsule> needs <robot version=\"1.1\"> (or 1.2): urdfdom reads it from "
+                             f"version 1.1 on, and in 1.0 it fails to parse the <{part.tag}> and link {name!r} loses "
+                             "all its collision geometry (printing errors); declare version=\"1.1\", or use "
+                             "<cylinder> (loaded as a capsule)")
         if shape.tag not in _SHAPES:
-            raise ValueError(f"{where}: <{part.tag}> shape <{shape.tag}> is none of urdfdom's {', '.join(_SHAPES)}{lost}")
+            raise ValueError(f"{where}: <{part.tag}> shape <{shape.tag}> is none of urdfdom's {', '.join(_SHAPES)}"
+                             f"{lost}")
         missing = [a for a in _SHAPES[shape.tag] if shape.get(a) is None]
         if missing:
             raise ValueError(f"{where}: <{shape.tag}> needs the attribute(s) {', '.join(missing)}{lost}")
