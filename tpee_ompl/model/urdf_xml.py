@@ -5,8 +5,11 @@ urdfdom (Pinocchio's URDF parser) prints a C++ error on stderr for each element 
 "not a valid URDF model"; what it would refuse is refused here first, with one line naming the file and element.
 What it reads is read: its XML parser, tinyxml2, knows no namespaces, so neither does this reader (a default
 ``xmlns`` on ``<robot>``, as Drake's URDFs have, or an undeclared prefix such as ``<sensor:camera>`` in a
-``<gazebo>`` block are names like any other), and it reads bytes as they are, so a file that is not UTF-8 is
-decoded as its XML declaration says (Latin-1 without one).
+``<gazebo>`` block are names like any other), keeps an attribute's tabs and line breaks, and reads bytes as they
+are, so a file that is not UTF-8 is decoded as its XML declaration says (Latin-1 without one).  Versions, numbers
+and shapes are read as urdfdom 6 reads them: ``version="1.01"`` is 1.1, ``<capsule>`` is read from version 1.1 on,
+a number is read whole (``effort="1 2"`` and ``"1 "`` are not numbers), and only where urdfdom looks (the first
+``<origin>`` of a joint, not a ``<transmission>``'s joints).
 """
 
 from __future__ import annotations
