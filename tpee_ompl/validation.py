@@ -14,8 +14,9 @@ from typing import Any, Literal, TypeVar, overload
 
 import numpy as np
 
-__all__ = ["MAX_COUNT", "MAX_JOINT_VALUE", "MAX_SECONDS", "MAX_SEED", "MOTION_VALIDATORS", "as_float_array",
-           "check_bool", "check_int", "check_name", "check_number", "check_seed", "resolve_options", "sub_seed"]
+__all__ = ["MAX_COUNT", "MAX_JOINT_VALUE", "MAX_SECONDS", "MAX_SEED", "MOTION_VALIDATORS", "as_config_batch",
+           "as_float_array", "check_bool", "check_int", "check_name", "check_number", "check_seed", "resolve_options",
+           "sub_seed"]
 
 
 _Options = TypeVar("_Options")
@@ -101,6 +102,22 @@ def as_float_array(x: object, what: str) -> np.ndarray:
         return a.astype(float, copy=False)
     except (TypeError, ValueError, OverflowError) as exc:
         raise ValueError(f"{what} must be real numbers, got {x!r} ({exc})"[:400]) from exc
+
+
+def as_config_batch(Q: np.ndarray, nq: int) -> np.ndarray:
+    """Q as a float array of shape (N, nq) (one row per configuration), or raise ValueError."""
+    if type(Q) is np.ndarray and Q.dtype == np.float64 and Q.ndim == 2 and Q.shape[1] == nq and np.isfinite(Q).all():
+        return Q  # the planners' own batches: one test instead of the checks below
+    Q = as_float_array(Q, "configurations")
+    if Q.ndim == 1:
+        Q = Q[None, :]
+    if Q.ndim != 2 or Q.shape[1] != nq:
+        raise ValueError(f"configurations must have shape (N, {nq}); got {Q.shape}")
+    bad = ~np.all(np.isfinite(Q), axis=1)
+    if bad.any():
+        k = int(np.flatnonzero(bad)[0])
+        raise ValueError(f"configurations contain NaN or inf: row {k} is {Q[k]}")
+    return Q
 
 
 MAX_COUNT = 10**7

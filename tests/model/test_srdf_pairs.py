@@ -86,3 +86,10 @@ def test_the_clearance_of_a_robot_with_no_pair_left_to_check_is_infinite(arm):
     robot = RobotChecker(urdf, srdf)
     assert len(robot.gmodel.collisionPairs) == 0 and robot.is_valid([0.0, 0.0])
     assert robot.clearance([0.0, 0.0]) == float("inf") == robot.clearance([0.0, 0.0], from_margins=True)
+
+
+def test_closest_pair_of_a_robot_with_no_pair_left_to_check_says_so(arm):
+    """It raised IndexError from Pinocchio's empty pair list."""
+    urdf, srdf = arm('<disable_default_collisions link="a"/><disable_default_collisions link="b"/>')
+    with pytest.raises(ValueError, match="closest_pair: no collision pair is checked"):
+        RobotChecker(urdf, srdf).closest_pair([0.0, 0.0])

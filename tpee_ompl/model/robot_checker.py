@@ -18,14 +18,14 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from ..validation import as_float_array, check_bool, check_int, check_number
+from ..validation import as_config_batch, as_float_array, check_bool, check_int, check_number
 from .clearance_balls import BallScreen, separated_pairs
 from .lever_arms import joint_lever_arms, pair_lever_arms
 from .obstacles import Obstacle
 from .stall_guard import StallGuard
 from .urdf_loading import LoadedModel, ModelFiles, bounding_radius, is_prismatic, load_urdf_model
 
-__all__ = ["DEFAULT_SECURITY_MARGIN", "MAX_SECURITY_MARGIN", "RobotChecker", "as_config_batch"]
+__all__ = ["DEFAULT_SECURITY_MARGIN", "MAX_SECURITY_MARGIN", "RobotChecker"]
 
 log = logging.getLogger(__name__)
 
@@ -37,22 +37,6 @@ FIRST_INVALID_PAIRS = True
 """``first_invalid`` checks its rows two at a time, one per thread, when the checker has two threads (the same
 answer and an exact count; False: one row at a time on one thread, before 2026-11-26; a switch for
 ``experiments/speed_switches.py pair-checks``)."""
-def as_config_batch(Q: np.ndarray, nq: int) -> np.ndarray:
-    """Q as a float array of shape (N, nq) (one row per configuration), or raise ValueError."""
-    if type(Q) is np.ndarray and Q.dtype == np.float64 and Q.ndim == 2 and Q.shape[1] == nq and np.isfinite(Q).all():
-        return Q  # the planners' own batches: one test instead of the checks below
-    Q = as_float_array(Q, "configurations")
-    if Q.ndim == 1:
-        Q = Q[None, :]
-    if Q.ndim != 2 or Q.shape[1] != nq:
-        raise ValueError(f"configurations must have shape (N, {nq}); got {Q.shape}")
-    bad = ~np.all(np.isfinite(Q), axis=1)
-    if bad.any():
-        k = int(np.flatnonzero(bad)[0])
-        raise ValueError(f"configurations contain NaN or inf: row {k} is {Q[k]}")
-    return Q
-
-
 class RobotChecker:
     """Collision checking of a URDF robot (every 1-DOF joint not locked is planned) among obstacles.
 
@@ -481,20 +465,25 @@ class RobotChecker:
             self.stall_guard.stalled(t, len(Q))
         return ~np.asarray(collides, dtype=bool)
 
+    def _closest(self, q: np.ndarray) -> int:
+        """Distances of every checked pair at q computed; the closest pair's index, -1 when none is checked."""
+        k = pin.computeDistances(self.model, self.data, self.gmodel, self._distance_data, self.check_config(q))
+        return k if len(self._pair_margins) else -1
+
     def clearance(self, q: np.ndarray, from_margins: bool = False) -> float:
         """Smallest distance (m, negative when penetrating) over all checked pairs at q; ``from_margins``: of each pair's
         distance less its margin, the distance to the nearest invalid configuration (OMPL's clearance; < 0 inside one)."""
-        q = self.check_config(q)
-        k = pin.computeDistances(self.model, self.data, self.gmodel, self._distance_data, q)
+        k = self._closest(q)
         if from_margins:
             d = np.fromiter((r.min_distance for r in self._distance_data.distanceResults), float)
             return float((d - self._pair_margins).min()) if len(d) else np.inf
-        return float(self._distance_data.distanceResults[k].min_distance) if len(self._pair_margins) else np.inf
+        return float(self._distance_data.distanceResults[k].min_distance) if k >= 0 else np.inf
 
     def closest_pair(self, q: np.ndarray) -> tuple[str, str, float]:
-        """The two geometry names of the closest checked pair at q, and their distance (m)."""
-        q = self.check_config(q)
-        k = pin.computeDistances(self.model, self.data, self.gmodel, self._distance_data, q)
+        """The two geometry names of the closest checked pair at q, and their distance (m); ValueError without pairs."""
+        k = self._closest(q)
+        if k < 0:
+            raise ValueError("closest_pair: no collision pair is checked (each was disabled or proven never close)")
         cp = self.gmodel.collisionPairs[k]
         names = self.gmodel.geometryObjects
         return names[cp.first].name, names[cp.second].name, float(self._distance_data.distanceResults[k].min_distance)
