@@ -267,3 +267,14 @@ def test_a_version_1_1_quaternion_turns_the_joint_and_is_ignored_in_1_0(tmp_path
         robot = _loads_as_urdfdom_reads_it(_write(tmp_path / f"q{version}.urdf", text), capfd)
         expected = pin.utils.rotate("z", np.pi / 2) if turned else np.eye(3)
         assert np.allclose(robot.model.jointPlacements[1].rotation, expected, atol=1e-6)
+
+
+def test_an_srdf_that_is_not_utf8_is_still_refused_naming_it(tmp_path):
+    """The SRDF is given to Pinocchio read as UTF-8 (:mod:`tpee_ompl.model.srdf_pairs`): a Latin-1 one, which the
+    reader now decodes, raised a bare UnicodeDecodeError there; it is refused naming the file, as before."""
+    urdf = _write(tmp_path / "one.urdf", ONE_JOINT)
+    srdf = _write(tmp_path / "latin1.srdf", ('<?xml version="1.0" encoding="ISO-8859-1"?>\n' + LATIN1_COMMENT
+                                             + '<robot name="t"><disable_collisions link1="base" link2="a"/></robot>'
+                                             ).encode("latin-1"))
+    with pytest.raises(ValueError, match=f"malformed SRDF {srdf}: not UTF-8 text"):
+        RobotChecker(urdf, srdf)

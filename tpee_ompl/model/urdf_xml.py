@@ -42,11 +42,12 @@ _WARNED_LATIN1: set[Path] = set()
 def read_text(path: Path, kind: str) -> str:
     """The file's text: UTF-8, else in the encoding its XML declaration names, else Latin-1 (with a warning, once per
     file).  urdfdom reads the bytes as they are, so a Latin-1 comment (``<!-- Jürgen -->``) loads there; UTF-16, which
-    it cannot read, is refused (ValueError naming the file)."""
+    it cannot read, is refused (ValueError naming the file), and so is an SRDF that is not UTF-8."""
     try:
         return path.read_text(encoding="utf-8")  # (the text a UTF-8 file's model hash has always covered)
-    except UnicodeDecodeError:
-        pass
+    except UnicodeDecodeError as exc:
+        if kind == "SRDF":  # srdf_pairs gives Pinocchio the SRDF read as UTF-8: refused here, naming it
+            raise ValueError(f"malformed SRDF {path}: not UTF-8 text ({exc})") from exc
     data = path.read_bytes()
     if data.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)) or b"\0" in data:
         raise ValueError(f"malformed {kind} {path}: UTF-16 (or binary) text, which urdfdom cannot read: save it as "
