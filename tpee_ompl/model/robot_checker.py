@@ -64,7 +64,8 @@ class RobotChecker:
         Where ``package://`` mesh files are found.
     cylinders_as_capsules : bool
         Load every URDF ``<cylinder>`` as a Coal capsule of the same radius and length (default,
-        the wearer's rule: urdfdom drops ``<capsule>``, so capsules are written as cylinders).
+        the wearer's rule: its 1.0 URDF writes capsules as cylinders; a ``<capsule>``, which urdfdom reads from
+        version 1.1 on, is one already).
         False keeps true cylinders.  Obstacles are never converted.
     extra_points : sequence of frame names
         Frames whose origins count as robot points in :meth:`lever_arms` (e.g. a tool tip).
