@@ -162,10 +162,18 @@ def test_animate_path_shows_a_progress_bar_with_the_time_left_and_writes_the_sam
     W = np.hstack([cross_sector_trajectory(1, 4), np.zeros((7, 2))])
     quiet = animate_path(robot, W, tmp_path / "quiet.gif", frames=4)
     assert capsys.readouterr().err == ""
+    phases, add = [], common.Progress.add
+
+    def spy(self, units, phase=None):  # what the bar is told, whatever tqdm redraws (at most every 0.1 s)
+        phases.append(phase)
+        add(self, units, phase)
+
+    monkeypatch.setattr(common.Progress, "add", spy)
     shown = animate_path(robot, W, tmp_path / "shown.gif", frames=4, progress=True)
+    named = [p for p in phases if p is not None]
+    assert named == ["frame 1/4", "frame 2/4", "frame 3/4", "frame 4/4", "encoding"] and len(phases) == 8
     lines = capsys.readouterr().err.replace("\r", "\n").split("\n")
-    assert any("frame 4/4" in line for line in lines) and "encoding" in lines[-2]
-    assert lines[-2].startswith("animate: 100%|") and "<00:00" in lines[-2]
+    assert lines[-2].startswith("animate: 100%|") and "<00:00" in lines[-2] and lines[-2].endswith("encoding")
     assert shown.read_bytes() == quiet.read_bytes()
     with pytest.raises(ValueError, match="progress"):
         animate_path(robot, W, tmp_path / "x.gif", frames=4, progress="yes")
