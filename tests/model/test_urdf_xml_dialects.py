@@ -278,3 +278,27 @@ def test_an_srdf_that_is_not_utf8_is_still_refused_naming_it(tmp_path):
                                              ).encode("latin-1"))
     with pytest.raises(ValueError, match=f"malformed SRDF {srdf}: not UTF-8 text"):
         RobotChecker(urdf, srdf)
+
+
+def test_an_axis_without_xyz_is_refused_as_the_zero_axis_urdfdom_reads(tmp_path):
+    """urdfdom takes (1, 0, 0) only when a joint has no ``<axis>``; an ``<axis/>`` without ``xyz`` is (0, 0, 0), and
+    Pinocchio then scaled the child (0.62 x identity at 0.9 rad) instead of turning it: it loaded without a word."""
+    urdf = _write(tmp_path / "axis.urdf", ONE_JOINT.replace('<axis xyz="0 0 1"/>', "<axis/>"))
+    model = pin.buildModelFromUrdf(str(urdf))
+    data = model.createData()
+    pin.forwardKinematics(model, data, np.array([0.9]))
+    assert np.allclose(data.oMi[1].rotation, np.cos(0.9) * np.eye(3))  # what urdfdom + Pinocchio make of it
+    with pytest.raises(ValueError, match=r"joint 'j1' has <axis> without xyz \(a zero axis\)"):
+        RobotChecker(urdf)
+    without = _write(tmp_path / "none.urdf", ONE_JOINT.replace('<axis xyz="0 0 1"/>', ""))
+    assert RobotChecker(without, n_threads=1).nq == 1  # no <axis> at all: urdfdom's (1, 0, 0)
+
+
+@pytest.mark.parametrize("declared", ["UTF-16", "UTF-16LE", "utf_32"])
+def test_a_latin1_urdf_declaring_utf16_loads_as_urdfdom_reads_its_bytes(tmp_path, capfd, declared):
+    """The declaration was trusted: "UTF-16" raised a bare UnicodeError naming no file, "UTF-16LE" decoded the bytes
+    into nonsense refused as not well-formed; urdfdom reads the bytes as they are and loads both."""
+    head = f'<?xml version="1.0" encoding="{declared}"?>\n'
+    text = head + LATIN1_COMMENT + ONE_JOINT
+    urdf = _write(tmp_path / "declared.urdf", (text + " " * (len(text) % 2)).encode("latin-1"))  # even length
+    _loads_as_urdfdom_reads_it(urdf, capfd)

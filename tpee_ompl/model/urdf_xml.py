@@ -53,10 +53,11 @@ def read_text(path: Path, kind: str) -> str:
         raise ValueError(f"malformed {kind} {path}: UTF-16 (or binary) text, which urdfdom cannot read: save it as "
                          "UTF-8")
     declared = _DECLARED_ENCODING.match(data)
-    if declared:
+    name = declared.group(1).decode("ascii").lower().replace("-", "").replace("_", "") if declared else ""
+    if declared and not name.startswith(("utf16", "utf32", "ucs")):  # (no NUL byte: not what it declares)
         try:
             return path.read_text(encoding=declared.group(1).decode("ascii"))
-        except (LookupError, UnicodeDecodeError):
+        except (LookupError, UnicodeError):  # an unknown name; bytes that are not in it (UTF-16 without a BOM)
             pass
     if path not in _WARNED_LATIN1:
         _WARNED_LATIN1.add(path)
@@ -96,11 +97,11 @@ def _parse_xml(text: str) -> ET.Element:
 
     def start(tag: str, attrs: dict[str, str]) -> None:
         raw = _START_TAG.match(data, parser.CurrentByteIndex) if attrs else None
-        if raw is not None and any(c in raw.group(1) for c in (b"\t", b"\n", b"\r", b"&")):
+        if raw is not None and any(c in raw.group(1) for c in (b"\t", b"\n", b"&")):  # (read_text made CRs LFs)
             for name, quoted in _ATTRIBUTE.findall(raw.group(1)):
                 name = name.decode("utf-8")
                 if name in attrs:  # (not one a DTD adds)
-                    attrs[name] = _ENTITY.sub(_entity, quoted[1:-1].decode("utf-8").replace("\r\n", "\n"))
+                    attrs[name] = _ENTITY.sub(_entity, quoted[1:-1].decode("utf-8"))
         builder.start(tag, attrs)
 
     parser.StartElementHandler = start
@@ -170,9 +171,10 @@ def parse_urdf(urdf: Path) -> ET.Element:
     for joint in root.findall("joint"):
         axis = joint.find("axis")
         if joint.get("type") in ("revolute", "prismatic", "continuous") and axis is not None \
-                and not any(float(v) for v in axis.get("xyz", "1 0 0").split()):
-            raise ValueError(f"URDF {urdf}: joint {joint.get('name')!r} has <axis xyz=\"{axis.get('xyz')}\">: a zero "
-                             "axis moves nothing (a revolute joint would scale its child instead of turning it)")
+                and not any(float(v) for v in axis.get("xyz", "0").split()):  # urdfdom: (1, 0, 0) without <axis> only
+            shown = f"<axis xyz=\"{axis.get('xyz')}\">" if "xyz" in axis.attrib else "<axis> without xyz (a zero axis)"
+            raise ValueError(f"URDF {urdf}: joint {joint.get('name')!r} has {shown}: a zero axis moves nothing (a "
+                             "revolute joint would scale its child instead of turning it)")
     _check_tree(root, set(links), urdf)
     return root
 
