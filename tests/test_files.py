@@ -199,3 +199,21 @@ def test_a_folder_no_file_can_be_made_in_is_refused_before_any_work_even_for_roo
         check_output_path("/proc/x.csv", what="--output")
     with pytest.raises(ValueError, match="^--out /proc/runs: folder /proc is not writable"):
         check_writable_folder("/proc/runs", what="--out")
+
+
+def test_an_interrupted_write_removes_the_folders_it_made_and_only_those(tmp_path):
+    """``-o new/dir/f`` interrupted left ``new/dir`` empty (the pictures removed them themselves; the library, query
+    sets, ``plan --json`` and the campaign files did not)."""
+    (tmp_path / "old").mkdir()
+    for path in (tmp_path / "old" / "new" / "dir" / "f.txt", tmp_path / "new" / "f.txt"):
+        with pytest.raises(KeyboardInterrupt), atomic_path(path) as tmp:
+            tmp.write_text("half")
+            raise KeyboardInterrupt
+    assert sorted(p.name for p in tmp_path.rglob("*")) == ["old"]
+    with pytest.raises(RuntimeError), atomic_path(tmp_path / "a" / "b" / "f.txt") as tmp:
+        (tmp_path / "a" / "other.txt").write_text("written meanwhile by someone else")
+        raise RuntimeError("stop")
+    assert sorted(p.relative_to(tmp_path).as_posix() for p in tmp_path.rglob("*")) == ["a", "a/other.txt", "old"]
+    with atomic_path(tmp_path / "c" / "d" / "f.txt") as tmp:
+        tmp.write_text("whole")
+    assert (tmp_path / "c" / "d" / "f.txt").read_text() == "whole"

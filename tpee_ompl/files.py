@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import contextlib
 import errno
+import itertools
 import os
 import tempfile
 import time
@@ -90,7 +91,8 @@ def _umask() -> int:
 def atomic_path(path: str | os.PathLike, *, force: bool = True, suffix_last: bool = False) -> Iterator[Path]:
     """A temporary path beside ``path`` to write to; on success it replaces ``path`` in one step.
 
-    On an exception (or KeyboardInterrupt) the temporary file is removed and ``path`` is unchanged.
+    On an exception (or KeyboardInterrupt) the temporary file is removed and ``path`` is unchanged, and the folders
+    made for it are removed again, deepest first, each only while empty (an interrupted ``-o new/dir/f.png`` left them).
     The file gets the mode a plain ``open`` would give (0666 less the umask), not ``mkstemp``'s 0600.
     ``suffix_last`` ends the temporary name with ``path``'s suffix (``.m.gif.XXXX.part.gif``) for
     writers that choose the format by the file name and cannot be told otherwise (Pillow, ffmpeg).
@@ -105,7 +107,9 @@ def atomic_path(path: str | os.PathLike, *, force: bool = True, suffix_last: boo
         raise OutputExistsError(f"{target} exists; pass --force (in Python: force=True) to replace it")
     if target.is_symlink():  # the file it points to is replaced, the link stays
         target = Path(os.path.realpath(target))
+    made = list(itertools.takewhile(lambda f: not f.exists(), (target.parent, *target.parent.parents)))  # deepest first
     target.parent.mkdir(parents=True, exist_ok=True)
+    done = False
     suffix = ".part" + target.suffix if suffix_last else target.suffix + ".part"
     # at most 100 bytes of the name: one near the 255-byte limit still leaves room for the temporary's
     prefix = "." + os.fsencode(target.name)[:100].decode(errors="ignore") + "."
@@ -122,6 +126,7 @@ def atomic_path(path: str | os.PathLike, *, force: bool = True, suffix_last: boo
             os.replace(tmp, target)
         else:
             _place_new(tmp, target)
+        done = True
     except OSError as exc:
         names_temporary = exc.filename is not None and Path(exc.filename).name.startswith(prefix)
         if names_temporary or exc.filename is None and exc.errno is not None:
@@ -133,6 +138,20 @@ def atomic_path(path: str | os.PathLike, *, force: bool = True, suffix_last: boo
         if tmp is not None:
             with contextlib.suppress(FileNotFoundError):
                 tmp.unlink()
+        if not done:
+            _remove_empty(made)
+
+
+def _remove_empty(folders: list[Path]) -> None:
+    """Remove ``folders`` (deepest first) while each is empty: the first that is not (something else wrote there
+    meanwhile) stays, and so do the folders above it."""
+    for folder in folders:
+        try:
+            folder.rmdir()
+        except FileNotFoundError:  # removed meanwhile, or never made
+            continue
+        except OSError:
+            return
 
 
 _NO_HARD_LINKS = {errno.EPERM, errno.EOPNOTSUPP, errno.ENOTSUP, errno.ENOSYS, errno.EMLINK, errno.EXDEV}

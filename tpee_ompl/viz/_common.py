@@ -5,11 +5,8 @@ matplotlib is imported inside the functions, so importing the package stays chea
 
 from __future__ import annotations
 
-import contextlib
-import itertools
 import logging
 import os
-from collections.abc import Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -186,32 +183,13 @@ def image_suffixes() -> tuple[str, ...]:
     return (*common, *others)
 
 
-@contextlib.contextmanager
-def folders_removed_on_failure(out: Path) -> Iterator[None]:
-    """Run the write of ``out``; when it does not complete (an error, Ctrl-C), remove the folders above ``out`` that
-    did not exist before it (:func:`~tpee_ompl.files.atomic_path` makes them), deepest first, each only if empty.
-    The file itself needs nothing: ``atomic_path`` never leaves a half-written one."""
-    target = Path(os.path.realpath(out)) if out.is_symlink() else out  # a link is written through
-    missing = list(itertools.takewhile(lambda folder: not folder.exists(), target.parents))  # deepest first
-    try:
-        yield
-    except BaseException:
-        for folder in missing:
-            try:
-                folder.rmdir()
-            except FileNotFoundError:  # never made (the write stopped before, or between two mkdirs)
-                continue
-            except OSError:  # not empty: something else wrote there meanwhile; it and its parents stay
-                break
-        raise
-
-
 def write_figure(fig: Figure, out: Path, dpi: int, force: bool = True, **savefig_kwargs: Any) -> Path:
     """Save ``fig`` to exactly ``out`` (format from its suffix), atomically; log it and return ``out``.
 
     A name without a known image suffix is refused (matplotlib would add ``.png`` and write another
     file than the one named); an existing file is replaced in one step, never left half-written (``force=False``:
-    refused, also one written meanwhile); folders made for it are removed again if the write does not complete.
+    refused, also one written meanwhile); folders made for it are removed again if the write does not complete
+    (:func:`~tpee_ompl.files.atomic_path`).
     """
     from ..files import atomic_path
 
@@ -220,7 +198,7 @@ def write_figure(fig: Figure, out: Path, dpi: int, force: bool = True, **savefig
     level = ps.level
     ps.setLevel(logging.ERROR)  # .eps/.ps: "does not support transparency" for the scene's translucent faces
     try:
-        with folders_removed_on_failure(out), atomic_path(out, force=force) as tmp:
+        with atomic_path(out, force=force) as tmp:
             fig.savefig(tmp, dpi=dpi, format=out.suffix[1:].lower(), **savefig_kwargs)
     finally:
         ps.setLevel(level)

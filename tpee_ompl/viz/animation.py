@@ -17,7 +17,7 @@ import numpy as np
 
 from ..files import atomic_path
 from ..validation import MAX_COUNT, MAX_JOINT_VALUE, as_float_array, check_bool, check_int
-from ._common import (Progress, check_view, check_waypoints, clip_segment, draw_floor, folders_removed_on_failure,
+from ._common import (Progress, check_view, check_waypoints, clip_segment, draw_floor,
                       new_axes, optional_target, output_path, set_view)
 from .meshes import arm_polygons, scene_mesh
 from .style import DEFAULT_AZIM, DEFAULT_ELEV, LOS_BLOCKED, LOS_CLEAR
@@ -218,7 +218,7 @@ def animate_path(
 
     encode = _ENCODE_UNITS if suffix == ".gif" else 0
     # interrupted (Ctrl-C), no file and none of the folders made for it are left
-    with folders_removed_on_failure(out), atomic_path(out, suffix_last=True, force=force) as tmp, \
+    with atomic_path(out, suffix_last=True, force=force) as tmp, \
             rc_context({"savefig.bbox": None}), \
             Progress("animate", frames * (_DRAW_UNITS + encode), progress) as bar:  # (rc as writer.saving sets)
         writer.setup(fig, str(tmp), dpi)  # not writer.saving: it finishes the file also on an error
