@@ -98,6 +98,30 @@ def test_the_default_scene_is_aimed_by_the_packages_ik_from_the_sector_select_se
     assert f"q = {np.round(q, 4).tolist()} rad, valid: True" in capsys.readouterr().out
 
 
+def test_show_with_a_target_and_no_q_aims_the_arm_at_that_target(tmp_path, capsys, monkeypatch):
+    """The arm was aimed at the default target while the line of sight went to the one given."""
+    import numpy as np
+
+    from tpee_ompl.cli import pictures
+    from tpee_ompl.model.pointing import AimingError, aim_errors
+    from tpee_ompl.model.wearer_arm import default_robot
+
+    robot, target = default_robot(), np.array([3.0, -2.0, 1.5])
+    q, aimed = pictures.default_scene(robot, target)
+    assert np.array_equal(aimed, target) and abs(aim_errors(robot, q, target)[2]) < 1e-9
+    assert main(["show", "--target", "3", "-2", "1.5", "-o", str(tmp_path / "s.png")]) == 0
+    assert f"q = {np.round(q, 4).tolist()} rad" in capsys.readouterr().out
+
+    def cannot(*a, **k):
+        raise AimingError("behind the wearer")
+
+    monkeypatch.setattr("tpee_ompl.model.pointing.aim", cannot)
+    assert main(["show", "--target", "3", "-2", "1.5", "-o", str(tmp_path / "t.png")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("tpee-ompl show: error: --target: target (3.0, -2.0, 1.5) m cannot be aimed at from sector")
+    assert "give --q" in err and len(err.splitlines()) == 1 and not (tmp_path / "t.png").exists()
+
+
 def test_an_interrupted_show_exits_130_and_removes_the_folders_it_made_for_the_output(tmp_path, capsys, monkeypatch):
     """Ctrl-C while ``show -o new/dir/s.png`` wrote left new/dir behind, empty."""
     from matplotlib.figure import Figure

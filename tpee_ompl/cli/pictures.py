@@ -43,20 +43,26 @@ DEFAULT_SCENE_TARGET = (4.0, 1.5, 1.9)
 """Metres: the target of the default scene (``show`` and ``view`` without ``--q``; :func:`default_scene`)."""
 
 
-def default_scene(robot: WearerArm) -> tuple[np.ndarray, np.ndarray]:
-    """The default scene's configuration (4,), radians, and target (3,), metres: :data:`DEFAULT_SCENE_TARGET` aimed at
-    by the aiming IK from the posture sector :func:`~tpee_ompl.model.sectors.select_sector` picks for it (sector 3,
-    q = (-50, 20, 7.4, -8.0) deg with the packaged model); RuntimeError when ``robot`` cannot aim there."""
+def default_scene(robot: WearerArm, target: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """A scene's configuration (4,), radians, and target (3,), metres: ``target`` (default :data:`DEFAULT_SCENE_TARGET`)
+    aimed at by the aiming IK from the posture sector :func:`~tpee_ompl.model.sectors.select_sector` picks for it
+    (the default: sector 3, q = (-50, 20, 7.4, -8.0) deg with the packaged model).  When ``robot`` cannot aim there:
+    RuntimeError for the default target, :class:`~tpee_ompl.model.pointing.AimingError` (a ValueError) for a given
+    one."""
     from ..model.pointing import AimingError, PointingGeometry, aim
     from ..model.sectors import select_sector
 
-    target = np.array(DEFAULT_SCENE_TARGET)
+    given = target is not None
+    target = np.array(target if given else DEFAULT_SCENE_TARGET, dtype=float)
     sector = select_sector(target)
     try:
         q = aim(target, sector, geometry=PointingGeometry.from_robot(robot))
     except AimingError as exc:
-        raise RuntimeError(f"the default scene's target {DEFAULT_SCENE_TARGET} m cannot be aimed at from sector "
-                           f"{sector} with this model ({exc}); give --q") from None
+        said = (f"target {tuple(target.round(4).tolist())} m cannot be aimed at from sector {sector} with this model "
+                f"({exc})")
+        if given:
+            raise AimingError(f"{said}; give --q to draw the arm elsewhere") from None
+        raise RuntimeError(f"the default scene's {said}; give --q") from None
     return q, target
 
 
@@ -67,12 +73,17 @@ def cmd_show(args: argparse.Namespace) -> int:
 
     check_output(args.output, "--output", args.force, image_suffixes())
     robot = load_robot(args)
-    q, target = default_scene(robot) if args.q is None else (np.array(args.q), None)
-    with argument("--q"):
-        q = robot.check_config(q)
+    target = None
     if args.target is not None:
         with argument("--target"):
             target = optional_target(args.target)
+    if args.q is None:  # aimed at the target given, else at the default one
+        with argument("--target"):
+            q, target = default_scene(robot, target)
+    else:
+        q = np.array(args.q)
+    with argument("--q"):
+        q = robot.check_config(q)
     with argument("--target"):
         check_target_off_muzzle(robot, q, target)
     out = save_scene(robot, q, args.output, target=target, sectors=args.sectors, force=args.force)
@@ -181,9 +192,10 @@ def register(sub: argparse._SubParsersAction, fmt: type) -> None:
                        description="Draw the wearer, the arm and the line of sight.\n\nexample:\n"
                                    "  tpee-ompl show -o scene.png\n"
                                    "  tpee-ompl show --q 0.87 0.35 0.3 -0.6 --target 4 1.5 1.9 --sectors -o s.png")
-    p.add_argument("--q", type=angle, nargs=4, metavar="Q", help="DOF1..DOF4 in radians (default: aimed at the default target 4 1.5 1.9 "
-                   "from the sector select_sector picks, by the aiming IK)")
-    p.add_argument("--target", type=finite, nargs=3, metavar=("X", "Y", "Z"), help="target point (m, world frame)")
+    p.add_argument("--q", type=angle, nargs=4, metavar="Q", help="DOF1..DOF4 in radians (default: aimed at --target, or at "
+                   "4 1.5 1.9, from the sector select_sector picks, by the aiming IK)")
+    p.add_argument("--target", type=finite, nargs=3, metavar=("X", "Y", "Z"),
+                   help="target point (m, world frame); without --q the arm aims at it")
     p.add_argument("--sectors", action="store_true", help="overlay the posture sectors")
     p.add_argument("-o", "--output", type=nonempty, default="scene.png", help="image file (.png, .pdf, .svg, ...; default scene.png)")
     add_force_arg(p)
