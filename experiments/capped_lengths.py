@@ -41,7 +41,8 @@ def measure(problems: list[str], caps: list[int], max_queries: int) -> dict[str,
         for qi, q in enumerate(rows[:max_queries]):
             for cap in caps:
                 ss, _ = problem.make_setup(q, checker)
-                ss.setPlanner(DimensionRRT(ss.getSpaceInformation(), groups=problem.groups, seed=qi + 1, max_samples=cap))
+                si = ss.getSpaceInformation()
+                ss.setPlanner(DimensionRRT(si, groups=problem.groups, seed=qi + 1, max_samples=cap))
                 ss.solve(600.0)
                 found.append([cap, qi, ss.getSolutionPath().length() if ss.haveExactSolutionPath() else math.nan])
             print(f"{name} query {qi}: done", file=sys.stderr, flush=True)
@@ -58,10 +59,14 @@ def compare(old: dict, new: dict) -> None:
             a = {int(r[1]): r[2] for r in old[name] if int(r[0]) == cap}
             b = {int(r[1]): r[2] for r in new[name] if int(r[0]) == cap}
             keys = sorted(k for k in a if k in b and math.isfinite(a[k]) and math.isfinite(b[k]))
+            if not keys:
+                print(f"{name:14s} cap {cap:5d}  no query solved in both files")
+                continue
             r = np.array([b[k] / a[k] for k in keys])
-            print(f"{name:14s} cap {cap:5d}  queries {len(keys):3d}  mean length {np.mean([a[k] for k in keys]):.4f} -> "
-                  f"{np.mean([b[k] for k in keys]):.4f}  per query new/old mean {r.mean():.4f}  shorter {(r < 0.999).sum()}"
-                  f"  longer {(r > 1.001).sum()}  same {(abs(r - 1) <= 0.001).sum()}")
+            mean_a, mean_b = np.mean([a[k] for k in keys]), np.mean([b[k] for k in keys])
+            print(f"{name:14s} cap {cap:5d}  queries {len(keys):3d}  mean length {mean_a:.4f} -> {mean_b:.4f}  "
+                  f"per query new/old mean {r.mean():.4f}  shorter {(r < 0.999).sum()}  longer {(r > 1.001).sum()}  "
+                  f"same {(abs(r - 1) <= 0.001).sum()}")
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -291,7 +291,8 @@ def test_the_headline_of_a_campaign_without_table4_says_why(tmp_path, monkeypatc
     runs = [run("DimensionRRT", q, 500, 1.0, 2.0, 1.0, 1.0) for q in (0, 1)]
     monkeypatch.setattr(report, "load_runs", lambda db: runs)
     out = report.write_report(tmp_path / "unused.db", tmp_path)
-    assert out["headline"].startswith("No Table 4: it compares DimensionRRT with RRTstar") and "##" not in out["headline"]
+    assert out["headline"].startswith("No Table 4: it compares DimensionRRT with RRTstar")
+    assert "##" not in out["headline"]
 
 
 def test_the_headline_of_an_anytime_only_campaign_is_its_first_path_table(tmp_path, monkeypatch):

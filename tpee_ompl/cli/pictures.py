@@ -192,8 +192,9 @@ def register(sub: argparse._SubParsersAction, fmt: type) -> None:
                        description="Draw the wearer, the arm and the line of sight.\n\nexample:\n"
                                    "  tpee-ompl show -o scene.png\n"
                                    "  tpee-ompl show --q 0.87 0.35 0.3 -0.6 --target 4 1.5 1.9 --sectors -o s.png")
-    p.add_argument("--q", type=angle, nargs=4, metavar="Q", help="DOF1..DOF4 in radians (default: aimed at --target, or at "
-                   "4 1.5 1.9, from the sector select_sector picks, by the aiming IK)")
+    p.add_argument("--q", type=angle, nargs=4, metavar="Q",
+                   help="DOF1..DOF4 in radians (default: aimed at --target, or at 4 1.5 1.9, from the sector "
+                        "select_sector picks, by the aiming IK)")
     p.add_argument("--target", type=finite, nargs=3, metavar=("X", "Y", "Z"),
                    help="target point (m, world frame); without --q the arm aims at it")
     p.add_argument("--sectors", action="store_true", help="overlay the posture sectors")

@@ -19,8 +19,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..model.sectors import SECTORS, posture_preset
-from ._common import (check_target_off_muzzle, check_view, check_waypoints, clip_segment, draw_floor, image_suffixes, new_axes, optional_target,
-                      output_path, set_view, write_figure)
+from ._common import (check_target_off_muzzle, check_view, check_waypoints, clip_segment, draw_floor, image_suffixes,
+                      new_axes, optional_target, output_path, set_view, write_figure)
 from .animation import muzzle_trace, resample_path
 from .meshes import arm_polygons, scene_mesh
 from .style import DEFAULT_AZIM, DEFAULT_ELEV, LOS_BLOCKED, LOS_CLEAR, SECTOR_COLORS, hex_rgb
