@@ -34,7 +34,7 @@ def test_a_problem_without_sectors_gets_its_own_labels_and_no_paper_figures(tmp_
     runs += [run("R", q, 500, 2.0, 4.0, 2.0, 2.0, from_sector=0) for q in (0, 1)]
     table = {r["metric"]: r for r in ratio_table(runs, "D", "R")}
     assert math.isnan(table["length"]["paper"]) and table["length"]["label"] == "Path length"
-    text = report._markdown(list(table.values()), [], [], [], "D", "R", "batched")
+    text = "\n".join(report._ratio_markdown(list(table.values()), "D", "R", "batched"))
     assert "DOF1" not in text and "paper" not in text and "| First group's length |" in text
 
 
@@ -218,16 +218,16 @@ def test_table4_says_what_the_dimension_rrt_it_compares_is():
     runs = [run("DimensionRRT", q, 500, 1.0, 2.0, 1.0, 1.0) for q in (0, 1)]
     runs += [run("RRTstar", q, 500, 2.0, 4.0, 2.0, 2.0) for q in (0, 1)]
     table = ratio_table(runs, "DimensionRRT", "RRTstar")
-    text = report._markdown(table, [], [], [], "DimensionRRT", "RRTstar", "batched")
+    text = "\n".join(report._ratio_markdown(table, "DimensionRRT", "RRTstar", "batched"))
     assert "`DimensionRRT`: the paper's dimension-RRT" in text and "DimensionRRTNoShortcuts" in text
     assert "Table 3's DOF1/DOF2 rows are kept" in text
     generic = [dict(r, from_sector=0) for r in runs]  # a problem without sectors: no Table 3, no radians promised
-    text = report._markdown(ratio_table(generic, "DimensionRRT", "RRTstar"), [], [], [], "DimensionRRT", "RRTstar",
-                            "batched")
+    text = "\n".join(report._ratio_markdown(ratio_table(generic, "DimensionRRT", "RRTstar"), "DimensionRRT",
+                                             "RRTstar", "batched"))
     assert "DimensionRRTNoShortcuts" in text and "Table 3" not in text and "joint space (rad)" not in text
     at300 = [dict(r, sample_cap=300) for r in runs]  # the wearer at a cap the paper gives no figures for
-    text = report._markdown(ratio_table(at300, "DimensionRRT", "RRTstar"), [], [], [], "DimensionRRT", "RRTstar",
-                            "batched")
+    text = "\n".join(report._ratio_markdown(ratio_table(at300, "DimensionRRT", "RRTstar"), "DimensionRRT",
+                                             "RRTstar", "batched"))
     assert "Table 3's DOF1/DOF2 rows are kept" in text
 
 
@@ -237,7 +237,7 @@ def test_runs_cut_by_the_time_limit_before_their_cap_are_said_under_the_success_
             "solution_length": 2.0, "planner": "R", "query_id": "0", "motion_validator": "batched", "time_budget": None}
     runs = [{**base, "iterations": 976, "time": 0.11}, {**base, "iterations": 5000, "time": 0.03, "query_id": "1"}]
     runs = [{**r, "success": report._success(r)} for r in runs]
-    text = report._markdown([], success_table(runs), [], [], "D", "R", "batched")
+    text = report._markdown(success_table(runs), [], [])
     assert "1 sample-capped run(s) stopped at the time limit (`--max-time`) before their cap" in text
 
 
@@ -271,7 +271,7 @@ def test_table4_marks_a_metric_with_fewer_ratios_than_the_row_count():
 def test_the_anytime_cost_table_has_a_row_per_budget_and_planner():
     rows = [{"budget": b, "planner": pl, "runs": 2, "success": 2, "cost_median": 1.0, "cost_q1": 1.0, "cost_q3": 1.0}
             for b in (0.1, 1.0) for pl in ("A", "B")]
-    text = report._markdown([], [], [], rows, "D", "R", "batched")
+    text = report._markdown([], [], rows)
     assert [line for line in text.splitlines() if line.startswith(("| 0.1 |", "| 1 |"))] == [
         f"| {b} | {pl} | 2/2 | 1.000 [1.000, 1.000] |" for b in ("0.1", "1") for pl in ("A", "B")]
 
