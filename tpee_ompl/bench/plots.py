@@ -47,13 +47,13 @@ def make_plots(db_path: str | Path, directory: str | Path, planner: str | None =
     return written
 
 
-FIG15 = "fig15_ratios_{}.png"
+_FIG15 = "fig15_ratios_{}.png"
 """Per motion validator: the per-query ratios against the sample count."""
-BOX = {"time": "box_time.png", "solution_length": "box_length.png"}
+_BOX = {"time": "box_time.png", "solution_length": "box_length.png"}
 """Per run column: its box plot per planner and sample cap."""
-ANYTIME_COST = "anytime_cost.png"
-ANYTIME_WITHIN_BEST = "anytime_within_best.png"
-_PLOT_PATTERNS = (FIG15.format("*"), *BOX.values(), ANYTIME_COST, ANYTIME_WITHIN_BEST)
+_ANYTIME_COST = "anytime_cost.png"
+_ANYTIME_WITHIN_BEST = "anytime_within_best.png"
+_PLOT_PATTERNS = (_FIG15.format("*"), *_BOX.values(), _ANYTIME_COST, _ANYTIME_WITHIN_BEST)
 """The names :func:`make_plots` writes."""
 
 
@@ -101,11 +101,11 @@ def _make_plots(db_path: str | Path, directory: str | Path, planner: str | None,
             ax.title.set_fontsize(9)
             ax.legend(fontsize=7)
             fig.tight_layout()
-            p = directory / FIG15.format(chk)
+            p = directory / _FIG15.format(chk)
             _save(fig, p)
             out.append(p)
         for col, label in (("time", "time (s)"), ("solution_length", "raw path length")):
-            fname = BOX[col]
+            fname = _BOX[col]
             groups = defaultdict(list)
             for r in it:
                 if r["success"]:
@@ -143,7 +143,7 @@ def _make_plots(db_path: str | Path, directory: str | Path, planner: str | None,
         ax2.set_title("longest budget", fontsize=9)
         ax2.legend(fontsize=7)
         fig.tight_layout()
-        p = directory / ANYTIME_COST
+        p = directory / _ANYTIME_COST
         _save(fig, p)
         out.append(p)
         out.append(_within_best_plot(db_path, runs, directory, plt))
@@ -170,7 +170,7 @@ def _within_best_plot(db_path, runs: list[dict], directory: Path, plt) -> Path:
     ax.set_title("markers: runs of each budget; dashed: progress inside the longest-budget runs", fontsize=9)
     ax.legend(fontsize=7)
     fig.tight_layout()
-    p = directory / ANYTIME_WITHIN_BEST
+    p = directory / _ANYTIME_WITHIN_BEST
     _save(fig, p)
     return p
 
