@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import pinocchio as pin
 import pytest
 
 from tpee_ompl.model.robot_checker import RobotChecker
@@ -25,6 +26,21 @@ def test_a_folder_given_as_the_urdf_or_srdf_is_said_to_be_a_folder(tmp_path):
 
 
 _LIMIT = '<limit lower="-1" upper="1" effort="1" velocity="1"/>'
+
+
+def _urdfdom_fails_and_we_refuse_in_one_line(urdf, match: str, capfd) -> None:
+    """urdfdom refuses the file or drops the link's collision geometry, printing why; RobotChecker refuses it first,
+    in one line matching ``match`` after the file's name, with nothing on stderr."""
+    capfd.readouterr()
+    try:  # urdfdom refuses the file, or drops the link's collision geometry, printing why
+        model = pin.buildModelFromUrdf(str(urdf))
+        assert pin.buildGeomFromUrdf(model, str(urdf), pin.GeometryType.COLLISION).ngeoms == 0
+    except ValueError:
+        pass
+    assert "Error" in capfd.readouterr().err
+    with pytest.raises(ValueError, match=f"URDF {urdf}: {match}") as info:
+        RobotChecker(urdf)
+    assert "\n" not in str(info.value) and capfd.readouterr().err == ""
 
 
 @pytest.mark.parametrize("old, new, match", [
@@ -85,8 +101,6 @@ def test_a_capsule_in_a_version_1_0_urdf_is_refused_saying_what_urdfdom_does_wit
     """The message said "urdfdom drops <capsule> silently": in a version 1.0 URDF urdfdom fails to parse the element
     (printing errors) and the link loses all its collision geometry, even for a capsule in a <visual>; from
     version 1.1 on it reads the capsule."""
-    import pinocchio as pin
-
     urdf = tmp_path / "capsule.urdf"
     urdf.write_text(ONE_JOINT.replace(old, new, 1))
     capfd.readouterr()
@@ -121,21 +135,10 @@ def test_a_number_urdfdom_cannot_read_is_named_with_its_file_element_and_attribu
     "0.0_5" or a radius of two numbers passed (Python's float reads them) until urdfdom refused the file or dropped
     the link's collision geometry, printing C++ errors: urdfdom reads one number whole (blanks before it, nothing
     after) and a vector split at spaces."""
-    import pinocchio as pin
-
     assert old in ONE_JOINT
     urdf = tmp_path / "bad.urdf"
     urdf.write_text(ONE_JOINT.replace(old, new, 1))
-    capfd.readouterr()
-    try:  # urdfdom refuses the file, or drops the link's collision geometry, printing why
-        model = pin.buildModelFromUrdf(str(urdf))
-        assert pin.buildGeomFromUrdf(model, str(urdf), pin.GeometryType.COLLISION).ngeoms == 0
-    except ValueError:
-        pass
-    assert "Error" in capfd.readouterr().err
-    with pytest.raises(ValueError, match=f"URDF {urdf}: {match}") as info:
-        RobotChecker(urdf)
-    assert "\n" not in str(info.value) and capfd.readouterr().err == ""
+    _urdfdom_fails_and_we_refuse_in_one_line(urdf, match, capfd)
 
 
 @pytest.mark.parametrize("visual, match", [
@@ -149,8 +152,6 @@ def test_a_visual_urdfdom_cannot_read_is_refused_before_the_link_loses_its_colli
                                                                                               match):
     """A malformed <visual> passed: urdfdom then dropped all of its link's collision geometry, printing C++ errors,
     and the error said only that "1 <collision> elements but only 0 geometries were loaded (unsupported shape?)"."""
-    import pinocchio as pin
-
     urdf = tmp_path / "visual.urdf"
     urdf.write_text(ONE_JOINT.replace("<collision>", visual + "<collision>", 1))
     capfd.readouterr()
@@ -174,22 +175,11 @@ def test_a_tab_line_break_or_entity_in_a_number_is_refused_as_urdfdom_reads_it(t
     """XML parsers make a tab or line break in an attribute a space, and expand a DOCTYPE's entities; tinyxml2
     (urdfdom's parser) does neither, so these passed and urdfdom refused the file or dropped the link's collision
     geometry, printing C++ errors.  The attribute is read as urdfdom gets it, and the message stays on one line."""
-    import pinocchio as pin
-
     assert old in ONE_JOINT
     urdf = tmp_path / "raw.urdf"
     head = '<!DOCTYPE robot [ <!ENTITY r "0.05"> ]>\n' if "&r;" in new else ""
     urdf.write_bytes((head + ONE_JOINT.replace(old, new, 1)).replace("\n", "\r\n").encode())  # a Windows file too
-    capfd.readouterr()
-    try:  # urdfdom refuses the file, or drops the link's collision geometry, printing why
-        model = pin.buildModelFromUrdf(str(urdf))
-        assert pin.buildGeomFromUrdf(model, str(urdf), pin.GeometryType.COLLISION).ngeoms == 0
-    except ValueError:
-        pass
-    assert "Error" in capfd.readouterr().err
-    with pytest.raises(ValueError, match=f"URDF {urdf}: {match}") as info:
-        RobotChecker(urdf)
-    assert "\n" not in str(info.value) and capfd.readouterr().err == ""
+    _urdfdom_fails_and_we_refuse_in_one_line(urdf, match, capfd)
 
 
 @pytest.mark.parametrize("origin, match", [
@@ -205,7 +195,6 @@ def test_a_version_1_1_quaternion_urdfdom_refuses_or_pinocchio_ignores_is_named(
     urdf = tmp_path / "quaternion.urdf"
     urdf.write_text(text)
     if "no rotation" not in match:  # urdfdom refuses these, printing why
-        import pinocchio as pin
 
         with pytest.raises(ValueError):
             pin.buildModelFromUrdf(str(urdf))
