@@ -61,14 +61,14 @@ def mimics(root: ET.Element, urdf: Path) -> list[Mimic]:
     return out
 
 
-def check_mimics(root: ET.Element, planned: set[str], locked: Mapping[str, float], continuous: set[str],
-                 urdf: Path) -> None:
+def check_mimics(root: ET.Element, planned: set[str], locked: Mapping[str, float], urdf: Path) -> None:
     """Refuse a planned mimic joint, a planned joint whose mimic is locked, and locked values that break a relation.
 
-    ``planned``: the joints left to plan; ``locked``: the locked joints' values (checked numbers); ``continuous``:
-    the URDF's continuous joints (a locked angle is compared modulo 2 pi).  ValueError naming the joints.
+    ``planned``: the joints left to plan; ``locked``: the locked joints' values (checked numbers; a continuous
+    joint's angle is compared modulo 2 pi).  ValueError naming the joints.
     """
     moving = {j.get("name") for j in root.findall("joint") if j.get("type") in _MOVING}
+    continuous = {j.get("name") for j in root.findall("joint") if j.get("type") == "continuous"}
     found = mimics(root, urdf)
     for m in found:
         if m.master not in moving:

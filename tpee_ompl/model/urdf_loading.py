@@ -186,8 +186,7 @@ def load_urdf_model(
         model, gmodel = _lock_joints(model, gmodel, locked, urdf)
         extra.append("locked=" + ",".join(f"{k}={float(v)!r}" for k, v in sorted(locked.items())))
     _check_joints(model, urdf)
-    check_mimics(root, set(model.names[1:]), locked or {}, {j.get("name") for j in root.findall("joint")
-                                                            if j.get("type") == "continuous"}, urdf)
+    check_mimics(root, set(model.names[1:]), locked or {}, urdf)
     if model.nq == 0:
         raise ValueError(f"URDF {urdf}: no joint left to plan (every joint is fixed or locked)")
     if not any(go.parentJoint != 0 for go in gmodel.geometryObjects):
