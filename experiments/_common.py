@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import time
+from pathlib import Path
 
 from ompl import base as ob
 from ompl import geometric as og
@@ -10,6 +11,26 @@ from ompl import geometric as og
 from tpee_ompl import PathLibrary, WearerArm
 from tpee_ompl.bench.campaign import query_rows, stratified_subset
 from tpee_ompl.resources import default_library_path
+
+
+def summary(doc: str | None) -> str:
+    """A script's ``--help`` description: its docstring's first paragraph on one line (its first line alone was cut
+    mid-sentence where the paragraph wraps)."""
+    return " ".join((doc or "").strip().split("\n\n")[0].split())
+
+
+HELDOUT_HINT = ("make it with: PYTHONPATH=. python experiments/make_queries.py --seed 777 --n-per-pair 3 "
+                "--out /tmp/heldout")
+"""How the held-out query sets some scripts default to (``/tmp/heldout/*.json``) are made."""
+
+
+def missing_query_files(queries: list[str] | str) -> str | None:
+    """The first of ``queries`` that names a JSON file that is not there, with how to make the held-out sets; else
+    None (a set's name, such as ``planning_necessary``, is the package's own)."""
+    for q in [queries] if isinstance(queries, str) else queries:
+        if q.endswith(".json") and not Path(q).is_file():
+            return f"--queries: {q} not found; {HELDOUT_HINT}" if "/heldout/" in q else f"--queries: {q} not found"
+    return None
 
 
 def length_after(ss: og.SimpleSetup, planner: ob.Planner, seconds: float) -> float:

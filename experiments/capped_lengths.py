@@ -21,6 +21,7 @@ import math
 import sys
 from pathlib import Path
 
+from _common import summary
 import numpy as np
 
 
@@ -70,7 +71,7 @@ def compare(old: dict, new: dict) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=summary(__doc__))
     ap.add_argument("--problems", nargs="+", default=["arm5-so2", "kinova-posts"])
     ap.add_argument("--samples", nargs="+", type=int, default=[500, 2500])
     ap.add_argument("--max-queries", type=int, default=10)

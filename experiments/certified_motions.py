@@ -19,6 +19,7 @@ import subprocess
 import sys
 import time
 
+from _common import summary
 import numpy as np
 
 
@@ -152,7 +153,7 @@ def _planner_worker(robot_name: str, validator: str, n_queries: int, iterations:
 
 
 def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=summary(__doc__))
     parser.add_argument("--motions", type=int, default=300, help="random motions per robot")
     parser.add_argument("--queries", type=int, default=8, help="queries per robot for the planner comparison")
     parser.add_argument("--iterations", type=int, default=500, help="RRT* iterations / dimension-RRT samples")

@@ -12,6 +12,7 @@ import time
 from pathlib import Path
 
 import coal
+from _common import summary
 import numpy as np
 import pinocchio as pin
 
@@ -35,7 +36,7 @@ def coal_collides(c, q: np.ndarray) -> bool:
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=summary(__doc__))
     ap.add_argument("-n", type=int, default=10000)
     ap.add_argument("--seed", type=int, default=1)
     args = ap.parse_args()

@@ -20,6 +20,8 @@ import statistics
 import subprocess
 import sys
 
+from _common import summary
+
 _CHILD = r"""
 import json, sys, time
 import numpy as np
@@ -56,7 +58,7 @@ print(json.dumps(times))
 
 
 def main(argv: list[str] | None = None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=summary(__doc__))
     ap.add_argument("--runs", type=int, default=5, help="fresh processes per planner")
     ap.add_argument("--queries", default="5,5", help="indices into the 24 stratified queries, solved in turn")
     args = ap.parse_args(argv)

@@ -21,7 +21,7 @@ from __future__ import annotations
 import argparse
 
 import numpy as np
-from _common import length_after
+from _common import length_after, missing_query_files, summary
 from ompl import util as ou
 
 import tpee_ompl.planning.dimension_search as dimension_search
@@ -36,7 +36,7 @@ _RESPREAD = dimension_search.respread_candidate
 
 
 def main(argv: list[str] | None = None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=summary(__doc__))
     ap.add_argument("--queries", nargs="+", default=["/tmp/heldout/planning_necessary.json",
                                                      "/tmp/heldout/paper_random.json"])
     ap.add_argument("--max-queries", type=int, default=36)
@@ -44,6 +44,8 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--budget", type=float, default=0.1)
     ap.add_argument("--seeds", type=int, default=3)
     args = ap.parse_args(argv)
+    if (missing := missing_query_files(args.queries)) is not None:
+        ap.error(missing)
     ou.setLogLevel(ou.LOG_NONE)
     robot = WearerArm()
     lib = PathLibrary.load(default_library_path(), robot)

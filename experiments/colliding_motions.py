@@ -21,7 +21,7 @@ import statistics
 import time
 
 import numpy as np
-from _common import first_path_time
+from _common import first_path_time, summary
 from ompl import geometric as og
 from ompl import util as ou
 
@@ -31,7 +31,7 @@ from tpee_ompl.model.queries import load_queries
 
 
 def get_argument_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p = argparse.ArgumentParser(description=summary(__doc__))
     p.add_argument("--probes", type=int, default=clearance_balls.PROBES, help="probe states when on")
     p.add_argument("--ompl-seed", type=int, default=1)
     p.add_argument("--skip-rrtconnect", action="store_true")

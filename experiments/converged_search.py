@@ -22,7 +22,7 @@ import time
 
 import numpy as np
 import pinocchio as pin
-from _common import wearer_library_queries
+from _common import summary, wearer_library_queries
 from ompl import util as ou
 
 from tpee_ompl import make_simple_setup
@@ -67,7 +67,7 @@ def _bends(W: np.ndarray) -> int:
 
 
 def main(argv: list[str] | None = None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=summary(__doc__))
     ap.add_argument("--queries", default="planning_necessary")
     ap.add_argument("--max-queries", type=int, default=24)
     ap.add_argument("--budget", type=float, default=0.1, help="time per run, s")

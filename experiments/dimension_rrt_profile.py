@@ -15,11 +15,13 @@ import json
 import statistics
 import time
 
+from _common import summary
 import numpy as np
 from ompl import base as ob
 from ompl import geometric as og
 from ompl import util as ou
 
+from tpee_ompl.files import atomic_write_text, check_output_path
 from tpee_ompl.planning.tpee import tpee_dimension_rrt
 from tpee_ompl.examples.tpee_queries import cross_sector_query
 from tpee_ompl.model.sectors import SECTOR_PAIRS
@@ -28,13 +30,14 @@ from tpee_ompl.model.wearer_arm import WearerArm
 
 
 def get_argument_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p = argparse.ArgumentParser(description=summary(__doc__))
     p.add_argument("--reps", type=int, default=2, help="queries per pair type (12 pair types)")
     p.add_argument("--samples", type=int, nargs="+", default=[500, 2500])
     p.add_argument("--margin", type=float, default=0.02, help="security margin (m)")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--rrtstar", action="store_true", help="also time og.RRTstar at equal iterations")
-    p.add_argument("--out", default=None, help="JSON file for the rows")
+    p.add_argument("--out", default=None, help="JSON file for the rows (not replaced without --force)")
+    p.add_argument("--force", action="store_true", help="replace the --out file if it exists")
     p.add_argument("--queries", default=None,
                    help="stored query set (e.g. planning_necessary): its first --reps queries of each pair type")
     return p
@@ -130,11 +133,16 @@ def run(args: argparse.Namespace) -> list[dict]:
 
 
 def main(argv: list[str] | None = None) -> None:
-    args = get_argument_parser().parse_args(argv)
+    ap = get_argument_parser()
+    args = ap.parse_args(argv)
+    if args.out:
+        try:
+            check_output_path(args.out, force=args.force, what="--out file")
+        except (OSError, ValueError) as exc:
+            ap.error(str(exc))
     rows = run(args)
     if args.out:
-        with open(args.out, "w") as f:
-            json.dump(rows, f, indent=1)
+        atomic_write_text(args.out, json.dumps(rows, indent=1), force=args.force)
 
 
 if __name__ == "__main__":

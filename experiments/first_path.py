@@ -29,7 +29,7 @@ import statistics
 import time
 
 import numpy as np
-from _common import first_path_time
+from _common import first_path_time, summary
 from ompl import base as ob
 from ompl import geometric as og
 from ompl import util as ou
@@ -43,7 +43,7 @@ from tpee_ompl.planning.tpee import tpee_dimension_rrt
 
 
 def get_argument_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p = argparse.ArgumentParser(description=summary(__doc__))
     p.add_argument("--queries", nargs="+", default=["planning_necessary", "paper_random"])
     p.add_argument("--max-queries", type=int, default=None, help="first N queries of each set")
     p.add_argument("--limit", type=float, default=1.0, help="time limit per first-path run, s")

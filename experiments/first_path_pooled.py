@@ -22,6 +22,7 @@ import os
 import sys
 from collections import defaultdict
 
+from _common import summary
 import numpy as np
 
 
@@ -80,7 +81,7 @@ def bootstrap_ratio(by_query: dict[int, dict[str, list[float]]], draws: int, rng
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=summary(__doc__))
     ap.add_argument("files", nargs="+", help="JSON files written by first_path.py --save")
     ap.add_argument("--draws", type=int, default=2000, help="bootstrap resamplings")
     ap.add_argument("--seed", type=int, default=0, help="seed of the bootstrap's resampling")

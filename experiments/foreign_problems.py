@@ -26,7 +26,7 @@ import statistics
 import time
 from collections.abc import Callable
 
-from _common import first_path_time
+from _common import first_path_time, summary
 from ompl import base as ob
 from ompl import geometric as og
 from ompl import util as ou
@@ -90,7 +90,7 @@ def _med(v):
 
 
 def main() -> None:
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p = argparse.ArgumentParser(description=summary(__doc__))
     p.add_argument("--seeds", type=int, default=3)
     p.add_argument("--time", type=float, default=1.0, help="seconds for the equal-time length columns")
     p.add_argument("--limit", type=float, default=10.0, help="dimension-RRT's time limit for a first path")

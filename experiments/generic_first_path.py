@@ -20,7 +20,7 @@ from __future__ import annotations
 import argparse
 
 import numpy as np
-from _common import first_path_time
+from _common import first_path_time, summary
 from ompl import geometric as og
 from ompl import util as ou
 
@@ -31,7 +31,7 @@ from tpee_ompl.planning.dimension_rrt import DimensionRRT
 
 def main(argv: list[str] | None = None) -> None:
     names = list(GENERIC_PROBLEMS)
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=summary(__doc__))
     ap.add_argument("problems", nargs="*", default=names, help=f"generic problems (default: all of {names})")
     ap.add_argument("--seeds", type=int, default=10, help="runs per query and planner")
     ap.add_argument("--limit", type=float, default=10.0, help="time limit per run, s")

@@ -23,6 +23,7 @@ import math
 import statistics
 import time
 
+from _common import summary
 import numpy as np
 from ompl import base as ob
 from ompl import geometric as og
@@ -123,7 +124,7 @@ def _run(ss: og.SimpleSetup, make, seconds: float, first: bool, simplify: bool =
 
 
 def main(argv: list[str] | None = None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=summary(__doc__))
     ap.add_argument("--targets", type=int, default=6)
     ap.add_argument("--seeds", type=int, default=3)
     ap.add_argument("--goals", type=int, default=8, help="IK solutions per target (goal states)")

@@ -17,6 +17,7 @@ import argparse
 import collections
 import json
 
+from _common import summary
 import numpy as np
 from ompl import util as ou
 
@@ -27,7 +28,7 @@ from tpee_ompl.resources import default_library_path
 
 def main(argv: list[str] | None = None) -> None:
     """Print per-pair outcome counts and the query-to-demo distances, as Markdown and JSON."""
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=summary(__doc__))
     ap.add_argument("--sets", nargs="+", default=["planning_necessary", "paper_random"])
     ap.add_argument("--budget", type=float, default=0.01, help="seconds per query")
     ap.add_argument("--json", action="store_true")

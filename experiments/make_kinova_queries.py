@@ -18,6 +18,7 @@ import argparse
 import sys
 from pathlib import Path
 
+from _common import summary
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -50,7 +51,7 @@ def make_queries(checker, rng: np.random.Generator, n: int) -> list[JointQuery]:
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=summary(__doc__))
     ap.add_argument("--out", type=Path, default=query_set_path("kinova_posts"))
     ap.add_argument("--srdf", type=Path, default=data_path("model", KINOVA_SRDF))
     ap.add_argument("-n", type=int, default=30, help="number of queries")

@@ -19,6 +19,7 @@ import argparse
 import itertools
 from pathlib import Path
 
+from _common import summary
 import numpy as np
 import pinocchio as pin
 
@@ -125,7 +126,7 @@ def save_robot_queries(out: Path, queries: list[JointQuery], robot: str, seed: i
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=summary(__doc__))
     ap.add_argument("--out", type=Path, default=query_set_path("panda_shelf"))
     ap.add_argument("-n", type=int, default=30, help="number of queries")
     ap.add_argument("--seed", type=int, default=2022)

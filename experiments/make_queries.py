@@ -10,6 +10,7 @@ import argparse
 import logging
 from pathlib import Path
 
+from _common import summary
 from tpee_ompl.files import OutputExistsError, check_output_path
 from tpee_ompl.model.queries import save_queries
 from tpee_ompl.model.wearer_arm import default_robot
@@ -21,7 +22,7 @@ SETS = ("planning_necessary", "paper_random")
 
 def get_argument_parser() -> argparse.ArgumentParser:
     """Command-line options."""
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p = argparse.ArgumentParser(description=summary(__doc__))
     p.add_argument("--seed", type=int, default=2022, help="seed of the planning_necessary set (paper_random: seed + 1)")
     p.add_argument("--n-per-pair", type=int, default=10, help="queries per ordered sector pair (12 pairs)")
     p.add_argument("--out", type=Path, default=data_path("queries"), help="output directory")

@@ -15,12 +15,14 @@ the validator screens where it is at most ``SCREEN_COST_LIMIT``).
 
 from __future__ import annotations
 
+import argparse
 import re
 import tempfile
 import time
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
+from _common import summary
 import numpy as np
 import pinocchio as pin
 
@@ -83,7 +85,8 @@ def user_srdf(urdf: Path, shipped: Path | None, package_dirs: list[str], out: Pa
     return out
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> None:
+    argparse.ArgumentParser(description=summary(__doc__)).parse_args(argv)  # --help; no options
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
         for name in ROBOTS:

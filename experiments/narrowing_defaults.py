@@ -19,6 +19,7 @@ import tempfile
 import time
 from pathlib import Path
 
+from _common import summary
 import numpy as np
 from ompl import util as ou
 
@@ -32,7 +33,7 @@ GRID = [(200, 0.5), (100, 0.5), (50, 0.5), (200, 0.3), (150, 0.3), (100, 0.3), (
 
 
 def get_argument_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p = argparse.ArgumentParser(description=summary(__doc__))
     p.add_argument("--queries", type=Path, default=None, help="query set JSON (default: draw the held-out set)")
     p.add_argument("--samples", type=int, nargs="+", default=[500, 2500])
     return p

@@ -18,7 +18,7 @@ from __future__ import annotations
 import argparse
 import statistics
 
-from _common import first_path_time
+from _common import first_path_time, summary
 from ompl import geometric as og
 from ompl import util as ou
 
@@ -27,7 +27,7 @@ from tpee_ompl.planning.dimension_rrt import DimensionRRT
 
 
 def main(argv: list[str] | None = None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=summary(__doc__))
     ap.add_argument("--problem", choices=("panda-shelf", "kinova-posts"), default="panda-shelf")
     ap.add_argument("--queries", type=int, default=12, help="first N queries of the problem")
     ap.add_argument("--seeds", type=int, default=3, help="runs per query and planner (dimension-RRT seeds 0..k-1)")

@@ -18,7 +18,7 @@ from __future__ import annotations
 import argparse
 
 import numpy as np
-from _common import wearer_library_queries
+from _common import summary, wearer_library_queries
 from ompl import util as ou
 
 from tpee_ompl import make_simple_setup
@@ -26,7 +26,7 @@ from tpee_ompl.library.planner import LibraryDimensionRRT
 
 
 def main(argv: list[str] | None = None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=summary(__doc__))
     ap.add_argument("--queries", default="planning_necessary", help="query-set name or JSON file")
     ap.add_argument("--max-queries", type=int, default=24)
     ap.add_argument("--budgets", type=float, nargs="+", default=[0.1, 1.0, 10.0])

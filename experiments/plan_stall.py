@@ -16,6 +16,8 @@ import statistics
 import subprocess
 import sys
 
+from _common import summary
+
 
 def _plan(i: int, j: int, *extra: str) -> dict:
     out = subprocess.run([sys.executable, "-m", "tpee_ompl.cli", "plan", "--from", str(i), "--to", str(j), "--json", *extra],
@@ -24,7 +26,7 @@ def _plan(i: int, j: int, *extra: str) -> dict:
 
 
 def main(argv: list[str] | None = None) -> None:
-    argparse.ArgumentParser(description=__doc__.splitlines()[0]).parse_args(argv)  # --help; no options
+    argparse.ArgumentParser(description=summary(__doc__)).parse_args(argv)  # --help; no options
     times, excess = [], []
     for i in range(1, 5):
         for j in range(1, 5):

@@ -12,8 +12,10 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from _common import summary
 import numpy as np
 
+from tpee_ompl.files import atomic_write, check_output_path
 from tpee_ompl.model.wearer_arm import WearerArm
 
 SETTINGS = {  # name -> WearerArm keyword arguments
@@ -55,17 +57,26 @@ def record(robot: WearerArm, Q: np.ndarray, prefix: str) -> dict[str, np.ndarray
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=summary(__doc__))
     ap.add_argument("--out", type=Path, default=Path(__file__).resolve().parents[1] / "tests/model/data/wearer_oracle.npz")
     ap.add_argument("-n", type=int, default=3000)
     ap.add_argument("--seed", type=int, default=16)
+    ap.add_argument("--force", action="store_true", help="replace --out (the recorded test oracle by default)")
     args = ap.parse_args()
+    try:
+        check_output_path(args.out, force=args.force, what="--out file")
+    except (OSError, ValueError) as exc:
+        ap.error(str(exc))
     base = WearerArm(n_threads=2)
     Q = oracle_configs(base, args.n, args.seed)
     data = {"Q": Q, "within": np.all((Q >= base.lower) & (Q <= base.upper), axis=1)}
     for name, kwargs in SETTINGS.items():
         data.update(record(WearerArm(n_threads=2, **kwargs), Q, name))
-    np.savez_compressed(args.out, **data)
+    def save(tmp: Path) -> None:
+        with open(tmp, "wb") as f:  # (a file name not ending in .npz would get one added)
+            np.savez_compressed(f, **data)
+
+    atomic_write(args.out, save, force=args.force)
     valid = data["default_are_valid"]
     print(f"wrote {args.out}: {len(Q)} configs, {valid.sum()} valid at the default margin, "
           f"{data['default_n_pairs']} pairs ({data['default_pruned_pairs']} pruned)")

@@ -20,6 +20,7 @@ from __future__ import annotations
 import argparse
 import statistics
 
+from _common import summary
 import numpy as np
 from ompl import geometric as og
 from ompl import util as ou
@@ -47,7 +48,7 @@ def _proven_length(ss: og.SimpleSetup, start: np.ndarray, goal: np.ndarray) -> f
 
 
 def main(argv: list[str] | None = None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=summary(__doc__))
     ap.add_argument("--queries", nargs="+", default=["planning_necessary", "paper_random"],
                     help="named query sets or query-set JSON files")
     ap.add_argument("--max-queries", type=int, default=24)

@@ -22,7 +22,7 @@ from __future__ import annotations
 import argparse
 
 import numpy as np
-from _common import length_after
+from _common import length_after, missing_query_files, summary
 from ompl import util as ou
 
 from tpee_ompl import PathLibrary, WearerArm, make_simple_setup
@@ -54,13 +54,15 @@ def _joint(on: bool) -> None:
 
 
 def main(argv: list[str] | None = None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=summary(__doc__))
     ap.add_argument("--queries", nargs="+", default=["/tmp/heldout/planning_necessary.json",
                                                      "/tmp/heldout/paper_random.json"])
     ap.add_argument("--max-queries", type=int, default=36)
     ap.add_argument("--budgets", type=float, nargs="+", default=[0.1])
     ap.add_argument("--seeds", type=int, default=3)
     args = ap.parse_args(argv)
+    if (missing := missing_query_files(args.queries)) is not None:
+        ap.error(missing)
     ou.setLogLevel(ou.LOG_NONE)
     robot = WearerArm()
     lib = PathLibrary.load(default_library_path(), robot)

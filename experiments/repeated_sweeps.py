@@ -22,7 +22,7 @@ import argparse
 import time
 
 import numpy as np
-from _common import wearer_library_queries
+from _common import summary, wearer_library_queries
 from ompl import util as ou
 
 from tpee_ompl import make_simple_setup
@@ -32,7 +32,7 @@ from tpee_ompl.planning.tpee import tpee_dimension_rrt
 
 
 def main(argv: list[str] | None = None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=summary(__doc__))
     ap.add_argument("--queries", default="planning_necessary", help="query-set name or JSON file")
     ap.add_argument("--max-queries", type=int, default=24)
     ap.add_argument("--seeds", type=int, default=4, help="runs per query and setting, each with its own seed")

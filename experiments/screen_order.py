@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import argparse
 
+from _common import summary
 import numpy as np
 from ompl import util as ou
 
@@ -38,7 +39,7 @@ def _states_to_failure(order: np.ndarray, ok: np.ndarray) -> int:
 
 
 def main(argv: list[str] | None = None) -> None:
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p = argparse.ArgumentParser(description=summary(__doc__))
     p.add_argument("--queries", default="planning_necessary")
     p.add_argument("--limit", type=float, default=1.0, help="time limit per first-path run, s")
     args = p.parse_args(argv)

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import argparse
 
+from _common import summary
 import numpy as np
 from ompl import util as ou
 
@@ -24,7 +25,7 @@ from tpee_ompl.planning.tpee import tpee_dimension_rrt
 
 
 def main(argv: list[str] | None = None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=summary(__doc__))
     ap.add_argument("--queries", default="planning_necessary", help="query-set name or JSON file")
     ap.add_argument("--index", type=int, default=0, help="index into the 24 stratified queries")
     ap.add_argument("--seeds", type=int, default=20)

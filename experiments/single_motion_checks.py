@@ -20,6 +20,7 @@ import argparse
 import statistics
 import time
 
+from _common import summary
 import numpy as np
 from mesh_robots import robot_files
 from ompl import base as ob
@@ -32,8 +33,8 @@ from tpee_ompl.planning import setup as setup_module
 VARIANTS = ("bisection", "all at once", "discrete")
 
 
-def _all_at_once(self, chunks):
-    """The batched validator's ``all_valid`` before the change: every state of every chunk in one batch."""
+def _all_at_once(self, chunks, probes=0):
+    """The batched validator's ``all_valid`` before the change: every state of every chunk in one batch (no probes)."""
     if not chunks:
         return np.zeros(0, dtype=bool)
     ok = self.robot.are_valid(np.concatenate(chunks))
@@ -42,7 +43,7 @@ def _all_at_once(self, chunks):
 
 
 def main(argv: list[str] | None = None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=summary(__doc__))
     ap.add_argument("--queries", type=int, default=10)
     ap.add_argument("--reps", type=int, default=3, help="runs per query and variant")
     ap.add_argument("--limit", type=float, default=3.0, help="time limit per run, s")

@@ -46,7 +46,7 @@ import time
 from collections.abc import Callable
 
 import numpy as np
-from _common import wearer_library_queries
+from _common import summary, wearer_library_queries
 from ompl import util as ou
 
 from tpee_ompl import make_simple_setup
@@ -102,9 +102,11 @@ SWITCHES: dict[str, tuple[Callable[[str], None], list[str]]] = {
 
 
 def main(argv: list[str] | None = None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=summary(__doc__))
     ap.add_argument("switch", choices=sorted(SWITCHES))
-    ap.add_argument("--values", nargs="+", help="settings to compare, the reference first (default: see above)")
+    defaults = "; ".join(f"{k}: {' '.join(v)}" for k, (_, v) in sorted(SWITCHES.items()))
+    ap.add_argument("--values", nargs="+",
+                    help=f"settings to compare, the reference first (default per switch: {defaults})")
     ap.add_argument("--queries", default="planning_necessary")
     ap.add_argument("--max-queries", type=int, default=24)
     ap.add_argument("--samples", type=int, default=5000, help="sample cap per run")

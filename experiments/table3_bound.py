@@ -34,6 +34,7 @@ import sys
 from collections import defaultdict
 from pathlib import Path
 
+from _common import summary
 import numpy as np
 from ompl import util as ou
 
@@ -76,7 +77,7 @@ def end_motion_bound(robot: WearerArm, q, limit: float, grid: float) -> float:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=summary(__doc__))
     ap.add_argument("db", type=Path, help="a campaign's benchmark.db with an anytime comparison")
     ap.add_argument("--planner", default="DimensionRRT", help="a planner that keeps the Table 3 row (one run per "
                     "query and budget, as the anytime comparison has)")

@@ -27,6 +27,8 @@ import subprocess
 import sys
 import time
 
+from _common import summary
+
 
 def _run(n_threads: int, samples: int, guard: bool) -> tuple[float, int]:
     """Wall time of one process's plans (this script with ``--child``) and its checker's stalled calls."""
@@ -88,7 +90,7 @@ def _deadline(n_threads: int, guard: bool) -> str:
 
 
 def main(argv: list[str] | None = None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=summary(__doc__))
     ap.add_argument("--samples", type=int, default=2500, help="sample cap per query")
     ap.add_argument("--no-stall-guard", action="store_true", help="the checker never falls back to one thread")
     ap.add_argument("--deadline", action="store_true", help="how late 0.1-s solves end beside two busy processes")

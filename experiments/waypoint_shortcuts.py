@@ -24,6 +24,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from _common import missing_query_files, summary
 from ompl import util as ou
 
 from tpee_ompl import PathLibrary, WearerArm, make_simple_setup
@@ -60,7 +61,7 @@ def _report(label: str, res: dict[bool, list[tuple[float, float, int]]]) -> None
 
 
 def main(argv: list[str] | None = None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=summary(__doc__))
     ap.add_argument("--queries", default="/tmp/heldout/planning_necessary.json", help="query-set name or JSON file")
     ap.add_argument("--max-queries", type=int, default=36)
     ap.add_argument("--seeds", type=int, default=3)
@@ -69,6 +70,8 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--arm-samples", type=int, default=2000)
     ap.add_argument("--arm-seeds", type=int, default=10)
     args = ap.parse_args(argv)
+    if (missing := missing_query_files(args.queries)) is not None:
+        ap.error(missing)
     ou.setLogLevel(ou.LOG_NONE)
     robot = WearerArm()
     lib = PathLibrary.load(default_library_path(), robot) if args.budgets else None

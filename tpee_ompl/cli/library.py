@@ -210,7 +210,8 @@ def register(subparsers: argparse._SubParsersAction, formatter_class: type = arg
         add_model_args(p)  # a library is made for one model: its file records the model's hash
 
     b = sub.add_parser("build", help="build a library (dimension-RRT demonstrations)", epilog=_BUILD_EXAMPLE,
-                       formatter_class=formatter_class)
+                       description="Build a path library: per ordered sector pair, dimension-RRT demonstrations "
+                       "learned as DMPs (paper sec. 4.2).", formatter_class=formatter_class)
     # no default: the packaged library lives inside the installed package, which a build must not write into
     # unasked (``make library`` names it on purpose); queries and stats read it by default
     b.add_argument("--library", type=nonempty, required=True, metavar="FILE",
@@ -244,7 +245,9 @@ def register(subparsers: argparse._SubParsersAction, formatter_class: type = arg
     add_force_arg(b)
     b.set_defaults(func=run_build)
 
-    q = sub.add_parser("query", help="answer one query", epilog=_QUERY_EXAMPLE, formatter_class=formatter_class)
+    q = sub.add_parser("query", help="answer one query", epilog=_QUERY_EXAMPLE, formatter_class=formatter_class,
+                       description="Answer one cross-sector query from the library: its path, validated, and how it "
+                       "was found (dmp, repaired, fallback).")
     common(q)
     q.add_argument("--query-set", metavar="NAME", type=nonempty, help="take the query from a named set (e.g. planning_necessary)")
     q.add_argument("--index", type=index, default=None, help="index in --query-set, from 0 (default 0)")
@@ -256,7 +259,8 @@ def register(subparsers: argparse._SubParsersAction, formatter_class: type = arg
     q.add_argument("--json", action="store_true", help="print the result (with the path) as JSON")
     q.set_defaults(func=run_query)
 
-    s = sub.add_parser("stats", help="describe a library file", epilog=_STATS_EXAMPLE, formatter_class=formatter_class)
+    s = sub.add_parser("stats", help="describe a library file", epilog=_STATS_EXAMPLE, formatter_class=formatter_class,
+                       description="Describe a library file: its model, settings and demonstrations per sector pair.")
     common(s)
     s.set_defaults(func=run_stats)
     return lib
