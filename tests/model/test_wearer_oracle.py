@@ -11,6 +11,7 @@ five foot-arm pairs (out of reach) are not; every verdict, clearance and closest
 from __future__ import annotations
 
 import importlib.util
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -23,9 +24,14 @@ ORACLE = Path(__file__).parent / "data" / "wearer_oracle.npz"
 
 
 def _recorder():
+    """The recording script as a module (it imports ``_common`` from its own folder, as a script run does)."""
     spec = importlib.util.spec_from_file_location("record_wearer_oracle", ROOT / "experiments/record_wearer_oracle.py")
     module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
+    sys.path.insert(0, str(ROOT / "experiments"))
+    try:
+        spec.loader.exec_module(module)
+    finally:
+        sys.path.remove(str(ROOT / "experiments"))
     return module
 
 
