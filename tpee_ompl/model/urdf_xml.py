@@ -168,13 +168,6 @@ def parse_urdf(urdf: Path) -> ET.Element:
         twice = next((n for k, n in enumerate(names) if n in names[:k]), None)
         if twice is not None:
             raise ValueError(f"URDF {urdf}: {kind} {twice!r} appears twice")
-    for joint in root.findall("joint"):
-        axis = joint.find("axis")
-        if joint.get("type") in ("revolute", "prismatic", "continuous") and axis is not None \
-                and not any(float(v) for v in axis.get("xyz", "0").split()):  # urdfdom: (1, 0, 0) without <axis> only
-            shown = f"<axis xyz=\"{axis.get('xyz')}\">" if "xyz" in axis.attrib else "<axis> without xyz (a zero axis)"
-            raise ValueError(f"URDF {urdf}: joint {joint.get('name')!r} has {shown}: a zero axis moves nothing (a "
-                             "revolute joint would scale its child instead of turning it)")
     _check_tree(root, set(links), urdf)
     return root
 
@@ -327,6 +320,12 @@ def _check_joint(joint: ET.Element, urdf: Path, version: tuple[int, int]) -> str
         negative = [a for a in ("effort", "velocity") if limit.get(a) is not None and float(limit.get(a)) < 0]
         if negative:
             raise ValueError(f"{where}: <limit {negative[0]}=\"{limit.get(negative[0])}\"> is negative")
+    axis = joint.find("axis")
+    if kind in ("revolute", "prismatic", "continuous") and axis is not None \
+            and not any(float(v) for v in axis.get("xyz", "0").split()):  # urdfdom: (1, 0, 0) without <axis> only
+        shown = f"<axis xyz=\"{axis.get('xyz')}\">" if "xyz" in axis.attrib else "<axis> without xyz (a zero axis)"
+        raise ValueError(f"{where} has {shown}: a zero axis moves nothing (a revolute joint would scale its child "
+                         "instead of turning it)")
     for tag, attrs, what in (("safety_controller", ("k_velocity",), "k_velocity"), ("mimic", ("joint",), "joint"),
                              ("dynamics", ("damping", "friction"), "damping or friction")):
         el = joint.find(tag)
