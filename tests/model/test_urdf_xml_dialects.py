@@ -10,7 +10,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from tpee_ompl.model.obstacles import Obstacle
+from tpee_ompl.model.obstacles import Obstacle, box
 from tpee_ompl.model.robot_checker import RobotChecker
 
 LINK_A = ('<link name="a"><collision><origin xyz="0.3 0 0"/><geometry><sphere radius="0.05"/></geometry></collision>'
@@ -269,15 +269,16 @@ def test_a_version_1_1_quaternion_turns_the_joint_and_is_ignored_in_1_0(tmp_path
         assert np.allclose(robot.model.jointPlacements[1].rotation, expected, atol=1e-6)
 
 
-def test_an_srdf_that_is_not_utf8_is_still_refused_naming_it(tmp_path):
-    """The SRDF is given to Pinocchio read as UTF-8 (:mod:`tpee_ompl.model.srdf_pairs`): a Latin-1 one, which the
-    reader now decodes, raised a bare UnicodeDecodeError there; it is refused naming the file, as before."""
+def test_a_latin1_srdf_loads_and_its_pairs_apply(tmp_path):
+    """A Latin-1 SRDF (a comment with an umlaut) was refused as "not UTF-8 text": Pinocchio was given the file read
+    as UTF-8.  It gets the text as the reader decoded it now, so the file loads as MoveIt's tinyxml2 reads it."""
     urdf = _write(tmp_path / "one.urdf", ONE_JOINT)
     srdf = _write(tmp_path / "latin1.srdf", ('<?xml version="1.0" encoding="ISO-8859-1"?>\n' + LATIN1_COMMENT
-                                             + '<robot name="t"><disable_collisions link1="base" link2="a"/></robot>'
+                                             + '<robot name="t"><disable_default_collisions link="a"/></robot>'
                                              ).encode("latin-1"))
-    with pytest.raises(ValueError, match=f"malformed SRDF {srdf}: not UTF-8 text"):
-        RobotChecker(urdf, srdf)
+    post = box("post", (0.1, 0.1, 0.1), (0.3, 0.2, 0.1))  # within the sphere's reach
+    assert len(RobotChecker(urdf, obstacles=[post]).gmodel.collisionPairs) == 1  # a against the post
+    assert len(RobotChecker(urdf, srdf, obstacles=[post]).gmodel.collisionPairs) == 0
 
 
 def test_an_axis_without_xyz_is_refused_as_the_zero_axis_urdfdom_reads(tmp_path):

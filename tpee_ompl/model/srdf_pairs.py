@@ -40,7 +40,7 @@ def apply_srdf(model: pin.Model, gmodel: pin.GeometryModel, srdf: Path, unknown_
     that an ``<enable_collisions link1 link2>`` enables again; ``<disable_collisions>`` wins over
     ``<enable_collisions>``.
     """
-    root = read_robot_xml(srdf, "SRDF")
+    root, text = read_robot_xml(srdf, "SRDF")
     for vj in root.iter("virtual_joint"):  # a mobile or legged robot's base: the URDF's root stays fixed here
         if vj.get("type") in ("floating", "planar"):
             log.warning("SRDF %s declares the %s virtual joint %r: its base is fixed to the world here (only the "
@@ -68,8 +68,9 @@ def apply_srdf(model: pin.Model, gmodel: pin.GeometryModel, srdf: Path, unknown_
         raise ValueError(f"SRDF {srdf} names unknown link {name!r} ({len(foreign)} of its {len(entries)} collision "
                          "entries name links the URDF lacks: an SRDF of another or a larger robot? keep only the "
                          "entries of this URDF's links, or pass srdf_unknown_links='skip')")
-    # from the text, not the path: Pinocchio's path reader refuses a file not named *.srdf (an SRDF saved as .xml)
-    pin.removeCollisionPairsFromXML(model, gmodel, srdf.read_text(encoding="utf-8"))
+    # from the text, not the path: Pinocchio's path reader refuses a file not named *.srdf (an SRDF saved as .xml),
+    # and the text is decoded as the reader decoded it (a Latin-1 comment)
+    pin.removeCollisionPairsFromXML(model, gmodel, text)
     known = [(el.tag, names) for el, names in entries if all(n in links for n in names)]
     no_default = {names[0] for tag, names in known if tag == "disable_default_collisions"}
     if no_default:

@@ -42,12 +42,11 @@ _WARNED_LATIN1: set[Path] = set()
 def read_text(path: Path, kind: str) -> str:
     """The file's text: UTF-8, else in the encoding its XML declaration names, else Latin-1 (with a warning, once per
     file).  urdfdom reads the bytes as they are, so a Latin-1 comment (``<!-- Jürgen -->``) loads there; UTF-16, which
-    it cannot read, is refused (ValueError naming the file), and so is an SRDF that is not UTF-8."""
+    it cannot read, is refused (ValueError naming the file)."""
     try:
         return path.read_text(encoding="utf-8")  # (the text a UTF-8 file's model hash has always covered)
-    except UnicodeDecodeError as exc:
-        if kind == "SRDF":  # srdf_pairs gives Pinocchio the SRDF read as UTF-8: refused here, naming it
-            raise ValueError(f"malformed SRDF {path}: not UTF-8 text ({exc})") from exc
+    except UnicodeDecodeError:
+        pass
     data = path.read_bytes()
     if data.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)) or b"\0" in data:
         raise ValueError(f"malformed {kind} {path}: UTF-16 (or binary) text, which urdfdom cannot read: save it as "
@@ -68,19 +67,21 @@ def read_text(path: Path, kind: str) -> str:
     return path.read_text(encoding="latin-1")
 
 
-def read_robot_xml(path: Path, kind: str) -> ET.Element:
-    """The ``<robot>`` root of a URDF or SRDF file, or FileNotFoundError / ValueError naming the file."""
+def read_robot_xml(path: Path, kind: str) -> tuple[ET.Element, str]:
+    """The ``<robot>`` root of a URDF or SRDF file and the file's text (:func:`read_text`), or FileNotFoundError /
+    ValueError naming the file."""
     if path.is_dir():
         raise ValueError(f"{kind} path {path} is a folder: {'an' if kind == 'SRDF' else 'a'} {kind} file is expected")
     if not path.is_file():
         raise FileNotFoundError(f"{kind} file not found: {path}")
+    text = read_text(path, kind)
     try:
-        root = _parse_xml(read_text(path, kind))
+        root = _parse_xml(text)
     except expat.ExpatError as exc:
         raise ValueError(f"malformed {kind} {path}: {exc}") from exc
     if root.tag != "robot":
         raise ValueError(f"malformed {kind} {path}: root element is <{root.tag}>, expected <robot>")
-    return root
+    return root, text
 
 
 def _parse_xml(text: str) -> ET.Element:
@@ -145,7 +146,7 @@ _SHAPES = {"sphere": ("radius",), "box": ("size",), "cylinder": ("radius", "leng
 def parse_urdf(urdf: Path) -> ET.Element:
     """The URDF's ``<robot>`` root, after refusing what urdfdom would refuse or drop (each with a C++ error on
     stderr and no name in Pinocchio's exception) and what it would read wrongly; ValueError naming the element."""
-    root = read_robot_xml(urdf, "URDF")
+    root, _ = read_robot_xml(urdf, "URDF")
     version = _check_robot(root, urdf)
     quaternion = ("quat_xyzw",) if version >= (1, 1) else ()  # (urdfdom ignores it in 1.0)
     for owner, el in _read_by_urdfdom(root):
