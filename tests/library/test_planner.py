@@ -388,3 +388,15 @@ def test_bounds_locked_after_the_pipeline_was_made_keep_its_posted_path_exact(ro
     assert ss.solve(5.0) == ob.PlannerStatus.EXACT_SOLUTION and "error" not in planner.last_run_stats()
     assert planner.last_run_stats()["library_outcome"] == "straight"
     assert path_passes_motion_checks(ss.getSpaceInformation(), ss.getSolutionPath(), in_bounds=True)
+
+
+def test_the_pipelines_library_pair_and_options_refuse_assignment(robot, library):
+    """p.pair = (1, 99) or p.options = ... was taken as it was: the pair unchecked, the options without the checks
+    the constructor makes (Table 3's groups and h)."""
+    ss = make_simple_setup(robot, *_query(robot, 1, 2, 0))
+    planner = LibraryDimensionRRT(ss.getSpaceInformation(), library, 1, 2)
+    for name, value, given in (("pair", (1, 99), "from_sector and to_sector"), ("library", None, "library"),
+                               ("options", DimensionRRTOptions(h=5), "options=...")):
+        with pytest.raises(AttributeError, match=f"LibraryDimensionRRT.{name} is fixed .* pass {given} to"):
+            setattr(planner, name, value)
+    assert planner.pair == (1, 2) and planner.options.h == 7 and planner.library is library

@@ -326,11 +326,14 @@ def test_the_first_path_does_not_depend_on_how_the_planned_dofs_are_grouped(conn
 
 
 def test_settings_fixed_at_construction_refuse_assignment_instead_of_being_ignored() -> None:
-    """p.h = 4 changed settings() (what a benchmark records) while the search went on with h = 7."""
+    """p.h = 4 changed settings() (what a benchmark records) while the search went on with h = 7; p.range_ = 0.05
+    (a number, as DimensionRRTOptions takes it) made every solve CRASH, p.narrowing = 5.0 overflowed mid-run, and
+    p.batch = "x" was recorded as it was."""
     ss = make_planar_arm_setup()
     planner = DimensionRRT(ss.getSpaceInformation(), seed=3)
     for name, value in (("h", 4), ("seed", 5), ("groups", [[0, 1, 2, 3]]), ("prescribed", {}),
-                        ("options", planner.options)):
+                        ("options", planner.options), ("range_", 0.05), ("narrowing", 5.0), ("narrow_after", -5),
+                        ("batch", "x"), ("shortcuts", "x")):
         with pytest.raises(AttributeError, match=f"pass {name}="):
             setattr(planner, name, value)
     with pytest.raises(ValueError, match="max_samples"):

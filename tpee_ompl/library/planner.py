@@ -27,7 +27,8 @@ from ..model.queries import straight_motion
 from ..model.sectors import check_sector, infer_sector, posture_preset
 from ..planning.dimension_rrt import RELEASE_AFTER, DimensionRRT, DimensionRRTOptions, shortcuts_on
 from ..planning.paths import array_to_path, path_passes_motion_checks, state_to_array
-from ..planning.planner_base import PythonPlanner, check_space_information, planner_status, problem_objective
+from ..planning.planner_base import (PythonPlanner, check_space_information, fixed_attribute, planner_status,
+                                     problem_objective)
 from ..planning.tpee import tpee_dimension_rrt, tpee_options
 from ..validation import sub_seed
 from .path_library import PathLibrary
@@ -103,11 +104,15 @@ class LibraryDimensionRRT(PythonPlanner):
         DimensionRRT.checked_setup(si, opts)  # the refining planner is built at solve time: its settings are checked now
         tpee_options(opts)  # groups and h that tpee_dimension_rrt refuses at solve time, refused now
         super().__init__(si, name)
-        self.library = library
-        self.pair = pair
-        self.options = opts
+        self._library, self._pair, self._options = library, pair, opts
         self._inner: DimensionRRT | None = None
         self._refinements = 0
+
+    library = fixed_attribute("library", lambda self: self._library, "The path library (``PathLibrary``).", "library")
+    pair = fixed_attribute("pair", lambda self: self._pair, "The sector pair, or None: inferred at each solve.",
+                           "from_sector and to_sector")
+    options = fixed_attribute("options", lambda self: self._options,
+                              "Settings of the refining dimension-RRT (``DimensionRRTOptions``).", "options=...")
 
     # ------------------------------------------------------------------ reporting
     def settings(self) -> dict[str, str]:

@@ -124,7 +124,7 @@ from .dimension_search import Search, SearchSettings
 from .goal_loop import GoalLoop, LoopLimits
 from .goal_runs import GoalRun, goal_states
 from .grouped_space import GroupedSpace
-from .planner_base import PythonPlanner, check_space_information, planner_status
+from .planner_base import PythonPlanner, check_space_information, fixed_attribute, planner_status
 from .search_checker import Checker
 from .solution_posting import SolutionPoster
 
@@ -142,14 +142,6 @@ printed "leaked instances" warnings; :func:`_drop_callbacks` breaks it first."""
 def _drop_callbacks() -> None:
     for planner in list(_WITH_CALLBACKS):
         planner._callback = None
-
-def _fixed(name: str, get: Callable[[Any], Any], doc: str) -> property:
-    """A read-only attribute of :class:`DimensionRRT` whose assignment says where it is set."""
-    def refuse(self: Any, value: Any) -> None:
-        raise AttributeError(f"DimensionRRT.{name} is fixed when the planner is built: pass {name}=... to "
-                             "DimensionRRT(si, ...) (or DimensionRRTOptions)")
-    return property(get, refuse, doc=doc)
-
 
 class DimensionRRT(PythonPlanner):
     """Dimension-RRT (paper sec. 4.1.2): anytime, fake-time, DOF-grouped path optimisation.
@@ -197,11 +189,7 @@ class DimensionRRT(PythonPlanner):
         self._options = opts
         self.grouped = grouped
         self.max_samples = opts.max_samples
-        self.narrow_after = opts.narrow_after
-        self.narrowing = opts.narrowing
-        self.range_ = rng_full
-        self.batch = opts.batch
-        self.shortcuts = shortcuts_on(opts, bool(grouped.prescribed))
+        self._range = rng_full
         self._rng = np.random.default_rng(opts.seed)
         self._initial = initial
         self._callback: Callable[[ob.Planner, list[ob.State], ob.Cost], object] | None = None
@@ -210,12 +198,26 @@ class DimensionRRT(PythonPlanner):
         self._samples_drawn = 0
 
     # fixed at construction (the groups, the steps and the random generator are built from them): read-only, so that
-    # an assignment cannot change settings() while the search goes on with the old value
-    h = _fixed("h", lambda self: self.grouped.h, "Fake-time steps (``DimensionRRTOptions.h``).")
-    groups = _fixed("groups", lambda self: self.grouped.groups, "The DOF groups (``DimensionRRTOptions.groups``).")
-    prescribed = _fixed("prescribed", lambda self: self.grouped.prescribed, "Groups with a prescribed trajectory.")
-    seed = _fixed("seed", lambda self: self.options.seed, "The seed of the planner's random generator.")
-    options = _fixed("options", lambda self: self._options, "The settings it was built with (``DimensionRRTOptions``).")
+    # an assignment cannot change settings() while the search goes on with the old value (``range_ = 0.05`` made
+    # every solve CRASH, ``narrowing = 5.0`` overflowed mid-run)
+    h = fixed_attribute("h", lambda self: self.grouped.h, "Fake-time steps (``DimensionRRTOptions.h``).")
+    groups = fixed_attribute("groups", lambda self: self.grouped.groups,
+                             "The DOF groups (``DimensionRRTOptions.groups``).")
+    prescribed = fixed_attribute("prescribed", lambda self: self.grouped.prescribed,
+                                 "Groups with a prescribed trajectory.")
+    seed = fixed_attribute("seed", lambda self: self.options.seed, "The seed of the planner's random generator.")
+    options = fixed_attribute("options", lambda self: self._options,
+                              "The settings it was built with (``DimensionRRTOptions``).")
+    narrow_after = fixed_attribute("narrow_after", lambda self: self._options.narrow_after,
+                          "Samples before the sampling region narrows (``DimensionRRTOptions.narrow_after``).")
+    narrowing = fixed_attribute("narrowing", lambda self: self._options.narrowing,
+                       "The narrowing factor (``DimensionRRTOptions.narrowing``).")
+    range_ = fixed_attribute("range_", lambda self: self._range,
+                    "The narrowed region's least padding per DOF (``DimensionRRTOptions.range_``, for these bounds).")
+    batch = fixed_attribute("batch", lambda self: self._options.batch,
+                   "Whether the checker's batched calls are used (``DimensionRRTOptions.batch``).")
+    shortcuts = fixed_attribute("shortcuts", lambda self: shortcuts_on(self._options, bool(self.grouped.prescribed)),
+                       "Whether the search takes shortcuts between waypoints (``DimensionRRTOptions.shortcuts``).")
 
     @property
     def max_samples(self) -> int | None:
@@ -259,7 +261,7 @@ class DimensionRRT(PythonPlanner):
         except ValueError as e:
             log.error("%s: the space's bounds changed and %s", self.getName(), e)
             return planner_status(ob.PlannerStatus.ABORT)
-        self.grouped, self.range_, self._initial = grouped, self._full_range(self.options, grouped), initial
+        self.grouped, self._range, self._initial = grouped, self._full_range(self.options, grouped), initial
         return None
 
     def _regrouped(self) -> GroupedSpace | None:
@@ -284,7 +286,7 @@ class DimensionRRT(PythonPlanner):
         grouped = self._regrouped() or self.grouped  # checked against the bounds as they are now
         self._initial = grouped.check_initial(W)
         if grouped is not self.grouped:
-            self.grouped, self.range_ = grouped, self._full_range(self.options, grouped)
+            self.grouped, self._range = grouped, self._full_range(self.options, grouped)
 
     def set_intermediate_solution_callback(
         self, callback: Callable[[ob.Planner, list[ob.State], ob.Cost], object] | None

@@ -12,14 +12,25 @@ from __future__ import annotations
 import logging
 import math
 import sys
+from collections.abc import Callable
 from typing import Any
 
 from ompl import base as ob
 
-__all__ = ["PythonPlanner", "check_space_information", "finite_state", "planner_status", "status_text",
-           "validator_mismatch"]
+__all__ = ["PythonPlanner", "check_space_information", "finite_state", "fixed_attribute", "planner_status",
+           "status_text", "validator_mismatch"]
 
 log = logging.getLogger(__name__)
+
+
+def fixed_attribute(name: str, get: Callable[[Any], Any], doc: str, given: str | None = None) -> property:
+    """A planner's read-only attribute (a setting fixed when it is built) whose assignment says where it is set
+    (``given``: how the constructor takes it; default ``name=...`` or ``DimensionRRTOptions``)."""
+    def refuse(self: Any, value: Any) -> None:
+        kind = type(self).__name__
+        raise AttributeError(f"{kind}.{name} is fixed when the planner is built: pass "
+                             f"{given or f'{name}=... (or DimensionRRTOptions)'} to {kind}(si, ...)")
+    return property(get, refuse, doc=doc)
 
 
 def problem_objective(pdef: ob.ProblemDefinition) -> ob.OptimizationObjective | None:
