@@ -6,7 +6,8 @@ import pytest
 
 from dataclasses import dataclass
 
-from tpee_ompl.validation import MAX_SEED, as_float_array, check_seed, resolve_options
+from tpee_ompl.planning.dimension_rrt_options import DimensionRRTOptions
+from tpee_ompl.validation import MAX_SEED, as_float_array, check_name, check_seed, resolve_options
 
 
 @pytest.mark.parametrize("seed", [0, -5, MAX_SEED + 1, 10**20, 1.5, True, "3", None])
@@ -40,3 +41,13 @@ def test_options_resolve_to_defaults_or_the_given_ones_with_overrides_and_refuse
 def test_as_float_array_refuses_what_is_not_a_real_float_with_a_value_error(x):
     with pytest.raises(ValueError, match="things must be real numbers"):
         as_float_array(x, "things")
+
+
+@pytest.mark.parametrize("value", ["my dim\nrrt", "tab\there", "bell\x07"])
+def test_names_with_control_characters_are_refused_naming_the_argument(value):
+    """A planner named "my dim\\nrrt" broke the benchmark log it was written to (one name per line)."""
+    with pytest.raises(ValueError, match="name must be printable text"):
+        check_name("name", value)
+    with pytest.raises(ValueError, match="name must be printable text"):
+        DimensionRRTOptions(name=value)
+    assert check_name("name", "Dimension RRT (é)") == "Dimension RRT (é)"

@@ -82,9 +82,13 @@ def check_bool(name: str, value: Any) -> bool:
 
 
 def check_name(name: str, value: Any) -> str:
-    """``value`` if it is a non-empty string."""
+    """``value`` if it is a non-empty string without control characters (a planner's name with a line break split
+    its line in OMPL's benchmark log, which ``ompl_benchmark_statistics`` then could not read)."""
     if not isinstance(value, str) or not value:
         raise ValueError(f"{name} must be a non-empty string, got {value!r}")
+    if not value.isprintable():
+        raise ValueError(f"{name} must be printable text (no line breaks, tabs or other control characters), "
+                         f"got {value!r}")
     return value
 
 
