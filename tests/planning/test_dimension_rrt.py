@@ -288,6 +288,28 @@ def test_released_wearer_search_gives_one_path_whatever_the_call_sizes_and_the_h
         np.testing.assert_array_equal(path(), ref)
 
 
+def test_a_condition_on_samples_drawn_stops_the_connect_trees_at_that_sample() -> None:
+    """The connect trees ask the termination condition before each sample, but samples_drawn() was counted only
+    after their batch: ``samples_drawn() >= 1`` let 47 samples through (a plain 2-D wall problem)."""
+    from ompl import geometric as og
+
+    space = ob.RealVectorStateSpace(2)
+    space.setBounds(-1.0, 1.0)
+    ss = og.SimpleSetup(space)
+    ss.setStateValidityChecker(lambda s: not (-0.1 < s[0] < 0.1 and s[1] > -0.6))
+    start, goal = space.allocState(), space.allocState()
+    start[0], start[1], goal[0], goal[1] = -0.8, 0.8, 0.8, 0.8
+    ss.setStartAndGoalStates(start, goal)
+    for n in (1, 3, 10):
+        planner = DimensionRRT(ss.getSpaceInformation(), seed=1)
+        ss.clear()
+        ss.setPlanner(planner)
+        seen: list[int] = []
+        ptc = ob.PlannerTerminationCondition(lambda: seen.append(planner.samples_drawn()) or seen[-1] >= n)
+        assert ss.solve(ptc) == ob.PlannerStatus.TIMEOUT  # (the wall needs more samples)
+        assert planner.last_run_stats()["samples"] == n and seen == sorted(seen) and seen[-1] == n
+
+
 def test_termination_condition_is_asked_at_each_sample_checkpoint_and_between_batches(robot: WearerArm) -> None:
     q = load_queries("planning_necessary")[1]
     ss = make_simple_setup(robot, q.start, q.goal)

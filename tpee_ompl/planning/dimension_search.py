@@ -195,7 +195,14 @@ class Search(SampleDraws):
         lo, hi = self._fbounds
         X = np.repeat(self.W[:1], len(U), axis=0)
         X[:, self._fdims] = lo + U[:, 1:] * (hi - lo)
-        P, used = self._connect.run(X, stop)
+        base = self.samples
+
+        def counting() -> bool:  # asked after each sample but the last: ``samples`` counts them as they are drawn
+            self.samples += 1
+            return stop()
+
+        P, used = self._connect.run(X, None if stop is None else counting)
+        self.samples = base
         self._ui += used
         planned = self.g.planned
         for s in range(self.samples, self.samples + used):

@@ -158,7 +158,12 @@ class GoalLoop:
         if self.several:
             limit = min(limit, run.turn_end - run.samples)
         before = search.samples
-        accepted = search.iterate(max(1, limit), ptc)
+
+        def stop() -> bool:  # asked within a call too (between connect-tree samples): the count as it is then
+            self.on_drawn(self.drawn + search.samples - before)
+            return bool(ptc())
+
+        accepted = search.iterate(max(1, limit), stop)
         self.drawn += search.samples - before
         self.on_drawn(self.drawn)
         now = time.perf_counter()
