@@ -207,7 +207,8 @@ def test_max_h_below_h_is_refused_naming_it() -> None:
 
 
 
-def test_a_batched_checker_answering_the_wrong_shape_is_named_in_the_error(caplog: pytest.LogCaptureFixture) -> None:
+def _wall_checker_setup(are_valid) -> og.SimpleSetup:
+    """A 2-D wall problem whose checker has a method named ``are_valid`` (given) beside ``isValid``."""
     space = ob.RealVectorStateSpace(2)
     space.setBounds(0.0, 1.0)
     ss = og.SimpleSetup(space)
@@ -216,13 +217,37 @@ def test_a_batched_checker_answering_the_wrong_shape_is_named_in_the_error(caplo
         def isValid(self, s: ob.State) -> bool:
             return not (0.4 < s[0] < 0.6 and s[1] < 0.7)
 
-        def are_valid(self, Q: np.ndarray) -> np.ndarray:
-            return np.ones(len(Q) + 1, dtype=bool)  # one answer too many
-
+    Checker.are_valid = are_valid
     si = ss.getSpaceInformation()
-    checker = Checker(si)
-    ss.setStateValidityChecker(checker)
+    ss._checker = Checker(si)  # referenced from Python, or it is collected
+    ss.setStateValidityChecker(ss._checker)
     ss.setStartAndGoalStates(set_state(si.allocState(), (0.1, 0.1)), set_state(si.allocState(), (0.9, 0.1)))
+    return ss
+
+
+@pytest.mark.parametrize("are_valid", [
+    lambda self, states: all(self.isValid(s) for s in states),  # "are all of these valid?": one bool
+    lambda self, states: [self.isValid(s) for s in states if isinstance(s, ob.State)],  # for OMPL states only
+    lambda self, Q: np.zeros(len(Q), dtype=bool),  # disagrees with isValid on the start
+    lambda self, Q, margin: np.ones(len(Q), dtype=bool),  # other arguments
+], ids=["all-valid", "ompl-states", "disagrees", "arguments"])
+def test_a_checker_method_named_are_valid_that_is_not_the_batched_call_is_passed_over_with_a_warning(
+        are_valid, caplog: pytest.LogCaptureFixture) -> None:
+    """A user's checker with a helper of that name meaning something else made every solve CRASH (the name alone
+    made the search take it for the batched call): it is asked once, on the start, and passed over with a warning
+    naming it; the states are then checked one by one, as RRTConnect checks them."""
+    ss = _wall_checker_setup(are_valid)
+    with caplog.at_level(logging.WARNING):
+        planner, status = _run(ss, seed=0, max_samples=300)
+    assert status == ob.PlannerStatus.EXACT_SOLUTION
+    assert caplog.text.count("the validity checker's are_valid (Checker)") == 1
+    assert path_passes_motion_checks(ss.getSpaceInformation(), ss.getSolutionPath().getStates())
+
+
+def test_a_batched_checker_answering_the_wrong_shape_later_is_named_in_the_error(
+        caplog: pytest.LogCaptureFixture) -> None:
+    """Right for the start alone, one answer too many for several states: the run ends in CRASH naming it."""
+    ss = _wall_checker_setup(lambda self, Q: np.ones(len(Q) + (len(Q) > 1), dtype=bool))
     with caplog.at_level(logging.ERROR):
         status = _run(ss, seed=0, max_samples=50)[1]
     assert status == ob.PlannerStatus.CRASH

@@ -419,7 +419,7 @@ class DimensionRRT(PythonPlanner):
         q0, fits = ends
         si, pdef = self.getSpaceInformation(), self.getProblemDefinition()
         layout, grouped = self.grouped.layout, self.grouped
-        checker = Checker(si, layout, self.batch)
+        checker = Checker(si, layout, self.batch, probe=q0)
         checks0 = checker.counter()
         release = self.options.release_after if grouped.prescribed and grouped.planned else None
 

@@ -9,7 +9,9 @@ failure) for screens that only need the first failure, and the project's motion 
 
 from __future__ import annotations
 
+import logging
 import math
+from collections.abc import Callable
 
 import numpy as np
 from ompl import base as ob
@@ -18,6 +20,8 @@ from .paths import bisection_levels, motion_interior_states
 from .space_layout import RealVectorLayout
 
 __all__ = ["Checker", "segment_key"]
+
+log = logging.getLogger(__name__)
 
 _COARSE_STRIDE = 16
 """First pass over a motion checks every 16th interior state (collisions span many states): 8 until
@@ -52,6 +56,23 @@ def _longest_stretch_key(level: np.ndarray, length: np.ndarray) -> np.ndarray:
     return -length / np.exp2(level + 1)
 
 
+def _answers_per_row(svc: ob.StateValidityChecker, are_valid: Callable[[np.ndarray], object], q: np.ndarray) -> bool:
+    """Whether a checker's ``are_valid`` is the batched call the search takes it for: one True for the row q, a
+    state ``isValid`` passed (the start).  A method of that name meaning something else ("are all of these
+    valid?") made every solve CRASH; it is passed over with a warning and the states are checked one by one.
+    A checker whose class sets ``batched_protocol = True`` (the project's) is not asked."""
+    try:
+        ok = np.asarray(are_valid(q[None, :]))
+        if ok.shape == (1,) and ok.dtype == bool and bool(ok[0]):
+            return True
+        got = f"returned {ok!r} for the start state, which isValid passed (one True wanted)"
+    except Exception as exc:  # noqa: BLE001 (a method of that name with other arguments)
+        got = f"raised {type(exc).__name__}: {exc}"
+    log.warning("the validity checker's are_valid (%s) %s: not taken as the batched check; checking state by state "
+                "(set batched_protocol = True on the checker's class to skip this test)", type(svc).__name__, got)
+    return False
+
+
 def segment_key(a: np.ndarray, b: np.ndarray) -> bytes:
     """Key of the motion a -> b (n,): the bytes of its two float64 ends, as ``W[k : k + 2].tobytes()``."""
     return np.ascontiguousarray(a, dtype=float).tobytes() + np.ascontiguousarray(b, dtype=float).tobytes()
@@ -60,12 +81,15 @@ def segment_key(a: np.ndarray, b: np.ndarray) -> bytes:
 class Checker:
     """Validity of states and motions for one SpaceInformation, batched when the setup allows it."""
 
-    def __init__(self, si: ob.SpaceInformation, layout: RealVectorLayout, batch: bool) -> None:
+    def __init__(self, si: ob.SpaceInformation, layout: RealVectorLayout, batch: bool,
+                 probe: np.ndarray | None = None) -> None:
         self.si = si
         self.layout = layout
         svc = si.getStateValidityChecker()
         mv = si.getMotionValidator()
         are_valid = getattr(svc, "are_valid", None)
+        if batch and callable(are_valid) and probe is not None and not getattr(svc, "batched_protocol", False):
+            are_valid = are_valid if _answers_per_row(svc, are_valid, probe) else None
         self.step: float | None = None
         self.euclid = True
         self._ompl_counts = False

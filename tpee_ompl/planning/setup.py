@@ -89,6 +89,9 @@ class RobotValidityChecker(ob.StateValidityChecker):
     ``are_valid`` offers the batched check to planners that know about it (dimension-RRT).
     """
 
+    batched_protocol = True
+    """``are_valid`` and ``first_invalid`` agree with ``isValid`` (tested): dimension-RRT takes them at their word."""
+
     def __init__(self, si: ob.SpaceInformation, robot: RobotChecker) -> None:
         super().__init__(si)
         self.robot = robot
