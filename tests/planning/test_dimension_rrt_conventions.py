@@ -244,6 +244,20 @@ def test_a_checker_method_named_are_valid_that_is_not_the_batched_call_is_passed
     assert path_passes_motion_checks(ss.getSpaceInformation(), ss.getSolutionPath().getStates())
 
 
+def test_a_batched_call_that_passes_what_is_valid_rejects_is_said_once_per_solve(
+        caplog: pytest.LogCaptureFixture) -> None:
+    """An are_valid that says True to everything (right for the start) had the search accept paths si.checkMotion
+    then rejected, each logged: over 100 warnings in 0.3 s.  One per solve now, naming the likely cause; every
+    path posted passed si.checkMotion all the same."""
+    ss = _wall_checker_setup(lambda self, Q: np.ones(len(Q), dtype=bool))
+    with caplog.at_level(logging.WARNING):
+        planner, status = _run(ss, seed=0, max_samples=2000)
+    assert caplog.text.count("rejected a path the search accepted") == 1
+    assert "is the checker's are_valid the same test as its isValid?" in caplog.text
+    if status == ob.PlannerStatus.EXACT_SOLUTION:
+        assert path_passes_motion_checks(ss.getSpaceInformation(), ss.getSolutionPath().getStates())
+
+
 def test_a_batched_checker_answering_the_wrong_shape_later_is_named_in_the_error(
         caplog: pytest.LogCaptureFixture) -> None:
     """Right for the start alone, one answer too many for several states: the run ends in CRASH naming it."""

@@ -66,6 +66,8 @@ class SolutionPoster:
         self.satisfied = False
         self._pending: tuple[np.ndarray, float] | None = None
         self._spent = 0.0
+        self.rejected = 0
+        """Paths the search accepted that ``si.checkMotion`` or the bounds rejected (said once per solve)."""
         self._passed: set[bytes] = set() if passed is None else passed
         """Segments (two waypoint rows as bytes) that already passed ``si.checkMotion``, shared with the
         search's checker so a motion it checked that way is not checked again."""
@@ -105,6 +107,10 @@ class SolutionPoster:
                 self.first_time = time.perf_counter() - self.t0
             self.notify(path, cost)
         else:
-            log.warning("DimensionRRT: si.checkMotion or the bounds rejected a path the search accepted; not reported")
+            self.rejected += 1
+            if self.rejected == 1:  # (one per improvement when the checker's batched call disagrees with isValid)
+                log.warning("DimensionRRT: si.checkMotion or the bounds rejected a path the search accepted; not "
+                            "reported (later ones in this solve are not logged: is the checker's are_valid the same "
+                            "test as its isValid?)")
             self.found_cost = self.best_cost  # not found after all: the loop must not stop on its cost
         self._spent += time.perf_counter() - t
