@@ -157,9 +157,25 @@ def test_settings_the_refining_planner_would_refuse_are_refused_when_the_pipelin
         LibraryDimensionRRT(ss.getSpaceInformation(), library, **kwargs)
 
 
-def test_a_joint_space_with_a_dimension_of_width_zero_is_refused_when_the_pipeline_is_made(library):
-    with pytest.raises(ValueError, match="width 0"):
-        LibraryDimensionRRT(ob.SpaceInformation(locked_dimension_space(4, 2, bound=3.0)), library)
+def test_a_joint_locked_by_bounds_of_width_zero_keeps_its_value_on_the_pipelines_path(robot, library):
+    """DOF4 locked at the start's value (bounds of width 0, as OMPL users lock a joint): refused until 2026-11-27;
+    the library's paths move DOF4, so they leave the bounds, and the path is planned with DOF4 kept."""
+    rng = np.random.default_rng(0)
+    s, g = _query(robot, 3, 4, 5)
+    g[3] = s[3]
+    while not robot.is_valid(g):
+        g[2] = rng.uniform(robot.lower[2], robot.upper[2])
+    ss = make_simple_setup(robot, s, g)
+    old, bounds = ss.getStateSpace().getBounds(), ob.RealVectorBounds(4)
+    for k in range(4):
+        bounds.setLow(k, float(s[3]) if k == 3 else old.low[k])
+        bounds.setHigh(k, float(s[3]) if k == 3 else old.high[k])
+    ss.getStateSpace().setBounds(bounds)
+    planner = LibraryDimensionRRT(ss.getSpaceInformation(), library, max_samples=300, seed=0)
+    ss.setPlanner(planner)
+    assert ss.solve(10.0) == ob.PlannerStatus.EXACT_SOLUTION and "error" not in planner.last_run_stats()
+    assert path_passes_motion_checks(ss.getSpaceInformation(), ss.getSolutionPath(), in_bounds=True)
+    assert np.all(path_to_array(ss.getSolutionPath(), 4)[:, 3] == s[3])
 
 
 def test_several_goal_states_are_planned_by_dimension_rrt_on_the_row_without_the_library(robot, library, caplog):

@@ -342,3 +342,21 @@ def test_initial_waypoints_set_after_the_bounds_widened_are_checked_against_the_
     planner.set_initial_waypoints(W)  # was refused: checked against the old bounds
     ss.setPlanner(planner)
     assert ss.solve(ob.timedPlannerTerminationCondition(60.0)) == ob.PlannerStatus.EXACT_SOLUTION
+
+
+@pytest.mark.parametrize("groups", [None, [[0, 1, 2]], [[0], [1, 2]], [[2], [0, 1]]])
+def test_a_dimension_locked_by_bounds_of_width_zero_keeps_its_value_for_every_grouping(groups) -> None:
+    """Bounds of width 0 lock a joint for OMPL's planners (RRTConnect planned the space; DimensionRRT refused it):
+    the locked dimension keeps its value on every waypoint, whether it is grouped with others or alone."""
+    from tests.helpers.planning_spaces import locked_dimension_space
+
+    ss = og.SimpleSetup(locked_dimension_space(3, 2, value=0.3))
+    ss.setStateValidityChecker(lambda s: not (-0.1 < s[0] < 0.1 and s[1] > -0.6))
+    si = ss.getSpaceInformation()
+    ss.setStartAndGoalStates(set_state(si.allocState(), (-0.8, 0.8, 0.3)), set_state(si.allocState(), (0.8, 0.8, 0.3)))
+    planner, status = _run(ss, seed=1, max_samples=600, **({} if groups is None else {"groups": groups}))
+    assert status == ob.PlannerStatus.EXACT_SOLUTION
+    path = ss.getSolutionPath()
+    assert path_passes_motion_checks(si, path.getStates(), in_bounds=True)
+    assert all(s[2] == 0.3 for s in path.getStates())
+    assert path.length() < 4.0  # round the wall's end (straight-line bound 3.1), not along the bounds

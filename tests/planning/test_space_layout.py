@@ -81,10 +81,20 @@ def test_a_space_whose_bounds_were_never_set_is_told_to_set_them() -> None:
     assert "locked" not in str(e.value)
 
 
-def test_a_dimension_locked_by_bounds_of_width_zero_is_refused_saying_so() -> None:
-    """OMPL users lock a joint with low == high; the error said "no valid bounds: call space.setBounds" (they were set)."""
-    with pytest.raises(ValueError, match=r"bounds of width 0 for dimension\(s\) \[1\].*locked"):
-        RealVectorLayout(locked_dimension_space(3, 1))
+def test_a_dimension_locked_by_bounds_of_width_zero_is_taken_but_a_space_of_nothing_else_is_refused() -> None:
+    """OMPL users lock a joint with low == high (RRTConnect plans such a space): it was refused; a RealVector space
+    (or a compound's subspace) locked in every dimension cannot move at all, and OMPL divides by its extent."""
+    layout = RealVectorLayout(locked_dimension_space(3, 1))
+    assert layout.lower[1] == layout.upper[1] == 0.5
+    one = ob.RealVectorStateSpace(2)
+    one.setBounds(0.5, 0.5)
+    with pytest.raises(ValueError, match="bounds of width 0 for every dimension: nothing in it can move"):
+        RealVectorLayout(one)
+    cs = ob.CompoundStateSpace()
+    cs.addSubspace(locked_dimension_space(2, 0), 1.0)
+    cs.addSubspace(one, 1.0)
+    with pytest.raises(ValueError, match=r"\(subspace \[1\]\) has bounds of width 0 for every dimension"):
+        RealVectorLayout(cs)
 
 
 def test_so2_leaves_wrap_around_like_the_space() -> None:

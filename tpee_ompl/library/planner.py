@@ -253,7 +253,7 @@ class LibraryDimensionRRT(PythonPlanner):
         if inner is None:
             try:
                 inner = DimensionRRT(si, opts)
-            except ValueError as e:  # e.g. bounds changed since this planner was made: a DOF of zero width
+            except ValueError as e:  # e.g. bounds changed since this planner was made: every DOF of zero width
                 log.error("LibraryDimensionRRT: no refinement: %s", e)
                 return planner_status(ob.PlannerStatus.EXACT_SOLUTION if have_exact else ob.PlannerStatus.ABORT)
         inner._say_start_choice = not read_ends  # noqa: SLF001 (the pipeline said which start it took)

@@ -159,8 +159,9 @@ class SampleDraws:
             more = range(have, max(2 * have, 128))
             self._scales = np.concatenate((self._scales, [self.narrowing ** (i / _NARROWING_UNIT) for i in more]))
             if self._floor is None:
-                self._floor = min((float(np.min(self.range_[gi] / (hi - lo))) for gi, (lo, hi) in self._bounds.items()),
-                                  default=0.0) * (1 - 1e-12)
+                self._floor = min((float(np.min(self.range_[gi][hi > lo] / (hi - lo)[hi > lo]))
+                                   for gi, (lo, hi) in self._bounds.items() if (hi > lo).any()),
+                                  default=0.0) * (1 - 1e-12)  # (a dimension of width 0 keeps its value)
             below = np.flatnonzero(self._scales <= self._floor)
             self._cut = int(below[0]) if len(below) else None
         return self._scales[k if self._cut is None else np.minimum(k, self._cut)]

@@ -85,20 +85,19 @@ class RealVectorLayout:
                 return  # holds no value (and would give an empty leaf to the metric's reduceat)
             b = space.getBounds()
             lo, hi = [float(v) for v in b.low], [float(v) for v in b.high]
-            bad = [i for i in range(len(lo)) if not (math.isfinite(lo[i]) and math.isfinite(hi[i]) and lo[i] < hi[i])]
+            # a dimension of width 0 is a joint locked this way: it keeps its value, as OMPL's samplers keep it
+            bad = [i for i in range(len(lo)) if not (math.isfinite(lo[i]) and math.isfinite(hi[i]) and lo[i] <= hi[i])]
             where = f" (subspace {list(path)})" if path else ""
-            if bad and not any(lo + hi):  # OMPL's RealVectorBounds start at 0 and 0: none were set
+            if not any(lo + hi):  # OMPL's RealVectorBounds start at 0 and 0: none were set
                 raise ValueError(f"RealVectorStateSpace{where} has no bounds (every low and high is 0): call "
                                  "space.setBounds(low, high) first")
             if bad:
-                locked = [i for i in bad if math.isfinite(lo[i]) and lo[i] == hi[i]]
-                other = [i for i in bad if i not in locked]
-                why = [f"bounds of width 0 for dimension(s) {locked} (a joint locked this way): dimension-RRT samples "
-                       "every dimension of the space; leave a locked joint out of the space (RobotChecker(..., "
-                       "locked={joint: value}) does) or give it a width"] if locked else []
-                why += [f"no valid bounds for dimension(s) {other} (low must be < high, both finite): call "
-                        "space.setBounds(low, high) first"] if other else []
-                raise ValueError(f"RealVectorStateSpace{where} has {'; and '.join(why)}")
+                raise ValueError(f"RealVectorStateSpace{where} has no valid bounds for dimension(s) {bad} (low must be "
+                                 "<= high, both finite): call space.setBounds(low, high) first")
+            if all(a == b for a, b in zip(lo, hi)):
+                raise ValueError(f"RealVectorStateSpace{where} has bounds of width 0 for every dimension: nothing in "
+                                 "it can move (and OMPL's motion checks divide by its extent); leave it out of the "
+                                 "space")
             huge = [i for i in range(len(lo)) if max(abs(lo[i]), abs(hi[i])) > MAX_BOUND]
             if huge:
                 raise ValueError(f"RealVectorStateSpace{where} has bounds beyond +/-{MAX_BOUND:g} for dimension(s) {huge}: "
