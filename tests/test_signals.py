@@ -33,17 +33,19 @@ def test_a_child_starts_with_sigint_blocked_and_a_ctrl_c_before_it_is_ready_does
     assert signal.SIGINT not in signal.pthread_sigmask(signal.SIG_BLOCK, set())  # the parent's mask is back
 
 
-def test_sigterm_within_the_block_interrupts_like_ctrl_c_and_the_handler_is_restored_after() -> None:
-    before = signal.getsignal(signal.SIGTERM)
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGHUP])
+def test_sigterm_or_sighup_within_the_block_interrupts_like_ctrl_c_and_the_handler_is_restored_after(sig) -> None:
+    """SIGHUP (a closed terminal) killed a campaign or a library build at once, its workers left blocked."""
+    before = signal.getsignal(sig)
     try:
         with sigterm_as_keyboard_interrupt():
-            os.kill(os.getpid(), signal.SIGTERM)
+            os.kill(os.getpid(), sig)
             for _ in range(1000):  # the handler runs between bytecodes
                 pass
-        raise AssertionError("SIGTERM did not interrupt")
+        raise AssertionError(f"{sig.name} did not interrupt")
     except KeyboardInterrupt:
         pass
-    assert signal.getsignal(signal.SIGTERM) == before
+    assert signal.getsignal(sig) == before
 
 
 @pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")  # Python's "Exception ignored"

@@ -1,4 +1,4 @@
-"""Signals: child processes that a Ctrl-C cannot interrupt while they start, and SIGTERM handled like Ctrl-C.
+"""Signals: child processes that a Ctrl-C cannot interrupt while they start; SIGTERM and SIGHUP handled like Ctrl-C.
 
 A Ctrl-C in a terminal sends SIGINT to every process of the foreground group, children included.  A child
 spawned a moment earlier is still importing (unpickling its task imports OMPL), and a KeyboardInterrupt
@@ -9,9 +9,10 @@ SIGINT is held, not lost, while the block lasts (starting a process: millisecond
 handled by :func:`sigterm_as_keyboard_interrupt` (it raises when the block ends: a Dask cluster interrupted
 while it started left a traceback at exit).
 
-:func:`sigterm_as_keyboard_interrupt`: within it SIGTERM (``kill``, a cluster's scheduler) ends the work the
-way Ctrl-C does, so the same cleanup runs (finished logs kept, child processes ended).  Both signals are
-also counted (:func:`interrupts`): Python drops an exception raised in a weakref callback or ``__del__``
+:func:`sigterm_as_keyboard_interrupt`: within it SIGTERM (``kill``, a cluster's scheduler) and SIGHUP (the terminal
+closed, an ssh session dropped) end the work the way Ctrl-C does, so the same cleanup runs (finished logs kept, child
+processes ended: a SIGHUP used to kill the command at once, leaving a library build's workers blocked for good).
+All are also counted (:func:`interrupts`): Python drops an exception raised in a weakref callback or ``__del__``
 (matplotlib's, while plots are drawn), so a caller asks after the work whether one came; within the block such a
 dropped KeyboardInterrupt prints nothing (``sys.unraisablehook``), other dropped exceptions print as before.
 """
@@ -25,16 +26,21 @@ import threading
 from collections.abc import Callable, Iterator
 from typing import Any
 
-__all__ = ["child_sigint", "interrupts", "sigint_blocked_for_children", "sigterm_as_keyboard_interrupt"]
+__all__ = ["STOP_SIGNALS", "child_sigint", "interrupts", "sigint_blocked_for_children", "sigterm_as_keyboard_interrupt"]
+
+STOP_SIGNALS: tuple[signal.Signals, ...] = tuple(getattr(signal, name) for name in ("SIGTERM", "SIGHUP")
+                                                 if hasattr(signal, name))
+"""The signals handled as Ctrl-C besides SIGINT (SIGHUP where the platform has it)."""
 
 _RECEIVED: list[int] = []
-"""Every SIGINT or SIGTERM the handler of :func:`sigterm_as_keyboard_interrupt` was called for, in order."""
+"""Every SIGINT, SIGTERM or SIGHUP the handler of :func:`sigterm_as_keyboard_interrupt` was called for, in order."""
 _HELD: list[int] = []
-"""Non-empty while children start (:func:`sigint_blocked_for_children`): a SIGTERM then waits for the block's end."""
+"""Non-empty while children start (:func:`sigint_blocked_for_children`): a SIGTERM or SIGHUP then waits for the
+block's end."""
 
 
 def interrupts() -> int:
-    """How many interrupts (SIGINT, SIGTERM) :func:`sigterm_as_keyboard_interrupt` has seen in this process: compare
+    """How many interrupts (SIGINT, SIGTERM, SIGHUP) :func:`sigterm_as_keyboard_interrupt` has seen here: compare
     the count before and after a piece of work to know whether one came, even one whose KeyboardInterrupt Python
     dropped."""
     return len(_RECEIVED)
@@ -57,7 +63,7 @@ def sigint_blocked_for_children() -> Iterator[None]:
     finally:
         _HELD.pop()
         signal.pthread_sigmask(signal.SIG_SETMASK, previous)  # a held SIGINT is delivered here
-        if len(_RECEIVED) > held and not _HELD:  # a SIGTERM came while the children started
+        if len(_RECEIVED) > held and not _HELD:  # a SIGTERM or SIGHUP came while the children started
             raise KeyboardInterrupt(f"signal {_RECEIVED[-1]}")
 
 
@@ -71,15 +77,15 @@ def child_sigint(handler: Callable[[int, Any], Any] | int) -> None:
 
 @contextlib.contextmanager
 def sigterm_as_keyboard_interrupt() -> Iterator[None]:
-    """Within the block, SIGTERM raises KeyboardInterrupt like Ctrl-C, and both are counted (:func:`interrupts`);
-    main thread only, a no-op elsewhere."""
+    """Within the block, SIGTERM and SIGHUP (:data:`STOP_SIGNALS`) raise KeyboardInterrupt like Ctrl-C, and all are
+    counted (:func:`interrupts`); main thread only, a no-op elsewhere."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
 
     def handler(signum: int, frame: object) -> None:
         _RECEIVED.append(signum)
-        if signum == signal.SIGTERM and _HELD:  # children are starting: raised when they have (as SIGINT's mask does)
+        if signum != signal.SIGINT and _HELD:  # children are starting: raised when they have (as SIGINT's mask does)
             return
         raise KeyboardInterrupt(f"signal {signum}")
 
@@ -87,7 +93,7 @@ def sigterm_as_keyboard_interrupt() -> Iterator[None]:
         if not (isinstance(info.exc_type, type) and issubclass(info.exc_type, KeyboardInterrupt)):
             previous_hook(info)
 
-    previous = signal.signal(signal.SIGTERM, handler)
+    previous = {sig: signal.signal(sig, handler) for sig in STOP_SIGNALS}
     default_int = signal.getsignal(signal.SIGINT) is signal.default_int_handler  # (not a handler of someone else's)
     previous_int = signal.signal(signal.SIGINT, handler) if default_int else None
     previous_hook, sys.unraisablehook = sys.unraisablehook, unraisable
@@ -95,6 +101,7 @@ def sigterm_as_keyboard_interrupt() -> Iterator[None]:
         yield
     finally:
         sys.unraisablehook = previous_hook
-        signal.signal(signal.SIGTERM, previous)
+        for sig, before in previous.items():
+            signal.signal(sig, before)
         if previous_int is not None:
             signal.signal(signal.SIGINT, previous_int)

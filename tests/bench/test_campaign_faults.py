@@ -176,7 +176,8 @@ def _wait_for(pred, timeout: float = 60.0) -> None:
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize(("sig", "moment"), [(signal.SIGINT, "first_log"), (signal.SIGTERM, "start")])
+@pytest.mark.parametrize(("sig", "moment"), [(signal.SIGINT, "first_log"), (signal.SIGTERM, "start"),
+                                             (signal.SIGHUP, "first_log")])  # (SIGHUP killed it without a word)
 def test_signal_keeps_finished_runs_never_half_writes_the_db_and_resume_completes(query_file, tmp_path, sig, moment,
                                                                                   capsys):
     proc = _launch(query_file, tmp_path)
