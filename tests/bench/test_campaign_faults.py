@@ -347,3 +347,23 @@ def test_a_worker_whose_campaign_is_killed_while_it_starts_exits_without_running
         proc.kill()
     (directory,) = tmp_path.glob("*_sig")
     assert not list((directory / "logs").glob("*.log"))  # the orphan ran nothing
+
+
+@pytest.mark.parametrize("when", ["versions", "folder"])
+def test_an_interrupt_as_the_campaign_starts_leaves_no_folder_and_says_nothing_was_written(
+        query_file, tmp_path, monkeypatch, capsys, when):
+    """A SIGTERM in the ~40 ms the package versions take to read (after the folder was made, before the cleanup's
+    try) left an empty folder that --resume refused ("no campaign.json there"), and the message said "--resume DIR"."""
+    import tpee_ompl.bench.campaign as campaign
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(campaign, "package_versions" if when == "versions" else "write_json", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        run_campaign(tiny_config(query_file, tmp_path / "a"), report=False, progress_bar=False)
+    assert not (tmp_path / "a").exists() or not any((tmp_path / "a").iterdir())
+    code = main(["--queries", str(query_file), "--samples", "30", "--planners", STANDIN, "RRTstar", "--workers", "1",
+                 "--out", str(tmp_path / "b"), "--no-progress"])
+    assert code == 130 and "interrupted before the campaign started; nothing was written" in capsys.readouterr().err
+    assert not (tmp_path / "b").exists() or not any((tmp_path / "b").iterdir())

@@ -202,7 +202,6 @@ def run_campaign(
 
 def _run_campaign(plan: CampaignPlan, on_task_done, report: bool, progress_bar: bool, executor) -> CampaignResult:
     config, queries = plan.config, plan.queries
-    directory = make_results_dir(config.out, config.name)
     cfg = dataclasses.asdict(config)
     meta = {
         "config": cfg,
@@ -220,11 +219,15 @@ def _run_campaign(plan: CampaignPlan, on_task_done, report: bool, progress_bar: 
         "started_utc": utc_now(),
         "interrupted": True,  # until the campaign ends (a killed campaign stays marked)
     }
+    directory = None  # (the folder is made last, and within the try: an interrupt in the ~40 ms the versions take
+    # to read came between them and left an empty folder that --resume refused)
     try:
+        directory = make_results_dir(config.out, config.name)
         (directory / "logs").mkdir()
         write_json(directory / "campaign.json", meta)
     except BaseException:  # a folder without campaign.json could not be resumed: leave none
-        shutil.rmtree(directory, ignore_errors=True)
+        if directory is not None:
+            shutil.rmtree(directory, ignore_errors=True)
         raise
     return _execute(directory, meta, executor, on_task_done, report, progress_bar, int(config.workers))
 

@@ -316,9 +316,13 @@ def _lost_line(failed: list[dict], shown: int = 5) -> str:
 
 
 def _interrupted(prog: str, where: object) -> int:
-    """Say that the campaign was interrupted and how to finish it; the exit code 130."""
-    print(f"{prog}: interrupted; finished logs are kept: finish the campaign with --resume {where or 'DIR'}",
-          file=sys.stderr)
+    """Say that the campaign was interrupted and how to finish it (``where``: its folder, None when none was made);
+    the exit code 130."""
+    if where is None:  # (it said "--resume DIR" of a folder that did not exist)
+        print(f"{prog}: interrupted before the campaign started; nothing was written", file=sys.stderr)
+    else:
+        print(f"{prog}: interrupted; finished logs are kept: finish the campaign with --resume {where}",
+              file=sys.stderr)
     return 130
 
 
