@@ -164,6 +164,32 @@ def test_a_pipe_is_refused_at_once_instead_of_read(robot: WearerArm, tmp_path) -
         PathLibrary.load(fifo, robot)
 
 
+def test_a_file_it_may_not_read_raises_permission_error_naming_it(robot: WearerArm, tmp_path, monkeypatch) -> None:
+    """A file of mode 000 was a LibraryFileError "unreadable (truncated or not a library file): not an .npz
+    archive" (zipfile.is_zipfile says False for a file it cannot open).  Root reads any file: its open is made to
+    refuse as the system does for another user."""
+    import builtins
+    import errno
+    import os
+
+    from tpee_ompl.library.storage import library_model_hash
+
+    f = write_library_file(tmp_path / "lib.npz")
+    f.chmod(0)
+    if os.access(f, os.R_OK):
+        real_open = builtins.open
+
+        def refusing_open(file, *args, **kwargs):
+            if isinstance(file, (str, os.PathLike)) and os.path.abspath(file) == os.path.abspath(f):
+                raise PermissionError(errno.EACCES, os.strerror(errno.EACCES), os.fspath(file))
+            return real_open(file, *args, **kwargs)
+
+        monkeypatch.setattr(builtins, "open", refusing_open)
+    for read in (lambda: PathLibrary.load(f, robot), lambda: library_model_hash(f)):
+        with pytest.raises(PermissionError, match=re.escape(f"path library {f} cannot be read (Permission denied)")):
+            read()
+
+
 def test_a_corrupt_compressed_array_is_a_library_file_error(robot: WearerArm, tmp_path) -> None:
     """A damaged deflate stream escaped as zlib.error ("unexpected error" from the command line, no file named)."""
     import zipfile

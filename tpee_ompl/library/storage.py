@@ -262,20 +262,25 @@ def _beyond_limit(name: str, x: np.ndarray) -> str | None:
 
 @contextlib.contextmanager
 def _open_archive(path: Path) -> Iterator[_Archive]:
-    """The library file at ``path`` open for reading: FileNotFoundError, or LibraryFileError for what is not a
-    regular file (a folder, a pipe: np.load would wait on it forever) or not an ``.npz`` archive."""
+    """The library file at ``path`` open for reading: FileNotFoundError, PermissionError naming the file (one it may
+    not read), or LibraryFileError for what is not a regular file (a folder, a pipe: np.load would wait on it
+    forever) or not an ``.npz`` archive."""
     if path.exists() and not path.is_file():
         raise LibraryFileError(f"path library {path} is not a regular file")
-    if path.is_file() and not zipfile.is_zipfile(path):  # numpy's own message would advise loading it with pickle
-        raise _unreadable(path, "not an .npz archive")
     try:
-        z = np.load(path, allow_pickle=False)
-    except FileNotFoundError:
-        raise
-    except _READ_ERRORS as exc:
-        raise _unreadable(path, exc) from exc
-    with z:
-        yield _Archive(z, path)
+        fh = open(path, "rb")  # opened first: zipfile.is_zipfile says False for a file it may not read
+    except PermissionError as exc:
+        raise PermissionError(f"path library {path} cannot be read ({exc.strerror})") from None
+    with fh:
+        if not zipfile.is_zipfile(fh):  # numpy's own message would advise loading it with pickle
+            raise _unreadable(path, "not an .npz archive")
+        try:
+            fh.seek(0)
+            z = np.load(fh, allow_pickle=False)
+        except _READ_ERRORS as exc:
+            raise _unreadable(path, exc) from exc
+        with z:
+            yield _Archive(z, path)
 
 
 def _read_meta(archive: _Archive) -> Any:
@@ -296,7 +301,8 @@ def _read_meta(archive: _Archive) -> Any:
 def library_model_hash(path: str | Path) -> str:
     """The model hash a library file was built for, read from its metadata alone.
 
-    Raises FileNotFoundError (no such file) or LibraryFileError (not a regular file, unreadable, no model hash):
+    Raises FileNotFoundError (no such file), PermissionError (a file it may not read) or LibraryFileError (not a
+    regular file, unreadable, no model hash):
     a damaged library is said as such, never taken for one of another model."""
     return _meta_with_model(Path(path))["model_hash"]
 
@@ -336,6 +342,8 @@ def read_library(path: str | Path, robot: WearerArm) -> tuple[dict[tuple[int, in
     ------
     FileNotFoundError
         If there is no such file.
+    PermissionError
+        If the file may not be read (the message names it).
     LibraryFileError
         If the file is damaged, has another format version, was built for another model, or a field
         or array is malformed (the message names it).
