@@ -218,3 +218,14 @@ def test_asking_for_more_queries_than_a_set_has_says_so(query_file, tmp_path, ca
     with caplog.at_level(logging.WARNING):
         plan = prepare_campaign(tiny_config(query_file, tmp_path, max_queries=500))
     assert any(f"has {len(plan.queries)} queries: all of them run" in r.getMessage() for r in caplog.records)
+
+
+def test_a_campaign_of_one_planner_at_sample_caps_says_so_and_draws_no_ratio_plot(query_file, tmp_path):
+    """``--planners RRTstar``: the report said it "ran one planner at no sample cap" (it ran at 30 samples) and
+    fig15_ratios_batched.png was an empty axis labelled RRTstar / RRTstar."""
+    cfg = tiny_config(query_file, tmp_path, sample_caps=(30,), iteration_planners=("RRTstar",), anytime_budgets=())
+    res = run_campaign(cfg, progress_bar=False)
+    text = (res.directory / "report.md").read_text()
+    assert text.startswith("No Table 4: it compares two planners at equal sample counts, and the campaign ran only "
+                           "RRTstar at its sample caps.")
+    assert not list(res.directory.rglob("fig15_ratios_*.png"))

@@ -459,7 +459,8 @@ def write_report(db_path: str | Path, directory: str | Path, expected: dict | No
     note = ""
     if seen and not ratios:  # sample caps were run, but not both planners of the ratio
         note = (f"No Table 4: it compares {planner} with {reference} at equal sample counts, and the campaign ran "
-                f"{' and '.join(absent) if absent else 'one planner'} at no sample cap.\n\n")
+                f"{' and '.join(absent)} at no sample cap.\n\n" if absent else "No Table 4: it compares two planners "
+                f"at equal sample counts, and the campaign ran only {planner} at its sample caps.\n\n")
     succ = success_table(runs, expected)
     quality = length_quality_table(runs)
     anytime = anytime_table(runs)

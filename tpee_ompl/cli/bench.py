@@ -113,7 +113,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--seed", type=seed, default=_default("seed"),
                    help="campaign seed in [1, 2**32-1]; query k's process uses seed + k (default: %(default)s)")
     p.add_argument("--max-time", type=seconds, default=_default("max_time"), help="safety limit per iteration-capped run, s")
-    p.add_argument("--out", type=nonempty, default=_default("out"), help="parent folder of the timestamped results folder")
+    p.add_argument("--out", type=nonempty, default=_default("out"),
+                   help="parent folder of the timestamped results folder (default: %(default)s, under the current folder)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     g = p.add_argument_group("executor (default: local process pool of --workers)")
     g.add_argument("--dask", metavar="local|tcp://HOST:PORT", type=nonempty, default=None,
