@@ -33,3 +33,12 @@ def test_the_names_static_tools_see_are_the_names_exported_on_first_use():
     block = next(n for n in tree.body if isinstance(n, ast.If) and getattr(n.test, "id", "") == "TYPE_CHECKING")
     static = {a.name: "." + n.module for n in block.body if isinstance(n, ast.ImportFrom) for a in n.names}
     assert static == tpee_ompl._EXPORTS
+
+
+def test_dir_of_the_package_lists_its_public_names_not_the_helpers_it_imports() -> None:
+    """dir(tpee_ompl) also listed Any, TYPE_CHECKING, annotations and importlib (the module's own imports)."""
+    import tpee_ompl
+
+    names = set(dir(tpee_ompl))
+    assert set(tpee_ompl.__all__) <= names and {"model", "planning", "__version__"} <= names
+    assert not names & {"Any", "TYPE_CHECKING", "annotations", "importlib"}

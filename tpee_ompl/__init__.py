@@ -135,4 +135,5 @@ def __getattr__(name: str) -> Any:
 
 
 def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(__all__) | _SUBPACKAGES)
+    """The public names, the subpackages and the module's dunders (not the helpers it imports: ``Any``, ``importlib``)."""
+    return sorted({n for n in globals() if n.startswith("__")} | set(__all__) | _SUBPACKAGES)
