@@ -153,3 +153,20 @@ def test_workspace_and_animate_show_a_progress_bar_unless_no_progress(tmp_path, 
     assert main(["workspace", "--samples", "50", "--no-progress", "-o", str(tmp_path / "w2.png")]) == 0
     assert main(["animate", "--path", str(path), "--frames", "3", "--no-progress", "-o", str(tmp_path / "m2.gif")]) == 0
     assert capsys.readouterr().err == ""
+
+
+@pytest.mark.parametrize("given", [["--from", "1", "--to", "4"], ["--time", "5"], ["--queries", "planning_necessary"],
+                                   ["--stall", "1000", "--seed", "1"]])
+def test_animate_path_refuses_planning_options_given_at_their_default_values(tmp_path, capsys, given: list[str]):
+    """--from 1 --to 4 (or any planning option at its default value) with --path were ignored without a word: the
+    check compared the values with the defaults instead of asking whether the option was given."""
+    from helpers.cli_queries import GOAL, START
+    from helpers.hostile_files import write_path_file
+
+    path = write_path_file(tmp_path / "p.json", [START, GOAL])
+    out = tmp_path / "m.gif"
+    assert main(["animate", "--path", str(path), *given, "-o", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    named = " ".join(a for a in given if a.startswith("--"))
+    assert err.endswith(f"--path animates the path in the file: {named} would be ignored"), err
+    assert not out.exists()

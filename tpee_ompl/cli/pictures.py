@@ -131,9 +131,9 @@ def cmd_animate(args: argparse.Namespace) -> int:
     if args.output.lower().endswith(".mp4") and not animation.writers.is_available("ffmpeg"):
         raise CliError(f"--output {args.output}: writing .mp4 needs ffmpeg on PATH; write a .gif instead")
     if args.path:
-        given = [option for dest, (default, option) in args.plan_options.items() if getattr(args, dest) != default]
-        if given:  # they plan a motion; --path animates the file's
-            raise CliError(f"--path animates the path in the file: {' '.join(given)} would be ignored")
+        if args.plan_options_given:  # they plan a motion (even at their default values); --path animates the file's
+            raise CliError(f"--path animates the path in the file: {' '.join(args.plan_options_given)} would be "
+                           "ignored")
         check_input_file(args.path, "--path", "path file")
         check_model_args(args)
         robot = load_robot(args)

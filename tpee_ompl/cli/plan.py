@@ -215,32 +215,50 @@ def cmd_plan(args: argparse.Namespace) -> int:
     return 0 if result["exact"] else 1
 
 
+class _StoreNoted(argparse._StoreAction):  # noqa: SLF001 (argparse's plain "store", which it extends)
+    """argparse's "store" that also notes the option in ``args.plan_options_given``: ``animate --path`` plans
+    nothing and refuses each one given, also when given at its default value (``--from 1``)."""
+
+    def __call__(self, parser: argparse.ArgumentParser, namespace: argparse.Namespace, values: Any,
+                 option_string: str | None = None) -> None:
+        super().__call__(parser, namespace, values, option_string)
+        given = list(getattr(namespace, "plan_options_given", None) or [])  # a new list: the default one stays empty
+        if self.option_strings[0] not in given:
+            given.append(self.option_strings[0])
+        namespace.plan_options_given = given
+
+
 def add_plan_args(p: argparse.ArgumentParser, required: bool = False) -> None:
-    """The arguments of one planning problem (sectors, planner, limits, start/goal or a stored query)."""
-    p.add_argument("--from", dest="from_sector", type=sector, required=required, default=1,
+    """The arguments of one planning problem (sectors, planner, limits, start/goal or a stored query); the ones given
+    are listed in ``args.plan_options_given``."""
+    p.add_argument("--from", action=_StoreNoted, dest="from_sector", type=sector, required=required, default=1,
                    help="start posture sector (1-4)")
-    p.add_argument("--to", dest="to_sector", type=sector, required=required, default=4, help="goal posture sector (1-4)")
-    p.add_argument("--planner", choices=tuple(PLANNERS), default=None,
+    p.add_argument("--to", action=_StoreNoted, dest="to_sector", type=sector, required=required, default=4,
+                   help="goal posture sector (1-4)")
+    p.add_argument("--planner", action=_StoreNoted, choices=tuple(PLANNERS), default=None,
                    help="library: the DMP path library's validated path, refined by dimension-RRT (default when a "
                         "library for the model is at hand, else dimension-rrt); rrtconnect-simplify: RRTConnect + "
                         "OMPL's PathSimplifier; the others: OMPL's planners")
-    p.add_argument("--library", type=nonempty, default=None, metavar="FILE",
+    p.add_argument("--library", action=_StoreNoted, type=nonempty, default=None, metavar="FILE",
                    help="path library of --planner library (default: the packaged one, for the packaged model; "
                         "'tpee-ompl library build --urdf U --srdf S --library FILE' builds one for another)")
-    p.add_argument("--time", type=seconds, default=5.0, help="time limit in seconds, at most a day (default 5)")
-    p.add_argument("--samples", type=positive_int, default=None, help="sample / iteration cap")
-    p.add_argument("--stall", type=count, default=DEFAULT_STALL,
+    p.add_argument("--time", action=_StoreNoted, type=seconds, default=5.0,
+                   help="time limit in seconds, at most a day (default 5)")
+    p.add_argument("--samples", action=_StoreNoted, type=positive_int, default=None, help="sample / iteration cap")
+    p.add_argument("--stall", action=_StoreNoted, type=count, default=DEFAULT_STALL,
                    help="library / dimension-rrt: stop after this many samples without a shorter path, before --time "
                         f"(0: use the whole --time; default {DEFAULT_STALL})")
-    p.add_argument("--seed", type=seed, default=1, help="OMPL / planner seed, 1..2^32-1 (default 1)")
-    p.add_argument("--queries", type=nonempty, default="planning_necessary",
+    p.add_argument("--seed", action=_StoreNoted, type=seed, default=1,
+                   help="OMPL / planner seed, 1..2^32-1 (default 1)")
+    p.add_argument("--queries", action=_StoreNoted, type=nonempty, default="planning_necessary",
                    help="query set name or JSON file (made for the loaded model: its model_hash must match)")
-    p.add_argument("--query-index", type=index, default=0, help="which query of that pair, from 0 (default 0)")
-    p.add_argument("--start", type=finite, nargs=4, default=None, metavar="Q", help="start DOF1..DOF4 (rad)")
-    p.add_argument("--goal", type=finite, nargs=4, default=None, metavar="Q", help="goal DOF1..DOF4 (rad)")
-    # what planning was asked for beyond the defaults (``animate --path`` plans nothing: it refuses these)
-    p.set_defaults(plan_options={a.dest: (a.default, a.option_strings[0]) for a in p._actions  # noqa: SLF001
-                                 if a.option_strings and a.dest not in ("help", "json")})
+    p.add_argument("--query-index", action=_StoreNoted, type=index, default=0,
+                   help="which query of that pair, from 0 (default 0)")
+    p.add_argument("--start", action=_StoreNoted, type=finite, nargs=4, default=None, metavar="Q",
+                   help="start DOF1..DOF4 (rad)")
+    p.add_argument("--goal", action=_StoreNoted, type=finite, nargs=4, default=None, metavar="Q",
+                   help="goal DOF1..DOF4 (rad)")
+    p.set_defaults(plan_options_given=[])
     add_model_args(p)
 
 
