@@ -170,3 +170,27 @@ def test_animate_path_refuses_planning_options_given_at_their_default_values(tmp
     named = " ".join(a for a in given if a.startswith("--"))
     assert err.endswith(f"--path animates the path in the file: {named} would be ignored"), err
     assert not out.exists()
+
+
+def test_animate_path_refuses_a_plan_that_is_not_exact(tmp_path, capsys):
+    """A ``plan --json`` file of an approximate plan ("exact": false, plan's exit 1) was animated without a word, while
+    animate planning the motion itself refuses one ("found no exact path ...; nothing to animate")."""
+    import json
+
+    from helpers.cli_queries import GOAL, START
+
+    doc = {"planner": "rrtstar", "from_sector": 1, "to_sector": 4, "query_id": 20, "status": "Approximate solution",
+           "exact": False, "valid": True, "path": [list(START), list(GOAL)]}
+    path = tmp_path / "approx.json"
+    path.write_text(json.dumps(doc), encoding="utf-8")
+    out = tmp_path / "m.gif"
+    assert main(["animate", "--path", str(path), "-o", str(out)]) == 1
+    err = capsys.readouterr().err.strip()
+    assert err.endswith(f"--path {path}: its plan found no exact path (\"exact\": false, status 'Approximate "
+                        "solution'); nothing to animate"), err
+    assert not out.exists()
+    path.write_text(json.dumps({**doc, "exact": "no"}), encoding="utf-8")
+    assert main(["animate", "--path", str(path), "-o", str(out)]) == 1
+    assert "'exact' must be true or false, got 'no'" in capsys.readouterr().err
+    path.write_text(json.dumps({**doc, "exact": True, "status": "Exact solution"}), encoding="utf-8")
+    assert main(["animate", "--path", str(path), "--frames", "2", "--no-progress", "-o", str(out)]) == 0

@@ -93,14 +93,23 @@ def cmd_show(args: argparse.Namespace) -> int:
 
 def _read_path(file: str, robot: WearerArm) -> np.ndarray:
     """The 'path' list of waypoints in a JSON file (e.g. from ``plan --json``): at least two waypoints (a motion) of
-    the robot's ``nq`` finite numbers (JSON numbers, not strings or booleans) within its joint limits; ValueError
-    naming the file and the waypoint otherwise."""
+    the robot's ``nq`` finite numbers (JSON numbers, not strings or booleans) within its joint limits, and not marked
+    ``"exact": false`` (an approximate plan, which ``animate`` does not draw); ValueError naming the file and the
+    waypoint otherwise."""
     try:
         with open(file, encoding="utf-8") as fh:
             doc = json.load(fh)
     except (OSError, UnicodeDecodeError, json.JSONDecodeError, RecursionError) as exc:
         raise ValueError(f"cannot read a path from --path {file}: {exc}") from None
     W = doc.get("path") if isinstance(doc, dict) else None
+    exact = doc.get("exact", True) if isinstance(doc, dict) else True  # plan --json says it; a hand-made file may not
+    if exact is not True:
+        status = doc.get("status")
+        said = f", status {status[:80]!r}" if isinstance(status, str) else ""
+        if exact is False:
+            raise ValueError(f"--path {file}: its plan found no exact path (\"exact\": false{said}); nothing to "
+                             "animate")
+        raise ValueError(f"--path {file}: 'exact' must be true or false, got {exact!r}"[:300])
     if not isinstance(W, list) or not W:
         raise ValueError(f"--path {file}: expected a JSON object with a non-empty 'path' list of waypoints")
     if len(W) < 2:
