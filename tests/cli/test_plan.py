@@ -182,3 +182,23 @@ def test_track_json_says_where_its_csv_went(capsys, tmp_path):
     csv = tmp_path / "traj.csv"
     assert main(["track", "--script", "jitter", "--duration", "1", "--json", "-o", str(csv)]) == 0
     assert json.loads(capsys.readouterr().out)["output"] == str(csv) and csv.is_file()
+
+
+@pytest.mark.parametrize("planner", ["rrtstar", "rrtconnect", "bitstar"])
+@pytest.mark.parametrize("stall", ["5", "1000"])
+def test_stall_with_a_planner_that_does_not_read_it_is_a_usage_error(capsys, planner: str, stall: str):
+    """--stall was ignored without a word by the planners that do not use it (plan --planner rrtstar --stall 5)."""
+    assert main(_args("--planner", planner, "--stall", stall, "--time", "0.05")) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == f"tpee-ompl plan: error: --stall is read by --planner dimension-rrt and library, not {planner}"
+
+
+@pytest.mark.parametrize("planner", [[], ["--planner", "dimension-rrt"], ["--planner", "library"]])
+def test_stall_is_taken_by_the_planners_that_read_it(capsys, monkeypatch, planner: list[str]):
+    import tpee_ompl.bench.planners as planners
+
+    # a fresh library cache: a library loaded by an earlier test holds another robot instance, which
+    # PathLibrary.check_robot takes for another robot (it compares the bound methods robot.pair_margins)
+    monkeypatch.setattr(planners, "_LIBRARIES", {})
+    assert main(_args(*planner, "--stall", "5", "--time", "0.5", "--json")) == 0
+    assert json.loads(capsys.readouterr().out)["exact"]

@@ -48,6 +48,9 @@ MAX_TRACK_SAMPLES = 100_000
 DEFAULT_STALL = 1000
 """``plan --stall``: samples without a shorter path after which dimension-RRT counts as converged."""
 
+_STALL_PLANNERS = ("dimension-rrt", "library")
+"""The ``--planner`` choices that read ``--stall`` (the default planner is one of them)."""
+
 PLANNERS = CLI_PLANNER_NAMES
 """``--planner`` choices: CLI name -> planner class name (``ompl.geometric.<name>``; DimensionRRT is this package's)."""
 
@@ -89,6 +92,8 @@ def check_plan_args(args: argparse.Namespace) -> None:
             raise CliError(f"--library is read by --planner library, not {args.planner}")
         args.planner = "library"
         check_input_file(args.library, "--library", "path library")
+    if "--stall" in getattr(args, "plan_options_given", ()) and args.planner not in (None, *_STALL_PLANNERS):
+        raise CliError(f"--stall is read by --planner {' and '.join(_STALL_PLANNERS)}, not {args.planner}")
 
 
 def _default_planner(args: argparse.Namespace, robot: WearerArm) -> str:
