@@ -244,3 +244,39 @@ def test_a_model_given_without_its_srdf_whose_every_configuration_collides_is_wa
     caplog.clear()
     assert main(["aim", "--target", "5", "2", "1.5", "--urdf", str(urdf), "--srdf", str(srdf)]) == 0
     assert "collision pair" not in caplog.text
+
+
+@pytest.mark.parametrize("argv", [["aim", "--target", "5", "2", "1.5"], ["aim", "--target", "5", "2", "1.5", "--json"],
+                                  ["plan", "--from", "1", "--to", "4", "--planner", "rrtconnect", "--time", "1",
+                                   "--json"]])
+def test_standard_output_on_a_full_device_is_named_in_one_line_with_exit_1(argv):
+    """``tpee-ompl plan ... > /dev/full`` said "error: [Errno 28] No space left on device", not what could not be
+    written."""
+    import os
+    import subprocess
+    import sys
+
+    if not os.path.exists("/dev/full"):
+        pytest.skip("no /dev/full here")
+    with open("/dev/full", "w") as full:
+        proc = subprocess.run([sys.executable, "-m", "tpee_ompl", *argv], stdout=full, stderr=subprocess.PIPE,
+                              text=True, timeout=120)
+    assert (proc.returncode, proc.stderr) == (1, f"tpee-ompl {argv[0]}: error: cannot write to standard output: No "
+                                                 "space left on device\n")
+
+
+def test_a_failing_write_of_a_long_output_names_standard_output_too(monkeypatch, capsys):
+    """The output that fills the buffer fails inside the command's print, not at the final flush."""
+    import errno
+    import io
+    import os
+    import sys
+
+    class Full(io.StringIO):
+        def write(self, text: str) -> int:
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    monkeypatch.setattr(sys, "stdout", Full())
+    assert main(["aim", "--target", "5", "2", "1.5"]) == 1
+    assert capsys.readouterr().err == "tpee-ompl aim: error: cannot write to standard output: No space left on device\n"
+    assert isinstance(sys.stdout, Full)  # put back

@@ -14,13 +14,15 @@ the reader of its output went away (``tpee-ompl plan ... | head -1``), as a comm
 from __future__ import annotations
 
 import argparse
+import contextlib
 import gc
 import logging
 import os
 import select
 import sys
 import traceback
-from collections.abc import Sequence
+from collections.abc import Iterable, Iterator, Sequence
+from typing import Any, TextIO
 
 from .._version import __version__
 from ..signals import interrupts, sigterm_as_keyboard_interrupt
@@ -71,10 +73,15 @@ def main(argv: Sequence[str] | None = None) -> int:
     seen = interrupts()
     try:
         with sigterm_as_keyboard_interrupt():  # kill / a scheduler: the same cleanup as Ctrl-C (temporary files, workers)
+            stdout = sys.stdout
+            if stdout is not None:
+                sys.stdout = _NamedStdout(stdout)
             try:
                 code = int(args.func(args) or 0)
                 sys.stdout.flush()  # a closed pipe shows here, not in the interpreter's own flush at exit
             finally:  # in here: an interrupt during it is said like any other (it printed a traceback, or exit 0)
+                if isinstance(sys.stdout, _NamedStdout):
+                    sys.stdout = stdout
                 gc.collect()  # break si <-> Python checker cycles before exit (nanobind leak warnings otherwise)
             if interrupts() > seen and code != 130:  # its KeyboardInterrupt was dropped (raised in a weakref callback)
                 raise KeyboardInterrupt
@@ -91,6 +98,39 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         print(f"{args.prog}: interrupted", file=sys.stderr)
         return 130
+
+
+class _NamedStdout:
+    """``sys.stdout`` while a command runs: a write or flush that fails (``> /dev/full``: no space left on device)
+    raises an OSError saying it was standard output; a closed pipe's BrokenPipeError passes unchanged (exit 141)."""
+
+    def __init__(self, stream: TextIO) -> None:
+        self._stream = stream
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._stream, name)
+
+    def write(self, text: str) -> int:
+        with self._named():
+            return self._stream.write(text)
+
+    def writelines(self, lines: Iterable[str]) -> None:
+        with self._named():
+            self._stream.writelines(lines)
+
+    def flush(self) -> None:
+        with self._named():
+            self._stream.flush()
+
+    @staticmethod
+    @contextlib.contextmanager
+    def _named() -> Iterator[None]:
+        try:
+            yield
+        except BrokenPipeError:
+            raise
+        except OSError as exc:
+            raise OSError(f"cannot write to standard output: {exc.strerror or exc}") from exc
 
 
 def _command_parser(parser: argparse.ArgumentParser, args: argparse.Namespace) -> argparse.ArgumentParser:
