@@ -2,10 +2,10 @@
 
 Exit codes (:func:`tpee_ompl.cli.main.main`): **2** for a usage error -- argparse's own, or a
 :class:`CliError` raised while the arguments are checked, before any work starts (a bad value, a
-missing input file, an output that exists without ``--force``), and for an optional extra that is not
-installed (an ImportError saying what to install); **1** for a runtime error -- anything
+missing input file, an output that exists without ``--force``); **1** for a runtime error -- anything
 raised once the work has started (a damaged library or query file, a model mismatch, a planner
-failure, an unexpected exception).  Either way: one line on stderr, no traceback (``-v`` adds it).
+failure, an optional extra that is not installed: an ImportError saying what to install, an unexpected
+exception).  Either way: one line on stderr, no traceback (``-v`` adds it).
 
 :func:`argument` turns a ValueError raised while one argument is checked into a :class:`CliError`
 naming it; :func:`check_input_file` and :func:`check_output` are the input- and output-file checks.

@@ -3,10 +3,10 @@
 One module per command group, each with ``register(sub, fmt)``: :mod:`.plan` (plan, aim, track),
 :mod:`.pictures` (show, animate, workspace, view), :mod:`.library` (library build|query|stats) and
 the bench group.  Every subcommand is one function.  Errors are one line on stderr, never a
-traceback (``-v`` adds it): exit code 2 for a usage error (argparse's, a
-:class:`~tpee_ompl.cli._common.CliError` from the argument checks that run before any work, or a missing
-optional extra: an ImportError saying what to install), 1 for
-an error at run time (a damaged input file, a model mismatch, a failure, anything unexpected),
+traceback (``-v`` adds it): exit code 2 for a usage error (argparse's, or a
+:class:`~tpee_ompl.cli._common.CliError` from the argument checks that run before any work), 1 for
+an error at run time (a damaged input file, a model mismatch, a failure, a missing optional extra: an
+ImportError saying what to install, anything unexpected),
 130 when interrupted (Ctrl-C, or SIGTERM, which every command handles as Ctrl-C), 141 without a word when
 the reader of its output went away (``tpee-ompl plan ... | head -1``), as a command killed by SIGPIPE.
 """
@@ -172,8 +172,8 @@ def _describe(exc: Exception) -> tuple[int, str]:
     """Exit code and one-line message for an exception a command raised."""
     if isinstance(exc, CliError):
         return 2, str(exc)
-    if isinstance(exc, ImportError):  # an optional extra is missing: the message says what to install
-        return 2, str(exc)
+    if isinstance(exc, ImportError):  # an optional extra is missing (the message says what to install): the
+        return 1, str(exc)  # arguments were right, the installation lacks it
     if isinstance(exc, KeyError) and exc.args:
         return 1, str(exc.args[0])
     if isinstance(exc, (ValueError, OSError, RuntimeError)):
