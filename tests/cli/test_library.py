@@ -283,3 +283,16 @@ def test_a_library_file_it_may_not_read_is_said_to_be_unreadable_by_permission(s
     err = capsys.readouterr().err.strip()
     assert err.endswith(f"error: path library {lib} cannot be read (Permission denied)"), err
     assert len(err.splitlines()) == 1
+
+
+@pytest.mark.parametrize("command", [[], ["plan"], ["aim"], ["track"], ["show"], ["animate"], ["workspace"], ["view"],
+                                     ["bench"], ["library"], ["library", "build"], ["library", "query"],
+                                     ["library", "stats"]])
+def test_no_help_sends_the_reader_to_docs_which_the_wheel_does_not_ship(command: list[str], capsys) -> None:
+    """``library build --help`` said "docs/dmp.md says why" of --dmp-scaling; docs/ is not in the wheel."""
+    with pytest.raises(SystemExit):
+        main([*command, "--help"])
+    out = " ".join(capsys.readouterr().out.split())
+    assert "docs/" not in out and ".md" not in out
+    if command == ["library", "build"]:
+        assert "absolute forcing shifts the detour unchanged" in out

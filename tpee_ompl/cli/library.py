@@ -240,7 +240,9 @@ def register(subparsers: argparse._SubParsersAction, formatter_class: type = arg
                    help=f"processes building the pairs in parallel (default {d.workers})")
     b.add_argument("--dmp-scaling", choices=("none", "amplitude"), default=d.dmp_options.scaling,
                    help="DMP forcing: 'amplitude' = eq. 13's x(g - y0), 'none' = absolute "
-                        f"(default {d.dmp_options.scaling}; docs/dmp.md says why)")
+                        f"(default {d.dmp_options.scaling}: eq. 13's scaling shrinks a demo's detour around the "
+                        "backpack, or mirrors it into the body, for a query whose pan moves less far or the other "
+                        "way; absolute forcing shifts the detour unchanged)")
     b.add_argument("--no-progress", action="store_true", help="no progress bar (pairs done, time left)")
     add_force_arg(b)
     b.set_defaults(func=run_build)
