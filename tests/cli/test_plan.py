@@ -194,11 +194,6 @@ def test_stall_with_a_planner_that_does_not_read_it_is_a_usage_error(capsys, pla
 
 
 @pytest.mark.parametrize("planner", [[], ["--planner", "dimension-rrt"], ["--planner", "library"]])
-def test_stall_is_taken_by_the_planners_that_read_it(capsys, monkeypatch, planner: list[str]):
-    import tpee_ompl.bench.planners as planners
-
-    # a fresh library cache: a library loaded by an earlier test holds another robot instance, which
-    # PathLibrary.check_robot takes for another robot (it compares the bound methods robot.pair_margins)
-    monkeypatch.setattr(planners, "_LIBRARIES", {})
+def test_stall_is_taken_by_the_planners_that_read_it(capsys, planner: list[str]):
     assert main(_args(*planner, "--stall", "5", "--time", "0.5", "--json")) == 0
     assert json.loads(capsys.readouterr().out)["exact"]

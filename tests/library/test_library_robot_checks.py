@@ -29,6 +29,16 @@ def test_a_library_is_refused_by_a_pipeline_or_default_planner_for_a_robot_with_
         make_default_planner(wider, library=library)
 
 
+def test_a_library_is_taken_by_another_robot_of_the_same_model_and_margins(library):
+    """check_robot compared the bound methods ``pair_margins`` (not their values): a second WearerArm() of the same
+    model and margins was refused as "other collision margins (security_margin 0.02 against 0.02 m)"."""
+    other = WearerArm()
+    assert other is not library.robot and other.model_hash == library.robot.model_hash
+    library.check_robot(other)
+    q = load_queries("planning_necessary", other)[0]
+    LibraryDimensionRRT(make_simple_setup(other, q.start, q.goal).getSpaceInformation(), library, 1, 2)
+
+
 def test_a_library_of_another_model_is_named_by_check_robot(library):
     class Other:
         model_hash = "0123456789abcdef"

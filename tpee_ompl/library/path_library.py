@@ -263,7 +263,7 @@ class PathLibrary:
         if getattr(robot, "model_hash", None) != mine.model_hash:
             raise ValueError(f"{what}: built for model {mine.model_hash!r}, not the robot's "
                              f"{getattr(robot, 'model_hash', None)!r} (load or build one for this model)")
-        if not np.array_equal(robot.pair_margins, mine.pair_margins):
+        if not np.array_equal(robot.pair_margins(), mine.pair_margins()):
             raise ValueError(f"{what}: its robot has other collision margins than this robot (security_margin "
                              f"{mine.security_margin:g} against {robot.security_margin:g} m): load it with this robot")
 
