@@ -48,11 +48,12 @@ def test_cli_planner_names_are_the_anytime_planners():
     assert set(CLI_PLANNER_NAMES.values()) <= set(PLANNER_FACTORIES)
 
 
-def test_missing_dask_gives_a_clear_error(monkeypatch, capsys, tmp_path):
+def test_missing_dask_gives_a_clear_error_and_exits_1(monkeypatch, capsys, tmp_path):
+    """A missing optional extra is a runtime condition (exit 1, as view without meshcat); it exited 2, a usage error's."""
     monkeypatch.setitem(sys.modules, "distributed", None)  # import distributed -> ImportError
     code = main(["--dask", "local", "--samples", "10", "--anytime", "--out", str(tmp_path), "--no-progress"])
     err = capsys.readouterr().err
-    assert code == 2 and "pip install" in err and "dask" in err
+    assert code == 1 and "pip install" in err and "dask" in err
     assert not list(tmp_path.iterdir())  # nothing started
 
 

@@ -236,7 +236,8 @@ def run(args: argparse.Namespace) -> int:
     except (ValueError, FileNotFoundError, ImportError) as exc:
         given = {"scheduler": "--scheduler"} if args.scheduler and not args.dask else None
         print(f"{prog}: error: {_user_message(exc, given)}", file=sys.stderr)
-        return 1 if isinstance(exc, QuerySetError) else 2  # a damaged query file is a runtime error, as in ``plan``
+        # a damaged query file and a missing optional extra (dask) are runtime conditions, as in ``plan`` and ``view``
+        return 1 if isinstance(exc, (QuerySetError, ImportError)) else 2
     seen = interrupts()
     try:
         if args.resume:

@@ -7,7 +7,7 @@ traceback (``-v`` adds it): exit code 2 for a usage error (argparse's, or a
 :class:`~tpee_ompl.cli._common.CliError` from the argument checks that run before any work), 1 for
 an error at run time (a damaged input file, a model mismatch, a failure, a missing optional extra: an
 ImportError saying what to install, anything unexpected),
-130 when interrupted (Ctrl-C, or SIGTERM, which every command handles as Ctrl-C), 141 without a word when
+130 when interrupted (Ctrl-C, or SIGTERM or SIGHUP, which every command handles as Ctrl-C), 141 without a word when
 the reader of its output went away (``tpee-ompl plan ... | head -1``), as a command killed by SIGPIPE.
 """
 
