@@ -99,14 +99,26 @@ def test_of_more_goal_states_than_max_goals_the_nearest_are_kept_on_every_solve(
         assert planner.last_run_stats()["samples"] == 400  # the cap counts the samples of all goals
 
 
-def test_goal_states_beyond_max_goals_are_named_in_a_warning(caplog) -> None:
+def test_goal_states_beyond_max_goals_are_named_in_the_log(caplog) -> None:
     ss = _point_setup()
     ss.setGoal(_goal_states(ss, [(0.9, 0.5), (0.85, 0.15), (0.9, 0.9), (0.95, 0.1)]))
     planner = DimensionRRT(ss.getSpaceInformation(), groups=[[0, 1]], seed=3, max_samples=50, max_goals=2)
     ss.setPlanner(planner)
-    with caplog.at_level("WARNING"):
+    with caplog.at_level("INFO"):
         ss.solve(10.0)
-    assert "the 2 goal states nearest the start, of 4 (max_goals)" in caplog.text
+    assert "the 2 goal states nearest the start, of 4 (max_goals); the others take the place" in caplog.text
+
+
+def test_goal_states_beyond_max_goals_take_the_place_of_those_that_find_no_path() -> None:
+    """The max_goals nearest goal states sealed off made every solve a TIMEOUT, while a farther one was reachable
+    (RRTConnect found it in milliseconds): a search without a path after GOAL_SWAP_AFTER samples gives its place
+    to the next goal state beyond them."""
+    ss = _point_setup()
+    status, planner = _solve(ss, _goal_states(ss, [(0.9, 0.5), (0.85, 0.15), (0.9, 0.9), (0.95, 0.1)]),
+                             max_samples=4000, max_goals=2)
+    assert status == ob.PlannerStatus.EXACT_SOLUTION
+    assert tuple(_proven(ss)[-1]) in ((0.9, 0.5), (0.9, 0.9))
+    assert planner.last_run_stats()["goals"] > 2
 
 
 def test_of_several_start_states_the_first_valid_is_planned_from_and_a_warning_says_so(caplog) -> None:

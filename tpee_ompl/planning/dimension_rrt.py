@@ -91,7 +91,9 @@ between batches of samples and, in the shortcut sweeps, before each batch of can
 Goal regions: a goal that is not one state (``GoalStates``, e.g. several IK solutions, or any other
 ``GoalSampleableRegion``) gives its ``max_goals`` valid goal states nearest the start (of a region: of
 ``max_goals`` drawn), and each gets its own search
-(:mod:`tpee_ompl.planning.goal_runs`), nearest to the start first, in turns of 100 samples; every
+(:mod:`tpee_ompl.planning.goal_runs`), nearest to the start first, in turns of 100 samples (a search with no
+path after 500 samples gives its place to the next of the other goal states, its own goal going to the back of
+that queue, so a goal sealed off does not hold the solve for good); every
 search's shorter paths go to the same problem definition, and a goal whose start-goal distance is no
 shorter than the best path found stops.  A goal off a prescribed row is skipped.  Of several start states
 the first valid one is planned from (OMPL's RRTConnect grows its start tree from all of them).
@@ -404,8 +406,8 @@ class DimensionRRT(PythonPlanner):
         if len(fits) > 1:
             fits.sort(key=lambda q1: float(layout.distance(q0, q1)))  # nearest first (stable)
         if len(fits) > self.options.max_goals:
-            log.warning("%s plans to the %d goal states nearest the start, of %d (max_goals)", self.getName(),
-                        self.options.max_goals, len(fits))
+            log.info("%s plans to the %d goal states nearest the start, of %d (max_goals); the others take the place "
+                     "of one that found no path", self.getName(), self.options.max_goals, len(fits))
         return q0, fits
 
     def _solve(self, ptc: ob.PlannerTerminationCondition) -> ob.PlannerStatus:
@@ -431,15 +433,19 @@ class DimensionRRT(PythonPlanner):
             return Search(grouped_, checker, self._rng, q0, goal, settings, self._ranges(grouped_), initial, turns,
                           local=local)
 
+        def new_run(q1: np.ndarray) -> GoalRun:
+            return GoalRun(q1, grouped, new_search(grouped, q1, self._initial), release, float(layout.distance(q0, q1)))
+
         runs = []  # each search checks its initial path: the termination condition is asked between them
         for q1 in fits[: self.options.max_goals]:
             if runs and ptc():
                 break
-            runs.append(GoalRun(q1, grouped, new_search(grouped, q1, self._initial), release, float(layout.distance(q0, q1))))
+            runs.append(new_run(q1))
         poster = SolutionPoster(self, si, pdef, t0, grouped.to_path, self._notify, checker.passed)
         limits = LoopLimits(self.max_samples if grouped.planned else 0, self.options.max_h or 0,
                             self.options.stall_samples, self._sample_checkpoints)
-        loop = GoalLoop(runs, poster, new_search, q0, limits, self._stats, t0, self._set_samples_drawn)
+        loop = GoalLoop(runs, poster, new_search, q0, limits, self._stats, t0, self._set_samples_drawn,
+                        waiting=fits[self.options.max_goals :], new_run=new_run)
         try:
             loop.run(ptc)
         finally:  # also when the user's validity checker raised: the paths posted before it are in the problem
@@ -451,6 +457,6 @@ class DimensionRRT(PythonPlanner):
                 first_solution_time=poster.first_time,
                 best_cost=poster.best_cost,
                 solutions_posted=poster.posted,
-                goals=len(runs),
+                goals=loop.tried,
             )
         return planner_status(ob.PlannerStatus.EXACT_SOLUTION if poster.posted else ob.PlannerStatus.TIMEOUT)

@@ -20,7 +20,7 @@ import numpy as np
 from ompl import base as ob
 
 from .dimension_search import Search
-from .goal_runs import GOAL_TURN, GoalRun
+from .goal_runs import GOAL_SWAP_AFTER, GOAL_TURN, GoalRun
 from .grouped_space import GroupedSpace
 from .solution_posting import SolutionPoster
 
@@ -61,10 +61,16 @@ class GoalLoop:
 
     def __init__(self, runs: list[GoalRun], poster: SolutionPoster, new_search: NewSearch, q0: np.ndarray,
                  limits: LoopLimits, stats: dict[str, Any], t0: float,
-                 on_drawn: Callable[[int], None]) -> None:
+                 on_drawn: Callable[[int], None], waiting: list[np.ndarray] | None = None,
+                 new_run: Callable[[np.ndarray], GoalRun] | None = None) -> None:
         self.runs, self.poster, self.new_search, self.q0 = runs, poster, new_search, q0
         self.limits, self.stats, self.t0, self.on_drawn = limits, stats, t0, on_drawn
-        self.several = len(runs) > 1
+        self.waiting = list(waiting or []) if new_run is not None else []
+        """Goal states beyond the ``max_goals`` nearest, in turn for a run's place (:data:`GOAL_SWAP_AFTER`)."""
+        self.new_run = new_run
+        self.tried = len(runs)
+        """Goal states searched so far (a goal taken again after its turn in the queue counts again)."""
+        self.several = len(runs) > 1 or bool(self.waiting)
         self.drawn = 0
         """Samples of every goal's searches so far."""
         self.turn = 0
@@ -98,6 +104,8 @@ class GoalLoop:
         if self.several:  # a goal no path to which beats the best found (its start-goal distance is no shorter) stops
             run.stopped |= run.bound >= self.poster.found_cost - 1e-12
             if run.stopped or run.samples >= run.turn_end:
+                if not run.stopped and self.waiting and not math.isfinite(run.best) and run.samples >= GOAL_SWAP_AFTER:
+                    self._swap(run)
                 return self._next_turn()
         search, stall = run.search, self.limits.stall
         if run.release is not None and search.valid and search.samples - run.improved_at >= run.release:
@@ -111,6 +119,18 @@ class GoalLoop:
         else:
             self._pass(run, ptc)
         return True
+
+    def _swap(self, run: GoalRun) -> None:
+        """The next waiting goal state takes the place of ``run``, which found no path; its goal waits at the back."""
+        fresh = self.new_run(self.waiting.pop(0))
+        self.waiting.append(run.goal)
+        self.runs[self.turn] = fresh
+        self.tried += 1
+        if math.isfinite(fresh.best) and fresh.best < self.poster.found_cost:  # its initial path is valid
+            self.poster.offer(fresh.search.W, fresh.best, time.perf_counter())
+            self.record(time.perf_counter())
+        log.info("DimensionRRT: no path to a goal state after %d samples; the next of the goal states beyond "
+                 "max_goals takes its place", run.samples)
 
     def _next_turn(self) -> bool:
         """Another goal's turn; False when none is left."""

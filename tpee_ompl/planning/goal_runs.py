@@ -33,12 +33,16 @@ if TYPE_CHECKING:  # pragma: no cover
     from .grouped_space import GroupedSpace
     from .planner_base import PythonPlanner
 
-__all__ = ["GOAL_TURN", "MAX_GOAL_STATES", "GoalRun", "goal_states"]
+__all__ = ["GOAL_SWAP_AFTER", "GOAL_TURN", "MAX_GOAL_STATES", "GoalRun", "goal_states"]
 
 log = logging.getLogger("tpee_ompl.planning.dimension_rrt")
 
 GOAL_TURN = 100
 """Samples a goal's search draws before the next goal's takes its turn (with several goal states)."""
+GOAL_SWAP_AFTER = 500
+"""Samples of a goal's search without a path after which, at the end of its turn, the next goal state beyond the
+``max_goals`` nearest takes its place (it goes to the back of that queue): the nearest goals sealed in a pocket
+made the solve TIMEOUT for good while a farther one was reachable (RRTConnect found it in 2 ms)."""
 _GOAL_TRIES = 100
 """Draws from a goal region per goal state wanted before it counts as having no more valid ones."""
 MAX_GOAL_STATES = 1000
@@ -86,7 +90,7 @@ def goal_states(planner: PythonPlanner, ptc: ob.PlannerTerminationCondition, max
 
     A ``GoalState``: its state (INVALID_GOAL when it is out of bounds or invalid).  ``GoalStates`` (and
     its subclass ``GoalLazySamples``): every valid one it holds, up to :data:`MAX_GOAL_STATES` (the caller
-    keeps the ``max_goals`` nearest, so below that cap the choice does not depend on OMPL's rotating sample
+    keeps the ``max_goals`` nearest first, so below that cap the choice does not depend on OMPL's rotating sample
     position; a ``GoalLazySamples`` holding none yet: its first waited for until ``ptc``).  Any other
     ``GoalSampleableRegion``: the first ``max_goals`` valid states drawn from it (with OMPL's random
     numbers, not the planner's seed; drawn until ``ptc`` while none is valid, as RRTConnect's ``nextGoal(ptc)``,
