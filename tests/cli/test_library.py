@@ -296,3 +296,46 @@ def test_no_help_sends_the_reader_to_docs_which_the_wheel_does_not_ship(command:
     assert "docs/" not in out and ".md" not in out
     if command == ["library", "build"]:
         assert "absolute forcing shifts the detour unchanged" in out
+
+
+_QUICK_PARALLEL_BUILD = ["library", "build", "--pairs", "1-2", "2-1", "--per-pair", "1", "--max-samples", "200",
+                         "--seed", "5", "--demo-margins", "--workers", "2", "--no-progress"]
+
+
+@pytest.mark.parametrize("times", [1, 2])
+def test_a_killed_build_worker_is_run_again_once_then_the_build_fails_in_one_line_naming_the_pair(
+        tmp_path, monkeypatch, capsys, caplog, times: int) -> None:
+    """kill -9 of one worker 4 s into a build: "error: A process in the process pool was terminated abruptly while
+    the future was running or pending.", exit 1, the two pairs already done thrown away."""
+    import multiprocessing as mp
+
+    from helpers.library_killers import arm
+
+    arm(monkeypatch, tmp_path / "kills", pair=(2, 1), times=times)
+    out = tmp_path / "lib.npz"
+    code = main([*_QUICK_PARALLEL_BUILD, "--library", str(out)])
+    captured = capsys.readouterr()
+    assert "running the pair again in a fresh process" in caplog.text
+    if times == 1:
+        assert code == 0 and out.exists() and f"wrote {out}: 2 demonstrations in 2 pairs" in captured.out
+    else:
+        assert code == 1 and not out.exists() and captured.out == ""
+        assert captured.err == ("tpee-ompl library build: error: pair 2->1 (worker process killed by SIGKILL, retry "
+                                "in a fresh process killed by SIGKILL) lost: no library built (a library needs "
+                                "every pair)\n")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["kills", "lib.npz"][:3 - times]
+    assert mp.active_children() == []
+
+
+def test_sigterm_during_a_parallel_build_exits_130_leaving_no_worker_and_no_file(tmp_path, monkeypatch,
+                                                                                  capsys) -> None:
+    """The build's pairs run in processes of their own: ``kill PID`` of the build must end them all."""
+    import multiprocessing as mp
+
+    from helpers.library_killers import arm
+
+    arm(monkeypatch, tmp_path / "kills", pair=(1, 2), whom="build")
+    out = tmp_path / "lib.npz"
+    assert main([*_QUICK_PARALLEL_BUILD, "--library", str(out)]) == 130
+    assert capsys.readouterr().err == "tpee-ompl library build: interrupted\n"
+    assert not out.exists() and mp.active_children() == []

@@ -90,3 +90,45 @@ def test_the_smallest_per_step_accepted_learns_its_dmps() -> None:
     collected = {(1, 4): (W[:1], W[-1:], W[None], np.zeros(1), Counter())}
     pd = learn_demos(collected, opts.per_step, opts.dmp_options)[(1, 4)]
     assert pd.forward[0].n_steps == pd.reverse[0].n_steps == 55
+
+
+@pytest.mark.slow
+def test_a_pair_whose_worker_is_killed_is_run_again_and_gives_the_demos_of_an_uninterrupted_build(
+        robot: WearerArm, rrt_library: PathLibrary, tmp_path, monkeypatch, caplog) -> None:
+    """A worker killed mid-build (kill -9, the OOM killer) broke the whole pool: the build failed with "A process
+    in the process pool was terminated abruptly ...", the pairs already done were thrown away, nothing resumable."""
+    import multiprocessing as mp
+
+    from helpers.library_killers import arm
+
+    kills = arm(monkeypatch, tmp_path / "kills", pair=(3, 4), times=1)
+    again = PathLibrary.build_default(robot, per_pair=2, seed=3, pairs=RRT_PAIRS, max_samples=300, timeout=5.0,
+                                      workers=2)
+    assert len(list(kills.iterdir())) == 1  # the worker of 3->4 really died once
+    assert "pair 3->4: worker process killed by SIGKILL; running the pair again in a fresh process" in caplog.text
+    for pair in RRT_PAIRS:
+        a, b = rrt_library.pairs[pair], again.pairs[pair]
+        assert np.array_equal(a.starts, b.starts) and np.array_equal(a.goals, b.goals)
+        assert np.array_equal(a.waypoints, b.waypoints) and np.array_equal(a.margins, b.margins, equal_nan=True)
+    assert again.build_stats == rrt_library.build_stats
+    assert mp.active_children() == []
+
+
+_TWO_QUICK_PAIRS = {"per_pair": 1, "seed": 5, "pairs": ((1, 2), (2, 1)), "max_samples": 200, "timeout": 5.0,
+                    "demo_margins": (), "workers": 2}
+
+
+def test_a_pair_whose_worker_dies_again_when_run_again_fails_the_build_naming_the_pair(
+        robot: WearerArm, tmp_path, monkeypatch) -> None:
+    """A killed worker gave the pool's "A process in the process pool was terminated abruptly while the future was
+    running or pending": no pair, no cause; its processes must not outlive the failure either."""
+    import multiprocessing as mp
+
+    from helpers.library_killers import arm
+
+    kills = arm(monkeypatch, tmp_path / "kills", pair=(2, 1), times=2)
+    with pytest.raises(RuntimeError, match=r"^pair 2->1 \(worker process killed by SIGKILL, retry in a fresh process "
+                                           r"killed by SIGKILL\) lost: no library built \(a library needs every pair\)$"):
+        PathLibrary.build_default(robot, **_TWO_QUICK_PAIRS)
+    assert len(list(kills.iterdir())) == 2
+    assert mp.active_children() == []

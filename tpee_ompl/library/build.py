@@ -12,13 +12,17 @@ smooth in fake time, which the DMP needs to reproduce it within 1e-3 rad (docs/d
 
 from __future__ import annotations
 
+import contextlib
 import logging
+import os
 import signal
-from collections import Counter
-from collections.abc import Mapping, Sequence
-from concurrent.futures import ProcessPoolExecutor, as_completed
+import sys
+from collections import Counter, deque
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import asdict, dataclass
 from multiprocessing import get_context
+from multiprocessing.connection import Connection, wait
+from multiprocessing.process import BaseProcess
 from typing import Any
 
 import numpy as np
@@ -182,38 +186,147 @@ def _collect_default_pair(job: tuple, robot: WearerArm | None = None) -> Collect
                         opts.per_pair, opts.min_difference, opts.draws_per_pair)
 
 
+def _die_with_parent(parent: int) -> None:
+    """Linux: get SIGKILL when the build's process (``parent``) dies, so no orphan keeps planning; exit at once when
+    it died already, while this process started."""
+    if sys.platform.startswith("linux"):
+        with contextlib.suppress(Exception):
+            import ctypes
+
+            ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
+    if os.getppid() != parent:
+        os._exit(1)
+
+
+def _pair_process(collect: Callable[[tuple], Collected], job: tuple, conn: Connection, parent: int) -> None:
+    """A pair's own process: send ``("ok", collect(job))`` or ``("error", exception)`` to the build (process
+    ``parent``), then leave at once."""
+    child_sigint(signal.SIG_IGN)  # Ctrl-C goes to the build, which ends us
+    _die_with_parent(parent)
+    try:
+        msg: tuple[str, Any] = ("ok", collect(job))
+    except Exception as exc:  # noqa: BLE001 (raised again by the build)
+        msg = ("error", exc)
+    except BaseException as exc:  # noqa: BLE001 (SystemExit, ...: an error of the pair, not an exit of the build)
+        msg = ("error", RuntimeError(f"{type(exc).__name__}: {exc}"))
+    try:
+        try:
+            conn.send(msg)
+        except Exception:  # noqa: BLE001 (an exception that cannot be pickled: its text)
+            conn.send(("error", RuntimeError(f"{type(msg[1]).__name__}: {msg[1]}")))
+    finally:
+        conn.close()
+    # no interpreter finalisation: the result is sent, and it only makes the nanobind bindings list "leaked" objects
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os._exit(0)
+
+
+def _death(exitcode: int | None) -> str:
+    """How a process that sent no result ended (its exit code), e.g. "killed by SIGKILL"."""
+    if exitcode is not None and exitcode < 0:
+        try:
+            return f"killed by {signal.Signals(-exitcode).name}"
+        except ValueError:
+            return f"killed by signal {-exitcode}"
+    return f"exited with status {exitcode} without a result"
+
+
+def _collect_in_processes(
+    collect: Callable[[tuple], Collected], jobs: Sequence[tuple], workers: int, done: Callable[[], Any]
+) -> list[Collected]:
+    """``collect(job)`` of every job, each in a fresh spawned process, at most ``workers`` at a time; ``done()`` after
+    each.
+
+    A pair whose process dies without a result (SIGKILL, the OOM killer, a crash) is run once more in a fresh
+    process (the result is the same: a pair's work depends only on its job); if that one dies too, RuntimeError
+    naming the pair and how its processes ended.  A pair that raises raises here at once.  Whatever ends the
+    call (that, Ctrl-C, SIGTERM) kills the processes still running.
+    """
+    ctx = get_context("spawn")
+    queue = deque(range(len(jobs)))
+    deaths: dict[int, list[str]] = {}
+    running: dict[int, tuple[BaseProcess, Connection]] = {}
+    results: dict[int, Collected] = {}
+    try:
+        while queue or running:
+            while queue and len(running) < workers:
+                k = queue.popleft()
+                recv, send = ctx.Pipe(duplex=False)
+                proc = ctx.Process(target=_pair_process, args=(collect, jobs[k], send, os.getpid()), daemon=True)
+                with sigint_blocked_for_children():  # a Ctrl-C now must not reach the child's imports
+                    proc.start()
+                    send.close()  # the child holds the only write end: EOF when it dies
+                    running[k] = (proc, recv)
+            wait([c for _, c in running.values()] + [p.sentinel for p, _ in running.values()])
+            lost: list[int] = []
+            for k, (proc, conn) in list(running.items()):
+                if not conn.poll():
+                    if proc.is_alive():
+                        continue
+                    message = None
+                else:
+                    try:
+                        message = conn.recv()
+                    except (EOFError, OSError):  # died before or while sending
+                        message = None
+                del running[k]
+                conn.close()
+                proc.join(timeout=30)  # it leaves right after sending, or is gone
+                if proc.is_alive():
+                    proc.kill()
+                    proc.join(timeout=5)
+                if message is None:
+                    deaths.setdefault(k, []).append(_death(proc.exitcode))
+                    lost.append(k)
+                elif message[0] == "ok":
+                    results[k] = message[1]
+                    done()
+                else:
+                    raise message[1]
+            for k in lost:
+                i, j = jobs[k][1:3]
+                if len(deaths[k]) == 1:
+                    log.warning("pair %d->%d: worker process %s; running the pair again in a fresh process",
+                                i, j, deaths[k][0])
+                    queue.appendleft(k)
+            twice = [k for k in lost if len(deaths[k]) > 1]
+            if twice:
+                said = ", ".join(f"{jobs[k][1]}->{jobs[k][2]} (worker process {deaths[k][0]}, retry in a fresh "
+                                 f"process {deaths[k][1]})" for k in twice)
+                raise RuntimeError(f"pair{'s' if len(twice) > 1 else ''} {said} lost: no library built (a library "
+                                   "needs every pair)")
+    finally:
+        for proc, conn in running.values():
+            if proc.is_alive():
+                proc.kill()
+        for proc, conn in running.values():
+            proc.join(timeout=5)
+            conn.close()
+    return [results[k] for k in range(len(jobs))]
+
+
 def collect_default_demos(
     robot: WearerArm, opts: LibraryBuildOptions
 ) -> tuple[dict[tuple[int, int], Collected], Counter[str]]:
     """Demos of every pair of ``opts.pairs`` with :func:`query_sampler` and :class:`DemoPlanner`, and the summed counters.
 
-    ``opts.workers`` > 1 runs the pairs in that many processes, each with a copy of ``robot`` (same
-    files and margins); the result is the same as with one (each pair has its own seed), unless a
-    demo hits the wall-clock ``opts.timeout``.
+    ``opts.workers`` > 1 runs the pairs in up to that many processes at once, a fresh one per pair with a copy of
+    ``robot`` (same files and margins); the result is the same as with one (each pair has its own seed), unless a
+    demo hits the wall-clock ``opts.timeout``.  A pair whose process dies (killed, out of memory) is run once more;
+    if it dies again, RuntimeError naming it (:func:`_collect_in_processes`).
     """
     children = np.random.SeedSequence(opts.seed).spawn(len(opts.pairs))
     model = (robot.files.urdf, robot.files.srdf, robot.security_margin, dict(robot.link_margins), robot.n_threads)
     jobs = [(model, i, j, child, opts) for (i, j), child in zip(opts.pairs, children)]
     from tqdm import tqdm
+    from tqdm.contrib.logging import logging_redirect_tqdm
 
     with tqdm(total=len(jobs), desc="library pairs", unit="pair", disable=not opts.progress) as bar:
         if opts.workers > 1 and len(jobs) > 1:
-            # the workers ignore Ctrl-C: the parent ends them (a worker that dies breaks the pool: an error, not a hang)
-            ex = ProcessPoolExecutor(min(opts.workers, len(jobs)), mp_context=get_context("spawn"),
-                                     initializer=child_sigint, initargs=(signal.SIG_IGN,))
-            try:
-                with sigint_blocked_for_children():  # the workers start on submit
-                    futures = [ex.submit(_collect_default_pair, job) for job in jobs]
-                for done in as_completed(futures):
-                    done.result()  # a failed pair raises now, not after the others
-                    bar.update()
-                results = [f.result() for f in futures]
-            except BaseException:
-                for proc in list((getattr(ex, "_processes", None) or {}).values()):  # no public way before 3.14
-                    proc.terminate()
-                ex.shutdown(wait=False, cancel_futures=True)
-                raise
-            ex.shutdown()
+            # a warning (a pair run again) on a line of its own, not glued to the bar's
+            with logging_redirect_tqdm() if opts.progress else contextlib.nullcontext():
+                results = _collect_in_processes(_collect_default_pair, jobs, opts.workers, bar.update)
         else:
             results = []
             for job in jobs:
