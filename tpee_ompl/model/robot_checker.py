@@ -22,6 +22,7 @@ from ..validation import as_config_batch, as_float_array, check_bool, check_int,
 from .clearance_balls import BallScreen, separated_pairs
 from .lever_arms import joint_lever_arms, pair_lever_arms
 from .obstacles import Obstacle
+from .pair_diagnostics import warn_always_colliding
 from .stall_guard import StallGuard
 from .urdf_loading import LoadedModel, ModelFiles, bounding_radius, is_prismatic, load_urdf_model
 
@@ -155,6 +156,7 @@ class RobotChecker:
         """:attr:`lower` and :attr:`upper` as the validity checks use them: +/- max float for a continuous joint."""
         self._lower_list = self.check_lower.tolist()
         self._upper_list = self.check_upper.tolist()
+        warn_always_colliding(self)  # pairs within their margin in every configuration sampled: no state is valid
         log.debug("loaded %s: %d geometries, %d pairs", files.urdf, self.gmodel.ngeoms, len(self.gmodel.collisionPairs))
 
     def _load_model(self) -> LoadedModel:
