@@ -237,7 +237,7 @@ def test_settings_and_stats_shape(robot: WearerArm) -> None:
     assert all(isinstance(v, str) for v in settings.values())
     assert set(planner.last_run_stats()) == {
         "samples", "h", "collision_checks", "first_solution_time", "best_cost", "iterations", "progress",
-        "solutions_posted", "released_at", "goals",
+        "solutions_posted", "released_at", "goals", "restarts",
     }
     assert settings["max_h"] == "None"
 

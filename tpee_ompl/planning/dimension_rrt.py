@@ -61,6 +61,13 @@ pressed against an obstacle shortens only by moving a waypoint in all DOFs at on
 are not checked again; ``stall_samples`` counts on across the release).  ``last_run_stats()["released_at"]``
 gives the sample count.  ``LibraryDimensionRRT`` sets it (:data:`RELEASE_AFTER`).
 
+Restarts (``restart_after``; off by default, as in the paper; without a prescribed group only): the paper's rule
+shortens a path where it lies, so the first path's way round an obstacle, or round a continuous joint's circle,
+is kept.  Once ``restart_after`` samples in a row brought no shorter path, a fresh search of the goal (a *twin*)
+takes turns with the converged one (25 samples to its 100 while it is the longer); the longer twin is started
+again whenever it too found nothing shorter in as many samples.  Every shorter path of either is posted.
+``last_run_stats()["restarts"]`` counts the fresh searches (:data:`RESTART_AFTER`: a measured value).
+
 Shortcuts (``shortcuts``; by default on when a group is prescribed): after each sample that improved the
 path (and on a new path), every intermediate waypoint's values of the sample's group move towards the point
 shortest between its neighbours, as far as its checks allow, sweep after sweep while each gains 0.3 % when
@@ -121,7 +128,8 @@ from ompl import base as ob
 from ompl import geometric as og
 
 from ..validation import check_int
-from .dimension_rrt_options import RELEASE_AFTER, DimensionRRTOptions, resolve_options, shortcuts_on
+from .dimension_rrt_options import (RELEASE_AFTER, RESTART_AFTER, DimensionRRTOptions, resolve_options,
+                                     shortcuts_on)
 from .dimension_search import Search, SearchSettings
 from .goal_loop import GoalLoop, LoopLimits
 from .goal_runs import GoalRun, goal_states
@@ -130,7 +138,7 @@ from .planner_base import PythonPlanner, check_space_information, fixed_attribut
 from .search_checker import Checker
 from .solution_posting import SolutionPoster
 
-__all__ = ["RELEASE_AFTER", "DimensionRRT", "DimensionRRTOptions", "shortcuts_on"]
+__all__ = ["RELEASE_AFTER", "RESTART_AFTER", "DimensionRRT", "DimensionRRTOptions", "shortcuts_on"]
 
 log = logging.getLogger(__name__)
 
@@ -238,6 +246,9 @@ class DimensionRRT(PythonPlanner):
         only at solve time (the library pipeline), to refuse bad settings when they are made."""
         check_space_information(si)
         grouped = GroupedSpace(si, opts.groups, opts.h, prescribed)
+        if opts.restart_after is not None and grouped.prescribed:  # (a fresh search on the rows: never measured)
+            raise ValueError("restart_after: restarts are for problems without a prescribed group (Table 3's rows "
+                             "are released with release_after instead)")
         return grouped, cls._full_range(opts, grouped)
 
     @staticmethod
@@ -357,6 +368,7 @@ class DimensionRRT(PythonPlanner):
             "shortcuts": str(self.shortcuts),
             "initial_waypoints": "none" if self._initial is None else "set",
             "max_goals": str(self.options.max_goals),
+            "restart_after": str(self.options.restart_after),
         }
 
     @staticmethod
@@ -371,6 +383,7 @@ class DimensionRRT(PythonPlanner):
             "progress": [],
             "solutions_posted": 0,
             "released_at": None,
+            "restarts": 0,
             "goals": 0,
         }
 
@@ -379,7 +392,8 @@ class DimensionRRT(PythonPlanner):
         most any goal's search used), collision_checks, first_solution_time (s or None),
         best_cost (inf if none), iterations, progress [(time_s, best_cost, samples), ...],
         solutions_posted (paths added to the problem definition), released_at (samples at which the
-        prescribed rows were first released, or None), goals (goal states planned to)."""
+        prescribed rows were first released, or None), goals (goal states planned to), restarts (fresh searches
+        started by ``restart_after``)."""
         return super().last_run_stats()
 
     def _start_run(self) -> None:
@@ -443,7 +457,8 @@ class DimensionRRT(PythonPlanner):
             runs.append(new_run(q1))
         poster = SolutionPoster(self, si, pdef, t0, grouped.to_path, self._notify, checker.passed)
         limits = LoopLimits(self.max_samples if grouped.planned else 0, self.options.max_h or 0,
-                            self.options.stall_samples, self._sample_checkpoints)
+                            self.options.stall_samples, self._sample_checkpoints,
+                            restart=None if grouped.prescribed else self.options.restart_after)
         loop = GoalLoop(runs, poster, new_search, q0, limits, self._stats, t0, self._set_samples_drawn,
                         waiting=fits[self.options.max_goals :], new_run=new_run)
         try:

@@ -13,10 +13,12 @@ from ..validation import check_bool, check_int, check_name, check_number
 from ..validation import resolve_options as resolve
 from .grouped_space import MAX_H, group_lists
 
-__all__ = ["RELEASE_AFTER", "DimensionRRTOptions", "resolve_options", "shortcuts_on"]
+__all__ = ["RELEASE_AFTER", "RESTART_AFTER", "DimensionRRTOptions", "resolve_options", "shortcuts_on"]
 
 RELEASE_AFTER = 100
 """A ``release_after`` that pays (the library pipeline's default; chosen on 36 held-out queries, ``docs/dimension_rrt.md``)."""
+RESTART_AFTER = 2000
+"""A ``restart_after`` measured on the generic problems (``experiments/restarts.py``, ``docs/dimension_rrt.md``)."""
 
 
 @dataclass(frozen=True)
@@ -64,6 +66,10 @@ class DimensionRRTOptions:
     max_goals : int
         Most goal states drawn from a goal region that is not one state (``GoalStates``, another
         ``GoalSampleableRegion``); one search per goal state (default 8).  See "Goal regions".
+    restart_after : int, optional
+        Without a prescribed group: after this many samples in a row without a shorter path, a fresh search of the
+        goal takes turns with the converged one, and is started again whenever it converges no shorter (None, the
+        default: one search, as in the paper, whose rule only shortens a path where it lies).  See "Restarts".
     """
 
     groups: Sequence[Sequence[int]] | None = None
@@ -81,6 +87,7 @@ class DimensionRRTOptions:
     release_after: int | None = None
     shortcuts: bool | None = None
     max_goals: int = 8
+    restart_after: int | None = None
 
     def __post_init__(self) -> None:
         check_name("name", self.name)
@@ -102,6 +109,7 @@ class DimensionRRTOptions:
             raise ValueError(f"max_h must be at least h ({self.h}), got {self.max_h}")
         set_("release_after", check_int("release_after", self.release_after, minimum=1, optional=True))
         set_("max_goals", check_int("max_goals", self.max_goals, minimum=1))
+        set_("restart_after", check_int("restart_after", self.restart_after, minimum=1, optional=True))
         if self.range_ is not None:
             try:
                 arr = np.asarray(self.range_, dtype=float)

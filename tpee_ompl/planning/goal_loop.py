@@ -38,6 +38,10 @@ PASS_BATCH = 64
 over in one vectorised step; the termination condition is asked between calls) or in the connect
 trees (which ask it before each sample, as RRTConnect does)."""
 
+TWIN_TURN = 25
+"""Samples of the longer twin's turn (``restart_after``; the shorter one's: :data:`GOAL_TURN`): a fresh search's
+samples cost more than a converged one's, most of which the cost test turns down."""
+
 NewSearch = Callable[..., Search]
 """``new_search(grouped, goal, initial, turns=None, local=False)``: a search of the solve's start to ``goal``."""
 
@@ -52,6 +56,7 @@ class LoopLimits:
     max_h: int
     stall: int | None
     stops: tuple[int, ...]
+    restart: int | None = None
 
 
 class GoalLoop:
@@ -104,10 +109,15 @@ class GoalLoop:
         if self.several:  # a goal no path to which beats the best found (its start-goal distance is no shorter) stops
             run.stopped |= run.bound >= self.poster.found_cost - 1e-12
             if run.stopped or run.samples >= run.turn_end:
-                if not run.stopped and self.waiting and not math.isfinite(run.best) and run.samples >= GOAL_SWAP_AFTER:
+                if not run.stopped and run.twin is not None:
+                    self._restart_twin(run)
+                elif not run.stopped and self.waiting and not math.isfinite(run.best) and run.samples >= GOAL_SWAP_AFTER:
                     self._swap(run)
                 return self._next_turn()
-        search, stall = run.search, self.limits.stall
+        search, stall, restart = run.search, self.limits.stall, self.limits.restart
+        if restart is not None and run.twin is None and search.valid and search.samples - run.improved_at >= restart:
+            self._add_twin(run)
+            return True
         if run.release is not None and search.valid and search.samples - run.improved_at >= run.release:
             self._release(run)
         elif stall is not None and math.isfinite(self.poster.found_cost) and search.samples - run.improved_at >= stall:
@@ -119,6 +129,30 @@ class GoalLoop:
         else:
             self._pass(run, ptc)
         return True
+
+    def _add_twin(self, run: GoalRun) -> None:
+        """``run`` found nothing shorter in ``restart_after`` samples: a fresh search of its goal (its *twin*) takes
+        turns with it from now on (the paper's rule only shortens a path where it lies: the first path's way round an
+        obstacle, or round a continuous joint's circle, was kept)."""
+        twin = self.new_run(run.goal)
+        run.twin, twin.twin = twin, run
+        self.runs.insert(self.runs.index(run) + 1, twin)
+        self.several = True
+        run.turn_end = run.samples  # its turn ends here: the twin's begins
+        self.stats["restarts"] += 1
+        log.info("DimensionRRT: no shorter path in %d samples; a fresh search of the goal takes turns with it",
+                 self.limits.restart)
+
+    def _restart_twin(self, run: GoalRun) -> None:
+        """At the end of ``run``'s turn: when it is the longer of two twins (or has no path) and found nothing
+        shorter in ``restart_after`` samples, a fresh search takes its place."""
+        other = run.twin
+        worse = run.best >= other.best
+        if worse and run.search.samples - run.improved_at >= self.limits.restart:
+            fresh = self.new_run(run.goal)
+            fresh.twin, other.twin = other, fresh
+            self.runs[self.runs.index(run)] = fresh
+            self.stats["restarts"] += 1
 
     def _swap(self, run: GoalRun) -> None:
         """The next waiting goal state takes the place of ``run``, which found no path; its goal waits at the back."""
@@ -138,7 +172,9 @@ class GoalLoop:
         if not active:
             return False
         self.turn = next((k for k in active if k > self.turn), active[0])
-        self.runs[self.turn].turn_end = self.runs[self.turn].samples + GOAL_TURN
+        nxt = self.runs[self.turn]
+        behind = nxt.twin is not None and nxt.best >= nxt.twin.best  # the longer twin: a shorter turn
+        nxt.turn_end = nxt.samples + (TWIN_TURN if behind else GOAL_TURN)
         return True
 
     def _release(self, run: GoalRun) -> None:

@@ -69,6 +69,8 @@ class GoalRun:
     best: float = field(init=False)
     turn_end: int = 0
     stopped: bool = False
+    twin: GoalRun | None = None
+    """A second search of the same goal, taking turns with this one (``DimensionRRTOptions.restart_after``)."""
 
     @property
     def samples(self) -> int:
