@@ -88,3 +88,15 @@ def test_pointing_workspace_shows_a_progress_bar_with_the_time_left_and_draws_th
     assert (tmp_path / "shown.png").read_bytes() == (tmp_path / "quiet.png").read_bytes()
     sample_pointing_workspace(robot, 50, np.random.default_rng(0), progress=True)
     assert "lines of sight" in capsys.readouterr().err
+
+
+def test_a_workspace_with_no_collision_free_configuration_says_so_in_a_warning(caplog):
+    """Every state in collision (a margin of 0.5 m): the figure was drawn empty, only its title saying "0 of N
+    configurations collision-free", and tpee-ompl workspace printed "wrote ... (N samples, seed 0)"."""
+    import logging
+
+    from tpee_ompl.model.wearer_arm import WearerArm
+
+    with caplog.at_level(logging.WARNING, logger="tpee_ompl.viz.workspace"):
+        pointing_workspace(WearerArm(security_margin=0.5), 50, np.random.default_rng(0))
+    assert "none of the 50 configurations drawn is collision-free" in caplog.text

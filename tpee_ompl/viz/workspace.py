@@ -281,6 +281,9 @@ def _pointing_workspace(robot: WearerArm, n_samples: int, rng: np.random.Generat
     per_point = _COST["plot"] + (_COST["draw"] if out is not None else 0.0)
     bar.expect(n_samples * (_COST["check"] + _VALID_SHARE * (_COST["sight"] + _CLEAR_SHARE * len(rs) * per_point)))
     s = _sample(robot, n_samples, rng, rs, presets_only, bar, per_point)
+    if s.n_valid == 0:  # (only the figure's title said "0 of N configurations collision-free")
+        log.warning("none of the %d configurations drawn is collision-free: the figure shows no points (is every "
+                    "state in collision? check the model's obstacles and margins)", s.n_samples)
     mesh = scene_mesh(robot)
     lo, hi = mesh.view_box(list(s.points), 10.0)
     if color_by == "sector":
