@@ -305,3 +305,25 @@ def test_a_goal_region_without_a_valid_state_is_drawn_from_until_the_time_is_up_
     ss = _thin_goal_region(-1.0)
     ss.setPlanner(DimensionRRT(ss.getSpaceInformation(), seed=1))
     assert ss.solve(0.2) == ob.PlannerStatus.TIMEOUT
+
+
+def test_goal_states_are_not_swapped_while_h_can_still_be_raised() -> None:
+    """GOAL_SWAP_AFTER and REFINE_AFTER are both 500: the swap came first, each swapped-in goal started at the base h,
+    and a problem that needs more steps cycled through its goals to the cap (an S-shaped wall, h = 3, max_h = 17)."""
+    def free(s: ob.State) -> bool:
+        x, y = s[0], s[1]
+        return not (0.28 < x < 0.32 and y < 0.8) and not (0.68 < x < 0.72 and y > 0.2)
+
+    space = ob.RealVectorStateSpace(2)
+    space.setBounds(0.0, 1.0)
+    ss = og.SimpleSetup(space)
+    ss.setStateValidityChecker(free)
+    si = ss.getSpaceInformation()
+    si.setStateValidityCheckingResolution(0.005)
+    ss.setOptimizationObjective(ob.PathLengthOptimizationObjective(si))
+    ss.setStartState(set_state(si.allocState(), (0.1, 0.1)))
+    planner = DimensionRRT(si, groups=[[0, 1]], seed=1, h=3, max_h=17, connect=False, max_samples=20000, max_goals=1)
+    ss.setGoal(_goal_states(ss, [(0.9, 0.9), (0.88, 0.92), (0.92, 0.88)]))
+    ss.setPlanner(planner)
+    assert ss.solve(20.0) == ob.PlannerStatus.EXACT_SOLUTION
+    assert planner.last_run_stats()["h"] > 3

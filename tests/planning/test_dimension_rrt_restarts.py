@@ -73,3 +73,30 @@ def test_restarts_are_refused_with_a_prescribed_group(robot) -> None:
 def test_a_bad_restart_after_is_refused_naming_it(value) -> None:
     with pytest.raises(ValueError, match="restart_after"):
         DimensionRRT(_torus().getSpaceInformation(), restart_after=value)
+
+
+def test_restarts_with_several_goal_states_take_turns_without_a_crash() -> None:
+    """A run that was not first in the loop's list made list.index compare GoalRuns field by field (their goal
+    arrays have no truth value): every solve with two goal states and restarts ended in CRASH."""
+    ss = _torus()
+    si = ss.getSpaceInformation()
+    goals = ob.GoalStates(si)
+    for q1 in ((1.0, 0.5), (1.1, 0.4)):
+        g = si.allocState()
+        g[0].value, g[1].value = q1
+        goals.addState(g)
+    ss.setGoal(goals)
+    planner = DimensionRRT(si, seed=1, max_samples=20000, restart_after=300)
+    ss.setPlanner(planner)
+    assert ss.solve(60.0) == ob.PlannerStatus.EXACT_SOLUTION
+    assert planner.last_run_stats()["restarts"] >= 2
+
+
+def test_stall_samples_still_end_a_solve_with_restarts() -> None:
+    """Each fresh twin started the stall count again: with restart_after below stall_samples no run ever reached
+    it, and the solve ran to its time limit (98,150 samples in 3 s)."""
+    ss = _torus()
+    planner = DimensionRRT(ss.getSpaceInformation(), seed=1, restart_after=40, stall_samples=1000, max_samples=200000)
+    ss.setPlanner(planner)
+    assert ss.solve(60.0) == ob.PlannerStatus.EXACT_SOLUTION
+    assert planner.last_run_stats()["samples"] < 50000

@@ -50,13 +50,14 @@ NewSearch = Callable[..., Search]
 class LoopLimits:
     """What ends a solve or a pass, besides the termination condition: ``cap`` samples of all goals (None: no
     cap), ``max_h`` fake-time steps at most when raising ``h``, ``stall`` samples without a shorter path (None:
-    never), and the ``stops`` (sample counts) a pass ends at exactly."""
+    never), and the ``stops`` (sample counts) a pass ends at exactly; and ``restart``, when twins start."""
 
     cap: int | None
     max_h: int
     stall: int | None
     stops: tuple[int, ...]
     restart: int | None = None
+    """``restart_after``: samples without a shorter path before a twin search starts (None: never)."""
 
 
 class GoalLoop:
@@ -111,7 +112,8 @@ class GoalLoop:
             if run.stopped or run.samples >= run.turn_end:
                 if not run.stopped and run.twin is not None:
                     self._restart_twin(run)
-                elif not run.stopped and self.waiting and not math.isfinite(run.best) and run.samples >= GOAL_SWAP_AFTER:
+                elif (not run.stopped and self.waiting and not math.isfinite(run.best) and run.samples >= GOAL_SWAP_AFTER
+                      and not self._can_raise_h(run)):  # (h first: a fresh run starts at the base h again)
                     self._swap(run)
                 return self._next_turn()
         search, stall, restart = run.search, self.limits.stall, self.limits.restart
@@ -123,12 +125,16 @@ class GoalLoop:
         elif stall is not None and math.isfinite(self.poster.found_cost) and search.samples - run.improved_at >= stall:
             run.stopped = True  # converged: nothing shorter in the last ``stall`` samples
             return not all(r.stopped for r in self.runs)
-        elif (not search.valid and 2 * run.grouped.h - 1 <= self.limits.max_h
+        elif (not search.valid and self._can_raise_h(run)
               and ((search.samples >= REFINE_AFTER and not search.connecting) or search.unfitted is not None)):
             self._raise_h(run)
         else:
             self._pass(run, ptc)
         return True
+
+    def _can_raise_h(self, run: GoalRun) -> bool:
+        """Whether ``max_h`` lets ``run``'s steps be doubled (h -> 2h - 1) once more."""
+        return 2 * run.grouped.h - 1 <= self.limits.max_h
 
     def _add_twin(self, run: GoalRun) -> None:
         """``run`` found nothing shorter in ``restart_after`` samples: a fresh search of its goal (its *twin*) takes
@@ -148,7 +154,9 @@ class GoalLoop:
         shorter in ``restart_after`` samples, a fresh search takes its place."""
         other = run.twin
         worse = run.best >= other.best
-        if worse and run.search.samples - run.improved_at >= self.limits.restart:
+        # not once the other has stopped (``stall_samples``): each fresh search would start the stall count again
+        if (worse and not other.stopped and run.search.samples - run.improved_at >= self.limits.restart
+                and (run.search.valid or not self._can_raise_h(run))):
             fresh = self.new_run(run.goal)
             fresh.twin, other.twin = other, fresh
             self.runs[self.runs.index(run)] = fresh

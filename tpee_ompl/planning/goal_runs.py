@@ -49,7 +49,7 @@ MAX_GOAL_STATES = 1000
 """Most states of a ``GoalStates`` read to pick the nearest ``max_goals`` from."""
 
 
-@dataclass
+@dataclass(eq=False)  # (identity: the loop finds a run in its list, and a goal array has no truth value)
 class GoalRun:
     """One goal state's search within a solve, and its counters.
 
