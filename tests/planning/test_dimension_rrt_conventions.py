@@ -244,6 +244,30 @@ def test_a_checker_method_named_are_valid_that_is_not_the_batched_call_is_passed
     assert path_passes_motion_checks(ss.getSpaceInformation(), ss.getSolutionPath().getStates())
 
 
+@pytest.mark.parametrize("answer", [lambda ok: ok.astype(np.int8), lambda ok: ok.tolist(), lambda ok: ok.astype(int)])
+def test_a_batched_call_answering_zeros_and_ones_is_taken_and_asked_once_per_checker(answer, caplog,
+                                                                                     monkeypatch) -> None:
+    """The probe wanted a bool array: an int8 or 0/1 answer, which the search reads as booleans, was refused with a
+    warning on every solve (and the states checked one by one)."""
+    from tpee_ompl.planning import search_checker
+
+    probes: list[bool] = []
+    real = search_checker._answers_per_row
+    monkeypatch.setattr(search_checker, "_answers_per_row", lambda *a: probes.append(real(*a)) or probes[-1])
+
+    def are_valid(self, Q):
+        Q = np.atleast_2d(Q)
+        calls.append(len(Q))
+        return answer(~((0.4 < Q[:, 0]) & (Q[:, 0] < 0.6) & (Q[:, 1] < 0.7)))
+
+    calls: list[int] = []
+    ss = _wall_checker_setup(are_valid)
+    with caplog.at_level(logging.WARNING):
+        for _ in range(2):
+            assert _run(ss, seed=0, max_samples=300)[1] == ob.PlannerStatus.EXACT_SOLUTION
+    assert probes == [True] and "are_valid" not in caplog.text and len(calls) > 10  # taken; asked once
+
+
 def test_a_batched_call_that_passes_what_is_valid_rejects_is_said_once_per_solve(
         caplog: pytest.LogCaptureFixture) -> None:
     """An are_valid that says True to everything (right for the start) had the search accept paths si.checkMotion

@@ -29,6 +29,9 @@ class PlanarArm(ob.StateValidityChecker):
         Points checked along each link.
     """
 
+    batched_protocol = True
+    """``are_valid`` is the batched form of ``isValid`` (dimension-RRT takes it without asking it about the start)."""
+
     def __init__(self, si: ob.SpaceInformation, link_length: float, obstacles: np.ndarray, samples_per_link: int = 6) -> None:
         super().__init__(si)
         self.link_length = float(link_length)

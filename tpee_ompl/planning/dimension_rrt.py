@@ -436,7 +436,7 @@ class DimensionRRT(PythonPlanner):
         si, pdef = self.getSpaceInformation(), self.getProblemDefinition()
         layout, grouped = self.grouped.layout, self.grouped
         checker = Checker(si, layout, self.batch, probe=q0)
-        checks0 = checker.counter()
+        checks0 = checker.counter() - checker.probe_checks  # (the probe's check is this solve's: counted)
         release = self.options.release_after if grouped.prescribed and grouped.planned else None
 
         settings = SearchSettings(self.narrow_after, self.narrowing, self.options.connect, self.shortcuts,

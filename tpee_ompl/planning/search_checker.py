@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import logging
 import math
+import weakref
 from collections.abc import Callable
 
 import numpy as np
@@ -56,21 +57,34 @@ def _longest_stretch_key(level: np.ndarray, length: np.ndarray) -> np.ndarray:
     return -length / np.exp2(level + 1)
 
 
+_PROBED: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+"""Validity checker -> whether its ``are_valid`` passed :func:`_answers_per_row` (asked once per checker)."""
+
+
 def _answers_per_row(svc: ob.StateValidityChecker, are_valid: Callable[[np.ndarray], object], q: np.ndarray) -> bool:
-    """Whether a checker's ``are_valid`` is the batched call the search takes it for: one True for the row q, a
-    state ``isValid`` passed (the start).  A method of that name meaning something else ("are all of these
-    valid?") made every solve CRASH; it is passed over with a warning and the states are checked one by one.
-    A checker whose class sets ``batched_protocol = True`` (the project's) is not asked."""
+    """Whether a checker's ``are_valid`` is the batched call the search takes it for: one true answer for the row q,
+    a state ``isValid`` passed (the start), read as :meth:`Checker.states` reads it (booleans, 0/1).  A method of that
+    name meaning something else ("are all of these valid?") made every solve CRASH; it is passed over with a warning
+    and the states are checked one by one.  A checker whose class sets ``batched_protocol = True`` (the project's)
+    is not asked."""
     try:
-        ok = np.asarray(are_valid(q[None, :]))
-        if ok.shape == (1,) and ok.dtype == bool and bool(ok[0]):
+        ok = np.asarray(are_valid(q[None, :]), dtype=bool)
+        if ok.shape == (1,) and bool(ok[0]):
             return True
-        got = f"returned {ok!r} for the start state, which isValid passed (one True wanted)"
+        got = f"returned {ok!r} for the start state, which isValid passed (one true answer wanted)"
     except Exception as exc:  # noqa: BLE001 (a method of that name with other arguments)
         got = f"raised {type(exc).__name__}: {exc}"
     log.warning("the validity checker's are_valid (%s) %s: not taken as the batched check; checking state by state "
                 "(set batched_protocol = True on the checker's class to skip this test)", type(svc).__name__, got)
     return False
+
+
+def _weakrefable(obj: object) -> bool:
+    try:
+        weakref.ref(obj)
+    except TypeError:
+        return False
+    return True
 
 
 def segment_key(a: np.ndarray, b: np.ndarray) -> bytes:
@@ -88,8 +102,15 @@ class Checker:
         svc = si.getStateValidityChecker()
         mv = si.getMotionValidator()
         are_valid = getattr(svc, "are_valid", None)
+        self.probe_checks = 0
+        """States checked to test the checker's ``are_valid`` (the start, once per checker), before any count."""
         if batch and callable(are_valid) and probe is not None and not getattr(svc, "batched_protocol", False):
-            are_valid = are_valid if _answers_per_row(svc, are_valid, probe) else None
+            answers = _PROBED.get(svc) if _weakrefable(svc) else None
+            if answers is None:
+                answers, self.probe_checks = _answers_per_row(svc, are_valid, probe), 1
+                if _weakrefable(svc):
+                    _PROBED[svc] = answers
+            are_valid = are_valid if answers else None
         self.step: float | None = None
         self.euclid = True
         self._ompl_counts = False
