@@ -307,22 +307,9 @@ def load_robot(args: argparse.Namespace) -> WearerArm:
     if not getattr(args, "urdf", None):
         return WearerArm()
     robot = WearerArm(args.urdf, args.srdf)
-    if not args.srdf:
-        _warn_if_nothing_is_free(robot, args.urdf)
+    if not args.srdf and robot.always_colliding:  # the robot's warning named the pairs; the cause here is plainer
+        import logging
+
+        logging.getLogger("tpee_ompl.cli").warning("without --srdf no collision pair is disabled: give the model's "
+                                                   "SRDF (it disables the pairs its links touch by design)")
     return robot
-
-
-def _warn_if_nothing_is_free(robot: WearerArm, urdf: str) -> None:
-    """Warn when no random configuration of a model loaded without an SRDF is collision-free: its neighbouring links
-    most likely touch, and only the SRDF's disabled pairs say they may (every check would fail, silently)."""
-    import logging
-
-    import numpy as np
-
-    Q = np.random.default_rng(0).uniform(robot.lower, robot.upper, (64, robot.nq))
-    if robot.are_valid(Q).any():
-        return
-    a, b, d = robot.closest_pair(Q[0])
-    logging.getLogger("tpee_ompl.cli").warning(
-        "none of 64 random configurations of --urdf %s is collision-free (the first: %s vs %s, %.3f m); without "
-        "--srdf no collision pair is disabled: give the model's SRDF", urdf, a, b, d)

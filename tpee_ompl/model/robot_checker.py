@@ -156,7 +156,8 @@ class RobotChecker:
         """:attr:`lower` and :attr:`upper` as the validity checks use them: +/- max float for a continuous joint."""
         self._lower_list = self.check_lower.tolist()
         self._upper_list = self.check_upper.tolist()
-        warn_always_colliding(self)  # pairs within their margin in every configuration sampled: no state is valid
+        self.always_colliding = warn_always_colliding(self)
+        """Link pairs within their margin in every configuration sampled at load (then no state is valid; warned)."""
         log.debug("loaded %s: %d geometries, %d pairs", files.urdf, self.gmodel.ngeoms, len(self.gmodel.collisionPairs))
 
     def _load_model(self) -> LoadedModel:
