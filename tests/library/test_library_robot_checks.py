@@ -39,6 +39,14 @@ def test_a_library_is_taken_by_another_robot_of_the_same_model_and_margins(libra
     LibraryDimensionRRT(make_simple_setup(other, q.start, q.goal).getSpaceInformation(), library, 1, 2)
 
 
+def test_a_robot_with_other_link_margins_is_refused_naming_them(library):
+    """Margins that differ only by link_margins were reported as "security_margin 0.02 against 0.02 m"."""
+    other = WearerArm(link_margins={"backpack": 0.03})
+    with pytest.raises(ValueError, match=r"other collision margins than this robot \(link_margins \{\} against "
+                                         r"\{'backpack': 0.03\}\)"):
+        library.check_robot(other)
+
+
 def test_a_library_of_another_model_is_named_by_check_robot(library):
     class Other:
         model_hash = "0123456789abcdef"

@@ -264,8 +264,12 @@ class PathLibrary:
             raise ValueError(f"{what}: built for model {mine.model_hash!r}, not the robot's "
                              f"{getattr(robot, 'model_hash', None)!r} (load or build one for this model)")
         if not np.array_equal(robot.pair_margins(), mine.pair_margins()):
-            raise ValueError(f"{what}: its robot has other collision margins than this robot (security_margin "
-                             f"{mine.security_margin:g} against {robot.security_margin:g} m): load it with this robot")
+            theirs, ours = dict(getattr(robot, "link_margins", None) or {}), dict(mine.link_margins or {})
+            which = (f"security_margin {mine.security_margin:g} against {robot.security_margin:g} m"
+                     if mine.security_margin != robot.security_margin else
+                     f"link_margins {ours} against {theirs}" if ours != theirs else "pair margins")
+            raise ValueError(f"{what}: its robot has other collision margins than this robot ({which}): load it with "
+                             "this robot")
 
     def query(
         self, start: np.ndarray, goal: np.ndarray, from_sector: int, to_sector: int, step: float | None = None
