@@ -415,18 +415,28 @@ class DaskExecutor:
         self._futures: list = []
         self.lost: list[dict] = []
         """One entry per time a task was given to a worker that died (``qpos``, ``attempt``, ``reason``, ``pid`` None),
-        read from the scheduler's story of each finished task: the scheduler reruns such a task without telling the
+        read from the scheduler's story once the tasks are done: the scheduler reruns such a task without telling the
         client, and cannot say whether it had started on that worker."""
 
-    def _worker_losses(self, key: str) -> int:
-        """How many times the task ``key`` was under way on a worker that died (the scheduler's transitions out of
-        ``processing`` for a worker's cleanup); 0 when the scheduler cannot say."""
+    def _record_losses(self, task_of: dict[str, dict]) -> None:
+        """Read from the scheduler's story (one call for all the tasks, the scheduler alone) how many times each task
+        was under way on a worker that died, and list each time in :attr:`lost` with a warning."""
+        def story(dask_scheduler, keys: list[str]) -> list[tuple]:  # (runs on the scheduler)
+            return [tuple(ev) for ev in dask_scheduler.story(*keys)]
+
         try:
-            story = self.client.story(key, on_error="ignore")
+            events = self.client.run_on_scheduler(story, keys=list(task_of))
         except Exception:  # noqa: BLE001 (a diagnostic: an older scheduler, a dropped connection)
-            return 0
-        return sum(1 for ev in story if len(ev) >= 6 and ev[0] == "scheduler" and ev[2] == "processing"
-                   and ev[3] in ("released", "waiting") and "worker" in str(ev[5]))
+            return
+        attempts: dict[str, int] = {}
+        for ev in events:  # (key, start, finish, recommendations, stimulus_id, time): a dead worker's cleanup
+            if len(ev) >= 5 and ev[1] == "processing" and ev[2] in ("released", "waiting") and \
+                    str(ev[4]).startswith(("handle-worker-cleanup", "worker-died")):
+                attempts[ev[0]] = attempts.get(ev[0], 0) + 1
+                qpos = task_of[ev[0]].get("qpos")
+                self.lost.append({"qpos": qpos, "attempt": attempts[ev[0]], "reason": "the Dask worker it was given "
+                                  "to died (the scheduler ran it again; it may not have started there)", "pid": None})
+                log.warning("task %s: the Dask worker it was given to died; the scheduler ran it again", qpos)
 
     def run(self, fn: TaskFn, tasks: Sequence[dict]) -> Iterator[dict]:
         """Submit one Dask task per task; yield each result as it completes."""
@@ -446,13 +456,9 @@ class DaskExecutor:
             except Exception as exc:  # noqa: BLE001 (raised after its retries, or KilledWorker: recorded as failed)
                 log.error("Dask task %s failed: %s", fut.key, exc)
                 res = task_failure(task_of[fut.key], f"{type(exc).__name__}: {exc}", self.retries + 1)
-            qpos = task_of[fut.key].get("qpos")
-            for attempt in range(1, self._worker_losses(fut.key) + 1):  # (as the local pool records its lost tasks)
-                self.lost.append({"qpos": qpos, "attempt": attempt, "reason": "the Dask worker it was given to died "
-                                  "(the scheduler ran it again; it may not have started there)", "pid": None})
-                log.warning("task %s: the Dask worker it was given to died; the scheduler ran it again", qpos)
             yield res
             fut.release()
+        self._record_losses(task_of)  # (as the local pool lists its lost tasks)
 
     def shutdown(self, cancel: bool = False) -> None:
         """Cancel unfinished tasks when ``cancel``; close the client and the local cluster this executor started."""
