@@ -358,6 +358,8 @@ def test_settings_fixed_at_construction_refuse_assignment_instead_of_being_ignor
                         ("batch", "x"), ("shortcuts", "x")):
         with pytest.raises(AttributeError, match=f"pass {name}="):
             setattr(planner, name, value)
+    with pytest.raises(ValueError, match="read-only"):
+        planner.range_[:] = 0.0  # (it changed the planner's own array)
     with pytest.raises(ValueError, match="max_samples"):
         planner.max_samples = -5  # was a silent TIMEOUT with 0 samples
     assert planner.h == 7 and planner.seed == 3 and planner.settings()["h"] == "7"

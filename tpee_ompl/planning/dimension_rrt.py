@@ -153,6 +153,13 @@ def _drop_callbacks() -> None:
     for planner in list(_WITH_CALLBACKS):
         planner._callback = None
 
+def _read_only(a: np.ndarray) -> np.ndarray:
+    """A view of ``a`` that cannot be written through (``p.range_[:] = 0`` changed the planner's own array)."""
+    v = a.view()
+    v.flags.writeable = False
+    return v
+
+
 class DimensionRRT(PythonPlanner):
     """Dimension-RRT (paper sec. 4.1.2): anytime, fake-time, DOF-grouped path optimisation.
 
@@ -222,7 +229,7 @@ class DimensionRRT(PythonPlanner):
                           "Samples before the sampling region narrows (``DimensionRRTOptions.narrow_after``).")
     narrowing = fixed_attribute("narrowing", lambda self: self._options.narrowing,
                        "The narrowing factor (``DimensionRRTOptions.narrowing``).")
-    range_ = fixed_attribute("range_", lambda self: self._range,
+    range_ = fixed_attribute("range_", lambda self: _read_only(self._range),
                     "The narrowed region's least padding per DOF (``DimensionRRTOptions.range_``, for these bounds).")
     batch = fixed_attribute("batch", lambda self: self._options.batch,
                    "Whether the checker's batched calls are used (``DimensionRRTOptions.batch``).")
