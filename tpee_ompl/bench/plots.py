@@ -79,7 +79,8 @@ def _make_plots(db_path: str | Path, directory: str | Path, planner: str | None,
     seen = sorted({r["planner"] for r in it})
     planner = planner or resolve_planner_name("DimensionRRT", seen)
     reference = reference or resolve_planner_name("RRTstar", seen)
-    if it and planner != reference:  # (one planner at the caps: no ratio; it drew an empty "RRTstar / RRTstar")
+    if it and planner != reference and {planner, reference} <= set(seen):  # (as the report's Table 4; one planner at
+        # the caps drew an empty "RRTstar / RRTstar")
         ratios = ratio_table(runs, planner, reference)
         for chk in sorted({r["checker"] for r in ratios}):
             fig, ax = plt.subplots(figsize=(7, 4.5))
