@@ -153,6 +153,7 @@ def _drop_callbacks() -> None:
     for planner in list(_WITH_CALLBACKS):
         planner._callback = None
 
+
 def _read_only(a: np.ndarray) -> np.ndarray:
     """A view of ``a`` that cannot be written through (``p.range_[:] = 0`` changed the planner's own array)."""
     v = a.view()
