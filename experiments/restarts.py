@@ -26,23 +26,9 @@ GENERIC = ["arm4", "arm6", "arm7", "arm8", "arm5-so2", "point4-hole", "narrow3",
 
 def torus_queries(n: int):
     """``n`` copies of the torus query (the seed varies between runs): (make_setup, groups) pairs."""
-    from ompl import base as ob
-    from ompl import geometric as og
+    from tpee_ompl.examples.so2_torus import make_so2_torus_setup
 
-    def make_setup():
-        space = ob.CompoundStateSpace()
-        space.addSubspace(ob.SO2StateSpace(), 1.0)
-        space.addSubspace(ob.SO2StateSpace(), 1.0)
-        ss = og.SimpleSetup(space)
-        ss.setStateValidityChecker(lambda s: not (-0.2 < s[0].value < 0.2 and s[1].value > 0.0))
-        si = ss.getSpaceInformation()
-        a, b = si.allocState(), si.allocState()
-        a[0].value, a[1].value, b[0].value, b[1].value = -1.0, 0.5, 1.0, 0.5
-        ss.setStartAndGoalStates(a, b)
-        ss.setOptimizationObjective(ob.PathLengthOptimizationObjective(si))
-        return ss
-
-    return [(make_setup, None)] * n
+    return [(make_so2_torus_setup, None)] * n
 
 
 def problem_queries(name: str, n: int):

@@ -157,14 +157,20 @@ def test_settings_the_refining_planner_would_refuse_are_refused_when_the_pipelin
         LibraryDimensionRRT(ss.getSpaceInformation(), library, **kwargs)
 
 
-def test_a_joint_locked_by_bounds_of_width_zero_keeps_its_value_on_the_pipelines_path(robot, library):
-    """DOF4 locked at the start's value (bounds of width 0, as OMPL users lock a joint): refused until 2026-11-27;
-    the library's paths move DOF4, so they leave the bounds, and the path is planned with DOF4 kept."""
+def _query_keeping_dof4(robot: WearerArm) -> tuple[np.ndarray, np.ndarray]:
+    """A 3 -> 4 query whose goal has the start's DOF4 (its DOF3 redrawn until the goal is valid): DOF4 can be locked."""
     rng = np.random.default_rng(0)
     s, g = _query(robot, 3, 4, 5)
     g[3] = s[3]
     while not robot.is_valid(g):
         g[2] = rng.uniform(robot.lower[2], robot.upper[2])
+    return s, g
+
+
+def test_a_joint_locked_by_bounds_of_width_zero_keeps_its_value_on_the_pipelines_path(robot, library):
+    """DOF4 locked at the start's value (bounds of width 0, as OMPL users lock a joint): refused until 2026-11-27;
+    the library's paths move DOF4, so they leave the bounds, and the path is planned with DOF4 kept."""
+    s, g = _query_keeping_dof4(robot)
     ss = make_simple_setup(robot, s, g)
     old, bounds = ss.getStateSpace().getBounds(), ob.RealVectorBounds(4)
     for k in range(4):
@@ -387,11 +393,7 @@ def test_of_several_start_states_the_pipeline_says_once_which_it_plans_from(robo
 def test_bounds_locked_after_the_pipeline_was_made_keep_its_posted_path_exact(robot, library):
     """Helper review, 2026-11-27: DOF4's bounds narrowed to one value after construction; the free direct motion was
     posted, then building the refining planner raised, and the solve said CRASH beside an exact path."""
-    rng = np.random.default_rng(0)
-    s, g = _query(robot, 3, 4, 5)
-    g[3] = s[3]
-    while not robot.is_valid(g):
-        g[2] = rng.uniform(robot.lower[2], robot.upper[2])
+    s, g = _query_keeping_dof4(robot)
     ss = make_simple_setup(robot, s, g)
     planner = LibraryDimensionRRT(ss.getSpaceInformation(), library, max_samples=50, seed=0)
     ss.setPlanner(planner)

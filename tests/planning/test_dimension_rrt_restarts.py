@@ -10,30 +10,15 @@ import pytest
 from ompl import base as ob
 from ompl import geometric as og
 
+from tpee_ompl.examples.so2_torus import make_so2_torus_setup
 from tpee_ompl.planning.dimension_rrt import DimensionRRT
 from tpee_ompl.planning.paths import path_to_array
 from tpee_ompl.planning.space_layout import RealVectorLayout
 from tpee_ompl.planning.tpee import tpee_dimension_rrt
 
 
-def _torus() -> og.SimpleSetup:
-    """Two continuous joints, the first blocked near 0 while the second is above 0: from (-1, 0.5) to (1, 0.5) the
-    short way (~3.0) dips the second joint to 0; the long way round the first joint's circle is ~4.28."""
-    space = ob.CompoundStateSpace()
-    space.addSubspace(ob.SO2StateSpace(), 1.0)
-    space.addSubspace(ob.SO2StateSpace(), 1.0)
-    ss = og.SimpleSetup(space)
-    ss.setStateValidityChecker(lambda s: not (-0.2 < s[0].value < 0.2 and s[1].value > 0.0))
-    si = ss.getSpaceInformation()
-    a, b = si.allocState(), si.allocState()
-    a[0].value, a[1].value, b[0].value, b[1].value = -1.0, 0.5, 1.0, 0.5
-    ss.setStartAndGoalStates(a, b)
-    ss.setOptimizationObjective(ob.PathLengthOptimizationObjective(si))
-    return ss
-
-
 def _solve(seed: int, restart_after: int | None) -> tuple[og.SimpleSetup, DimensionRRT]:
-    ss = _torus()
+    ss = make_so2_torus_setup()
     planner = DimensionRRT(ss.getSpaceInformation(), seed=seed, max_samples=20000, restart_after=restart_after)
     ss.setPlanner(planner)
     assert ss.solve(60.0) == ob.PlannerStatus.EXACT_SOLUTION
@@ -72,13 +57,13 @@ def test_restarts_are_refused_with_a_prescribed_group(robot) -> None:
 @pytest.mark.parametrize("value", [0, -1, 1.5, "x"])
 def test_a_bad_restart_after_is_refused_naming_it(value) -> None:
     with pytest.raises(ValueError, match="restart_after"):
-        DimensionRRT(_torus().getSpaceInformation(), restart_after=value)
+        DimensionRRT(make_so2_torus_setup().getSpaceInformation(), restart_after=value)
 
 
 def test_restarts_with_several_goal_states_take_turns_without_a_crash() -> None:
     """A run that was not first in the loop's list made list.index compare GoalRuns field by field (their goal
     arrays have no truth value): every solve with two goal states and restarts ended in CRASH."""
-    ss = _torus()
+    ss = make_so2_torus_setup()
     si = ss.getSpaceInformation()
     goals = ob.GoalStates(si)
     for q1 in ((1.0, 0.5), (1.1, 0.4)):
@@ -95,7 +80,7 @@ def test_restarts_with_several_goal_states_take_turns_without_a_crash() -> None:
 def test_stall_samples_still_end_a_solve_with_restarts() -> None:
     """Each fresh twin started the stall count again: with restart_after below stall_samples no run ever reached
     it, and the solve ran to its time limit (98,150 samples in 3 s)."""
-    ss = _torus()
+    ss = make_so2_torus_setup()
     planner = DimensionRRT(ss.getSpaceInformation(), seed=1, restart_after=40, stall_samples=1000, max_samples=200000)
     ss.setPlanner(planner)
     assert ss.solve(60.0) == ob.PlannerStatus.EXACT_SOLUTION

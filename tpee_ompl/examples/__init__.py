@@ -1,1 +1,1 @@
-"""Example problems for dimension-RRT: TPEE cross-sector queries and a plain-OMPL planar arm."""
+"""Example problems for dimension-RRT: TPEE cross-sector queries, a plain-OMPL planar arm and two continuous joints."""
