@@ -229,3 +229,17 @@ def test_a_campaign_of_one_planner_at_sample_caps_says_so_and_draws_no_ratio_plo
     assert text.startswith("No Table 4: it compares two planners at equal sample counts, and the campaign ran only "
                            "RRTstar at its sample caps.")
     assert not list(res.directory.rglob("fig15_ratios_*.png"))
+
+
+def test_a_campaign_json_edited_to_endless_runs_is_refused_on_resume(query_file, tmp_path):
+    """runs: 10**9 in campaign.json was accepted by --resume (the command line caps counts at 1e7) and ran for ever."""
+    from tpee_ompl.bench.config import load_campaign
+
+    res = run_campaign(tiny_config(query_file, tmp_path, sample_caps=(30,), anytime_budgets=()), report=False,
+                       progress_bar=False)
+    path = res.directory / "campaign.json"
+    meta = json.loads(path.read_text())
+    meta["config"]["runs"] = 10**9
+    path.write_text(json.dumps(meta))
+    with pytest.raises(ValueError, match=r"campaign.json has a bad config \(runs must be .*10000000"):
+        load_campaign(res.directory)

@@ -224,10 +224,12 @@ class CampaignConfig:
                 raise ValueError("alt_checker_caps must be None or at least one cap")
             set_("alt_checker_caps", tuple(check_int("alt_checker_caps", n, minimum=1, maximum=MAX_COUNT)
                                            for n in self.alt_checker_caps))
-        set_("anytime_queries", check_int("anytime_queries", self.anytime_queries, minimum=0, optional=True))
-        set_("max_queries", check_int("max_queries", self.max_queries, minimum=1, optional=True))
-        set_("runs", check_int("runs", self.runs, minimum=1))
-        set_("workers", check_int("workers", self.workers, minimum=0))
+        # counts capped as the command line caps them (a campaign.json edited to runs: 10**9 resumed for ever)
+        set_("anytime_queries", check_int("anytime_queries", self.anytime_queries, minimum=0, maximum=MAX_COUNT,
+                                          optional=True))
+        set_("max_queries", check_int("max_queries", self.max_queries, minimum=1, maximum=MAX_COUNT, optional=True))
+        set_("runs", check_int("runs", self.runs, minimum=1, maximum=MAX_COUNT))
+        set_("workers", check_int("workers", self.workers, minimum=0, maximum=MAX_COUNT))
         set_("seed", check_seed("seed", self.seed))
         set_("max_time", check_number("max_time", self.max_time, low=0, low_open=True, high=MAX_SECONDS))
         for flag in ("simplify", "one_run_per_ladder", "one_run_per_anytime_ladder"):
