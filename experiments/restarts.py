@@ -31,13 +31,19 @@ def torus_queries(n: int):
     return [(make_so2_torus_setup, None)] * n
 
 
-def problem_queries(name: str, n: int):
+def problem_queries(name: str, n: int, query_seed: int | None = None):
+    import dataclasses
+
+    from tpee_ompl.bench.generic_problems import GENERIC_PROBLEMS, generic_queries
     from tpee_ompl.bench.problems import get_problem
 
     if name == "torus":
         return torus_queries(n)
     problem = get_problem(name)
-    _, rows = problem.queries()
+    if query_seed is not None and name in GENERIC_PROBLEMS:  # held-out queries: the problem's sampler, another seed
+        rows = generic_queries(dataclasses.replace(GENERIC_PROBLEMS[name], seed=query_seed))
+    else:
+        _, rows = problem.queries()
     checker = problem.checkers[0]
     return [((lambda q=q: problem.make_setup(q, checker)[0]), problem.groups) for q in rows[:n]]
 
@@ -48,6 +54,9 @@ def main() -> None:
     p.add_argument("--max-queries", type=int, default=10)
     p.add_argument("--budget", type=float, default=1.0, help="seconds per run")
     p.add_argument("--restart-after", type=int, default=None, help="default: RESTART_AFTER")
+    p.add_argument("--query-seed", type=int, default=None,
+                   help="draw the generic problems' queries with this seed instead (held-out queries; kinova-posts and "
+                        "the torus keep theirs)")
     args = p.parse_args()
     from ompl import util as ou
 
@@ -55,10 +64,11 @@ def main() -> None:
 
     ou.setLogLevel(ou.LOG_NONE)
     after = args.restart_after or RESTART_AFTER
-    print(f"budget {args.budget:g} s per run, restart_after {after} against None")
+    print(f"budget {args.budget:g} s per run, restart_after {after} against None"
+          + ("" if args.query_seed is None else f", generic queries drawn with seed {args.query_seed}"))
     for name in args.problems:
         lengths: dict[str, list[float]] = {"restarts": [], "single": []}
-        for k, (make_setup, groups) in enumerate(problem_queries(name, args.max_queries)):
+        for k, (make_setup, groups) in enumerate(problem_queries(name, args.max_queries, args.query_seed)):
             for label, value in (("restarts", after), ("single", None)):
                 ss = make_setup()
                 ss.setPlanner(DimensionRRT(ss.getSpaceInformation(), groups=groups, seed=k + 1, restart_after=value))
