@@ -40,7 +40,7 @@ from multiprocessing.connection import Connection, wait
 from pathlib import Path
 from typing import Protocol
 
-from ..signals import child_sigint, sigint_blocked_for_children
+from ..signals import child_sigint, die_with_parent, exit_reason, sigint_blocked_for_children
 
 __all__ = [
     "DASK_INSTALL_HINT",
@@ -98,7 +98,7 @@ def _child_main(fn: TaskFn, task: dict, conn, parent: int) -> None:
     """A pool child: run ``fn(task)`` and send ``("ok", result)`` or ``("error", message)`` to the parent
     (process ``parent``)."""
     child_sigint(signal.SIG_IGN)  # Ctrl-C goes to the parent, which ends us
-    _die_with_parent(parent)
+    die_with_parent(parent)
     try:
         msg = ("ok", fn(task))
     except BaseException as exc:  # noqa: BLE001 (reported to the parent, which records the task as failed)
@@ -112,15 +112,6 @@ def _child_main(fn: TaskFn, task: dict, conn, parent: int) -> None:
     sys.stdout.flush()
     sys.stderr.flush()
     os._exit(0)
-
-
-def _death_reason(exitcode: int | None) -> str:
-    if exitcode is not None and exitcode < 0:
-        try:
-            return f"worker killed by {signal.Signals(-exitcode).name}"
-        except ValueError:
-            return f"worker killed by signal {-exitcode}"
-    return f"worker exited with status {exitcode} without a result"
 
 
 def task_failure(task: dict, reason: str, attempts: int) -> dict:
@@ -230,7 +221,7 @@ class ProcessPoolExecutor:
         r.proc.join(timeout=5)
         r.conn.close()
         reason = (f"no result within its time limit ({r.task.get('time_limit_s'):g} s): killed" if timed_out
-                  else _death_reason(r.proc.exitcode))
+                  else "worker " + exit_reason(r.proc.exitcode))
         return {"lost": reason}
 
     def shutdown(self, cancel: bool = False) -> None:
@@ -245,18 +236,6 @@ class ProcessPoolExecutor:
 
 
 # --------------------------------------------------------------------------- fresh subprocess per task
-def _die_with_parent(parent: int) -> None:
-    """Linux: get SIGKILL when the parent (process ``parent``: the campaign, or the Dask worker) dies, so no orphan
-    keeps running; exit at once when it died already, while this process started (its imports take ~1 s)."""
-    if sys.platform.startswith("linux"):
-        with contextlib.suppress(Exception):
-            import ctypes
-
-            ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
-    if os.getppid() != parent:
-        os._exit(1)
-
-
 def run_task_in_subprocess(task: dict, fn_path: str = "tpee_ompl.bench.experiment:run_query_task") -> dict:
     """Run ``fn(task)`` in a fresh Python process and return its (JSON) result.
 
@@ -330,7 +309,7 @@ def _subprocess_main(argv: Sequence[str]) -> int:
     import importlib
 
     fn_path, src, dst, parent = argv
-    _die_with_parent(int(parent))
+    die_with_parent(int(parent))
     mod, _, attr = fn_path.partition(":")
     fn = getattr(importlib.import_module(mod), attr)
     result = fn(json.loads(Path(src).read_text()))

@@ -27,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-from ..signals import child_sigint, sigint_blocked_for_children
+from ..signals import child_sigint, die_with_parent, exit_reason, sigint_blocked_for_children
 from ..model.sectors import SECTOR_PAIRS, check_sector
 from ..model.wearer_arm import WearerArm
 from ..planning.paths import resample_waypoints
@@ -186,23 +186,11 @@ def _collect_default_pair(job: tuple, robot: WearerArm | None = None) -> Collect
                         opts.per_pair, opts.min_difference, opts.draws_per_pair)
 
 
-def _die_with_parent(parent: int) -> None:
-    """Linux: get SIGKILL when the build's process (``parent``) dies, so no orphan keeps planning; exit at once when
-    it died already, while this process started."""
-    if sys.platform.startswith("linux"):
-        with contextlib.suppress(Exception):
-            import ctypes
-
-            ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
-    if os.getppid() != parent:
-        os._exit(1)
-
-
 def _pair_process(collect: Callable[[tuple], Collected], job: tuple, conn: Connection, parent: int) -> None:
     """A pair's own process: send ``("ok", collect(job))`` or ``("error", exception)`` to the build (process
     ``parent``), then leave at once."""
     child_sigint(signal.SIG_IGN)  # Ctrl-C goes to the build, which ends us
-    _die_with_parent(parent)
+    die_with_parent(parent)
     try:
         msg: tuple[str, Any] = ("ok", collect(job))
     except Exception as exc:  # noqa: BLE001 (raised again by the build)
@@ -220,16 +208,6 @@ def _pair_process(collect: Callable[[tuple], Collected], job: tuple, conn: Conne
     sys.stdout.flush()
     sys.stderr.flush()
     os._exit(0)
-
-
-def _death(exitcode: int | None) -> str:
-    """How a process that sent no result ended (its exit code), e.g. "killed by SIGKILL"."""
-    if exitcode is not None and exitcode < 0:
-        try:
-            return f"killed by {signal.Signals(-exitcode).name}"
-        except ValueError:
-            return f"killed by signal {-exitcode}"
-    return f"exited with status {exitcode} without a result"
 
 
 def _collect_in_processes(
@@ -277,7 +255,7 @@ def _collect_in_processes(
                     proc.kill()
                     proc.join(timeout=5)
                 if message is None:
-                    deaths.setdefault(k, []).append(_death(proc.exitcode))
+                    deaths.setdefault(k, []).append(exit_reason(proc.exitcode))
                     lost.append(k)
                 elif message[0] == "ok":
                     results[k] = message[1]
