@@ -6,6 +6,7 @@ import json
 
 import numpy as np
 import pytest
+from helpers.hostile_files import make_unreadable
 
 from tpee_ompl.cli._common import CliError
 from tpee_ompl.cli.library import DEFAULT_LIBRARY, build_parser
@@ -249,26 +250,6 @@ def test_plan_and_track_refuse_another_models_library_and_library_stats_describe
     assert "built for model" in out and "pairs: 1->4" in out and '"per_pair": 1' in out
 
 
-def _unreadable(path, monkeypatch: pytest.MonkeyPatch) -> None:
-    """Make ``path`` a file this process may not read: mode 000, and for root (who reads it anyway) an ``open``
-    that fails on it as the system does for another user."""
-    import builtins
-    import errno
-    import os
-
-    path = os.fspath(path)
-    os.chmod(path, 0)
-    if os.access(path, os.R_OK):
-        real_open = builtins.open
-
-        def refusing_open(file, *args, **kwargs):
-            if isinstance(file, (str, os.PathLike)) and os.path.abspath(file) == os.path.abspath(path):
-                raise PermissionError(errno.EACCES, os.strerror(errno.EACCES), os.fspath(file))
-            return real_open(file, *args, **kwargs)
-
-        monkeypatch.setattr(builtins, "open", refusing_open)
-
-
 @pytest.mark.parametrize("command", [["plan", "--from", "1", "--to", "2", "--time", "0.05"], ["library", "stats"],
                                      ["library", "query", "--query-set", "planning_necessary"]])
 def test_a_library_file_it_may_not_read_is_said_to_be_unreadable_by_permission(small_file: str, tmp_path, monkeypatch,
@@ -278,7 +259,7 @@ def test_a_library_file_it_may_not_read_is_said_to_be_unreadable_by_permission(s
 
     lib = tmp_path / "locked.npz"
     shutil.copy(small_file, lib)
-    _unreadable(lib, monkeypatch)
+    make_unreadable(lib, monkeypatch)
     assert main([*command, "--library", str(lib)]) == 1
     err = capsys.readouterr().err.strip()
     assert err.endswith(f"error: path library {lib} cannot be read (Permission denied)"), err

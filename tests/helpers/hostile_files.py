@@ -160,3 +160,23 @@ def write_path_file(path: Path, waypoints: Any) -> Path:
     """A ``plan --json``-like file whose ``path`` is ``waypoints``."""
     path.write_text(json.dumps({"path": waypoints}), encoding="utf-8")
     return path
+
+
+def make_unreadable(path: Path | str, monkeypatch: Any) -> None:
+    """Make ``path`` a file this process may not read: mode 000, and for root (who reads it anyway) an ``open``
+    that fails on it as the system does for another user (``monkeypatch``: pytest's fixture)."""
+    import builtins
+    import errno
+    import os
+
+    path = os.fspath(path)
+    os.chmod(path, 0)
+    if os.access(path, os.R_OK):
+        real_open = builtins.open
+
+        def refusing_open(file, *args, **kwargs):
+            if isinstance(file, (str, os.PathLike)) and os.path.abspath(file) == os.path.abspath(path):
+                raise PermissionError(errno.EACCES, os.strerror(errno.EACCES), os.fspath(file))
+            return real_open(file, *args, **kwargs)
+
+        monkeypatch.setattr(builtins, "open", refusing_open)

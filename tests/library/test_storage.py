@@ -6,7 +6,7 @@ import re
 
 import numpy as np
 import pytest
-from helpers.hostile_files import LIBRARY_DEFECTS, write_library_file
+from helpers.hostile_files import LIBRARY_DEFECTS, make_unreadable, write_library_file
 from helpers.library_standins import RRT_PAIRS, necessary_queries
 
 from tpee_ompl.files import OutputExistsError
@@ -168,23 +168,10 @@ def test_a_file_it_may_not_read_raises_permission_error_naming_it(robot: WearerA
     """A file of mode 000 was a LibraryFileError "unreadable (truncated or not a library file): not an .npz
     archive" (zipfile.is_zipfile says False for a file it cannot open).  Root reads any file: its open is made to
     refuse as the system does for another user."""
-    import builtins
-    import errno
-    import os
-
     from tpee_ompl.library.storage import library_model_hash
 
     f = write_library_file(tmp_path / "lib.npz")
-    f.chmod(0)
-    if os.access(f, os.R_OK):
-        real_open = builtins.open
-
-        def refusing_open(file, *args, **kwargs):
-            if isinstance(file, (str, os.PathLike)) and os.path.abspath(file) == os.path.abspath(f):
-                raise PermissionError(errno.EACCES, os.strerror(errno.EACCES), os.fspath(file))
-            return real_open(file, *args, **kwargs)
-
-        monkeypatch.setattr(builtins, "open", refusing_open)
+    make_unreadable(f, monkeypatch)
     for read in (lambda: PathLibrary.load(f, robot), lambda: library_model_hash(f)):
         with pytest.raises(PermissionError, match=re.escape(f"path library {f} cannot be read (Permission denied)")):
             read()
