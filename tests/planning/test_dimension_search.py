@@ -108,6 +108,27 @@ def test_search_finds_a_valid_path_around_the_box_and_only_shortens_it(batch: bo
     np.testing.assert_array_equal(search.W[[0, -1]], [start, goal])
 
 
+@pytest.mark.parametrize("batch", [True, False])
+def test_blocked_straight_path_costs_only_its_waypoints_when_the_connect_trees_start_alone(batch: bool) -> None:
+    si, _ = box_problem(lo=(-0.05, -1.0), hi=(0.05, 0.6))  # the middle waypoint of 7 is in the wall
+    grouped = GroupedSpace(si, [[0, 1]], 7)
+    start, goal = np.array([-0.8, 0.0]), np.array([0.8, 0.0])
+    checks = {}
+    for connect in (True, False):
+        checker = Checker(si, grouped.layout, batch)
+        search = Search(grouped, checker, np.random.default_rng(3), start, goal,
+                        settings=SearchSettings(narrow_after=200, narrowing=0.5, connect=connect),
+                        range_={0: np.full(2, 0.04)})
+        checks[connect] = checker.counter()
+        np.testing.assert_array_equal(search.V, [True, True, True, False, True, True, True])
+        assert not search.valid
+        while not search.valid and search.samples < 3000:
+            search.iterate()
+        assert search.valid and path_passes_motion_checks(si, search.W)
+    # the connect trees grow from the start and goal alone, so the valid motions beside the wall go unchecked
+    assert checks[True] == 5 < checks[False]  # 5 states, then 4 motions of ~10 states
+
+
 @pytest.mark.parametrize(("batch", "shortcuts"), [(True, False), (False, False), (True, True)])
 @pytest.mark.parametrize("limit", [2, 7, 64])
 def test_iterate_in_blocks_matches_one_sample_per_call(limit: int, batch: bool, shortcuts: bool) -> None:

@@ -57,14 +57,18 @@ class Search(SampleDraws):
                 W[1:-1, d] = initial[1:-1, d]
         self.W = W
         V = np.ones(len(W), dtype=bool)
+        checked = np.ones(len(W) - 1, dtype=bool)  # the motions whose validity E states
         if all(W[k : k + 2].tobytes() in checker.passed for k in range(len(W) - 1)):
             self.V, self.E = V, V[1:].copy()  # a path whose motions all passed si.checkMotion (released rows)
         else:
             V[1:-1] = checker.states(W[1:-1])
             self.V = V
             self.E = V[:-1] & V[1:]
-            # in full at once: the initial path is often valid, and then screening a coarse subset first only costs
-            self.E[self.E] = checker.check_motions(W[:-1][self.E], W[1:][self.E])
+            if V.all() or grouped.prescribed or not settings.connect or initial is not None or turns is not None:
+                # in full at once: the initial path is often valid, and then screening a coarse subset first only costs
+                self.E[self.E] = checker.check_motions(W[:-1][self.E], W[1:][self.E])
+            else:  # the connect trees grow from the start and goal alone: the valid prefix and suffix go unused
+                checked[:] = self.E[:] = False
         self.L = self.dist(W[:-1], W[1:])
         self._init_draws(grouped, rng, settings.narrow_after, settings.narrowing, range_, local)
         self._tree: LayeredTrees | None = None
@@ -75,7 +79,7 @@ class Search(SampleDraws):
         """Turning points of a connect-tree path that did not fit the h steps (None: no such path)."""
         self._spread_pending = False
         self._known: dict[bytes, bool] = {W[k : k + 2].tobytes(): bool(self.E[k]) for k in range(len(W) - 1)
-                                          if self.V[k] and self.V[k + 1]}
+                                          if self.V[k] and self.V[k + 1] and checked[k]}
         """Segment (two waypoint rows as bytes) -> motion valid, for every motion checked so far."""
         # feasibility phase: all planned groups vary jointly (with one planned group: that group), their DOFs in
         # index order, so that its samples, and so the first path, do not depend on how the DOFs are grouped
