@@ -43,6 +43,27 @@ def test_exact_solution_termination_stops_at_the_first_path() -> None:
     assert path_passes_motion_checks(ss.getSpaceInformation(), ss.getSolutionPath())
 
 
+def test_connect_trees_path_is_posted_as_found_before_it_is_fitted_to_the_steps() -> None:
+    ss = make_planar_arm_setup()
+    checker = ss.getStateValidityChecker()
+    at_post = []
+
+    def callback(planner, states, cost):
+        at_post.append((checker.collision_checks, len(states)))
+
+    ptc = ob.plannerOrTerminationCondition(ob.exactSolnPlannerTerminationCondition(ss.getProblemDefinition()),
+                                           ob.timedPlannerTerminationCondition(60.0))
+    planner = DimensionRRT(ss.getSpaceInformation(), seed=8, max_samples=CAP, batch=False)
+    planner.set_intermediate_solution_callback(callback)
+    ss.clear()
+    ss.setPlanner(planner)
+    assert ss.solve(ptc) == ob.PlannerStatus.EXACT_SOLUTION
+    assert len(at_post) == 1 and at_post[0][0] == checker.collision_checks  # nothing checked after the post
+    # every tree node on the way (9 here): more than the h = 7 steps a fitted path has
+    assert at_post[0][1] == ss.getSolutionPath().getStateCount() > planner.last_run_stats()["h"] == 7
+    assert path_passes_motion_checks(ss.getSpaceInformation(), ss.getSolutionPath())
+
+
 def test_infinite_cost_threshold_means_first_solution() -> None:
     ss = make_planar_arm_setup()
     ss.getProblemDefinition().getOptimizationObjective().setCostThreshold(ob.Cost(math.inf))

@@ -43,12 +43,23 @@ def _solve(ss: og.SimpleSetup, **kw) -> tuple[DimensionRRT, ob.PlannerStatus]:
     return planner, ss.solve(30.0)
 
 
-def test_fixed_h_that_cannot_bridge_times_out_at_its_sample_cap() -> None:
+def test_fixed_h_that_cannot_bridge_times_out_at_its_sample_cap_in_the_layered_trees() -> None:
     ss = _two_walls()
-    planner, status = _solve(ss, h=3, max_samples=1500)
+    planner, status = _solve(ss, h=3, max_samples=1500, connect=False)
     assert status == ob.PlannerStatus.TIMEOUT
     st = planner.last_run_stats()
     assert st["h"] == 3 and st["samples"] == 1500
+
+
+def test_fixed_h_that_cannot_bridge_still_returns_the_connect_trees_path() -> None:
+    ss = _two_walls()
+    planner, status = _solve(ss, h=3, max_samples=1500)
+    assert status == ob.PlannerStatus.EXACT_SOLUTION
+    st = planner.last_run_stats()
+    assert st["h"] == 3 and st["solutions_posted"] == 1
+    path = ss.getSolutionPath()
+    assert path.getStateCount() > 3  # every tree node on the way: more turns than the steps hold
+    assert path_passes_motion_checks(ss.getSpaceInformation(), path)
 
 
 def test_max_h_raises_h_by_inserting_steps_until_a_path_exists() -> None:

@@ -11,7 +11,8 @@ them.  Seeded with the valid prefix and suffix of the base path (the search pass
 The result is the path's turning points: the steps of one connect lie on one straight line and
 count as one segment (that longer motion is checked again, as one motion, when the path is fitted
 to the fake-time steps in :mod:`tpee_ompl.planning.dimension_search`); :attr:`ConnectTrees.verified`
-says which of its segments are single tree edges, checked already.
+says which of its segments are single tree edges, checked already, and :attr:`ConnectTrees.edges` is
+the same path through every tree node on the way (a valid path as it stands, posted before the fit).
 
 A sample costs Python time that RRTConnect spends in C++, so the per-sample path is kept lean: with
 a per-state checker (``check_step``) a step is one ``si.checkMotion`` on plain lists, and
@@ -56,6 +57,8 @@ class ConnectTrees:
         single step, the connect's first node for the steps of one connect; -1 for the root)."""
         self.verified: list[bool] = []
         """Once the trees met: per segment of the returned path, whether it is one tree edge (checked)."""
+        self.edges: np.ndarray | None = None
+        """Once the trees met: the path through every tree node on the way (each segment a tree edge, checked)."""
         f, b = valid_ends(V, E)
         for t in range(f + 1):
             self._add(0, W[t], t - 1, t - 1)
@@ -110,6 +113,8 @@ class ConnectTrees:
         if a == 1:
             P, verified = P[::-1], verified[::-1]
         self.verified = verified
+        E = np.vstack([self._nodes(a, new)[::-1], self._nodes(1 - a, end)[1:]])
+        self.edges = E[::-1] if a == 1 else E
         return P
 
     def _nearest(self, k: int, target: np.ndarray) -> tuple[int, float, np.ndarray]:
@@ -180,6 +185,13 @@ class ConnectTrees:
         for j in range(n):
             last = prev = self._add(k, pts[j], prev, i)
         return last, n == m
+
+    def _nodes(self, k: int, node: int) -> np.ndarray:
+        """Every node's values from node back to tree k's root."""
+        parents, out = self.trees[k].parents, [node]
+        while parents[out[-1]] >= 0:
+            out.append(parents[out[-1]])
+        return self.trees[k].values[out]
 
     def _chain(self, k: int, node: int) -> tuple[np.ndarray, list[bool]]:
         """Turning points from node back to tree k's root (straight runs of one connect merged), and per

@@ -32,12 +32,15 @@ a waypoint's configuration then does not depend on its step, so two trees grow a
 grows them (:mod:`tpee_ompl.planning.connect_trees`: uniform samples from the planner's own seeded
 generator, steps of at most 0.2 x the space's maximum extent, every motion checked in full), from
 the start and the goal alone (with ``initial_waypoints``: from their valid prefix and suffix; the
-straight line's prefix would pin the trees to the obstacle it ends at).  Once they meet, the path's turning points (a
-connect's collinear steps are one segment, checked again as one motion) are fitted to the ``h``
+straight line's prefix would pin the trees to the obstacle it ends at).  Once they meet, their path
+through every tree node (each motion checked) is posted at once, as RRTConnect's would be; then its turning
+points (a connect's collinear steps are one segment, checked again as one motion) are fitted to the ``h``
 steps: while there are more than ``h``, the interior point whose shortcut saves most and passes is
-dropped; the points are held (repeated) to fill the steps, the path is posted, and the next sample
-first spreads the held points over its segments (kept when that path passes the checker).  A path
-that cannot be fitted seeds the layered trees above with its points at ``h`` evenly spaced places.
+dropped; the points are held (repeated) to fill the steps, the path is posted when shorter, and the next
+sample first spreads the held points over its segments (kept when that path passes the checker).  The fit
+asks the termination condition before each check, so a run stopped at its first path checks nothing more.  A
+path that cannot be fitted seeds the layered trees above with its points at ``h`` evenly spaced places (the
+trees' path stays the answer until a shorter one fits).
 With a prescribed group (the TPEE case) the layered trees stay: its values depend on the step.
 
 Raising h (sec. 4.1.3: with ``h`` fixed, an obstacle that needs more than ``h - 1`` segments is never

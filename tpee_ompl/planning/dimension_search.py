@@ -112,7 +112,8 @@ class Search(SampleDraws):
     def cost(self) -> float:
         return float(self.L.sum())
 
-    def iterate(self, limit: int = 1, stop: Callable[[], bool] | None = None) -> int:
+    def iterate(self, limit: int = 1, stop: Callable[[], bool] | None = None,
+                found: Callable[[np.ndarray, float], None] | None = None) -> int:
         """Draw one sample and try it at every intermediate step (up to ``limit`` samples; see below).
 
         On a valid path the sample is the current group's (paper's rule), followed with ``shortcuts`` by
@@ -126,7 +127,10 @@ class Search(SampleDraws):
         first passed over in one vectorised step, unless a shortcut sweep is due (it runs after the next
         sample, and the samples after it are tested against the swept path); in the connect trees, up to ``limit``
         samples go through in one call, until the trees meet or ``stop()`` (asked before each sample
-        after the first): either way the same samples and result as single calls.
+        after the first): either way the same samples and result as single calls.  When they meet, their path
+        through every tree node (each motion checked) goes to ``found(path, cost)`` before it is fitted to the h
+        steps, and ``stop()`` is asked before the fit checks a motion (RRTConnect's first path, as soon as
+        it has one).
         """
         if self._spread_pending:
             self._spread()
@@ -152,7 +156,7 @@ class Search(SampleDraws):
             else:
                 self._tree = self._layered(self.W, self.V, self.E)
         if self._connect is not None:
-            return self._connect_samples(max(1, limit), stop)
+            return self._connect_samples(max(1, limit), stop, found)
         c = self.draw(gi if valid else None)
         self.samples += 1
         self.group_samples[gi] += 1
@@ -189,7 +193,8 @@ class Search(SampleDraws):
     def _layered(self, W: np.ndarray, V: np.ndarray, E: np.ndarray) -> LayeredTrees:
         return LayeredTrees(W, V, E, self._fdims, self._hold, functools.partial(self.delta, dims=self._fdims))
 
-    def _connect_samples(self, limit: int, stop: Callable[[], bool] | None) -> int:
+    def _connect_samples(self, limit: int, stop: Callable[[], bool] | None,
+                         found: Callable[[np.ndarray, float], None] | None = None) -> int:
         """Feasibility phase without prescribed groups: up to ``limit`` RRTConnect iterations (the random rows
         :meth:`draw` would use); once the trees meet, the path is fitted to the h steps (:meth:`_fit`) or
         handed to the layered trees.  Returns 1 when the path was fitted, else 0."""
@@ -218,6 +223,10 @@ class Search(SampleDraws):
             key = segment_key(P[k], P[k + 1])
             self._known[key] = True
             self.checker.passed.add(key)
+        if found is not None:
+            E = self._connect.edges
+            self.checker.passed.update(segment_key(E[k], E[k + 1]) for k in range(len(E) - 1))
+            found(E, float(self.dist(E[:-1], E[1:]).sum()))
         self._connect = None
         return int(self._fit(P, stop))
 
@@ -243,8 +252,8 @@ class Search(SampleDraws):
         While K > h, the interior point whose shortcut saves most and passes in full is dropped; the
         runs are checked as whole motions and the path adopted with its points held (:meth:`_adopt`).
         False when more points than steps remain, a run fails as one motion or ``stop()`` (asked before each
-        shortcut's check: a long path costs up to K^2 of them); :attr:`unfitted` then holds the points, for a
-        higher h or the layered trees."""
+        shortcut's check, a long path costs up to K^2 of them, and before the runs' checks); :attr:`unfitted`
+        then holds the points, for a higher h or the layered trees."""
         h, dist = self.g.h, self.dist
         while len(P) > h:
             gain = dist(P[:-2], P[1:-1]) + dist(P[1:-1], P[2:]) - dist(P[:-2], P[2:])
@@ -259,6 +268,10 @@ class Search(SampleDraws):
                 self.unfitted = P
                 return False
         W = np.vstack([P, np.repeat(P[-1:], h - len(P), axis=0)])
+        unchecked = any(W[k : k + 2].tobytes() not in self._known and (W[k] != W[k + 1]).any() for k in range(len(W) - 1))
+        if unchecked and stop is not None and stop():
+            self.unfitted = P
+            return False
         if self._check_segments(W):
             self.unfitted = P
             return False

@@ -208,6 +208,14 @@ class GoalLoop:
             self.record(time.perf_counter())
         log.info("DimensionRRT: no path after %d samples, h raised to %d", run.done, run.grouped.h)
 
+    def _found(self, W: np.ndarray, cost: float) -> None:
+        """A valid path the search found before it fits it to its steps (the connect trees' path, every motion
+        checked): offered at once, so that a first path is posted as soon as RRTConnect's would be."""
+        if cost < self.poster.found_cost:
+            now = time.perf_counter()
+            self.poster.offer(W, cost, now)
+            self.record(now)
+
     def _pass(self, run: GoalRun, ptc: ob.PlannerTerminationCondition) -> None:
         """Samples until the next limit (a batch, the cap, the stall, the release, a stop, the goal's turn); a
         shorter path is offered to OMPL at once."""
@@ -225,9 +233,9 @@ class GoalLoop:
 
         def stop() -> bool:  # asked within a call too (between connect-tree samples): the count as it is then
             self.on_drawn(self.drawn + search.samples - before)
-            return bool(ptc())
+            return self.poster.satisfied or bool(ptc())
 
-        accepted = search.iterate(max(1, limit), stop)
+        accepted = search.iterate(max(1, limit), stop, self._found)
         self.drawn += search.samples - before
         self.on_drawn(self.drawn)
         now = time.perf_counter()
