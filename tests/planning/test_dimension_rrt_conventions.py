@@ -16,6 +16,7 @@ from ompl import geometric as og
 
 from tests.helpers.planning_arms import planar_arm_setup
 from tests.helpers.planning_spaces import LengthTimes100, PathLengthTimes100
+from tpee_ompl.bench.problems import get_problem
 from tpee_ompl.examples.planar_arm import make_planar_arm_setup
 from tpee_ompl.planning.dimension_rrt import DimensionRRT
 from tpee_ompl.planning.paths import path_passes_motion_checks, set_state
@@ -62,6 +63,51 @@ def test_connect_trees_path_is_posted_as_found_before_it_is_fitted_to_the_steps(
     # every tree node on the way (9 here): more than the h = 7 steps a fitted path has
     assert at_post[0][1] == ss.getSolutionPath().getStateCount() > planner.last_run_stats()["h"] == 7
     assert path_passes_motion_checks(ss.getSpaceInformation(), ss.getSolutionPath())
+
+
+def _arm6_query1(cap: int, checkpoints: list[int] | None = None, ptc=None) -> tuple[DimensionRRT, og.SimpleSetup]:
+    """The generic problem arm6, query 1, seed 1 (its connect trees meet at sample 38 with one straight run)."""
+    problem = get_problem("arm6")
+    ss = problem.make_setup(problem.queries()[1][1], "discrete")[0]
+    planner = DimensionRRT(ss.getSpaceInformation(), groups=problem.groups, seed=1, max_samples=cap)
+    if checkpoints:
+        planner.set_sample_checkpoints(checkpoints)
+    ss.setPlanner(planner)
+    assert ss.solve(ob.timedPlannerTerminationCondition(60.0) if ptc is None else ptc(planner))
+    return planner, ss
+
+
+def test_progress_row_of_the_connect_trees_path_counts_the_samples_that_found_it() -> None:
+    planner, _ = _arm6_query1(300)
+    n = next(samples for _, cost, samples in planner.last_run_stats()["progress"] if math.isfinite(cost))
+    assert _arm6_query1(n)[0].last_run_stats()["solutions_posted"] >= 1
+    problem = get_problem("arm6")
+    ss = problem.make_setup(problem.queries()[1][1], "discrete")[0]
+    before = DimensionRRT(ss.getSpaceInformation(), groups=problem.groups, seed=1, max_samples=n - 1)
+    ss.setPlanner(before)
+    assert ss.solve(60.0) == ob.PlannerStatus.TIMEOUT
+
+
+def test_a_fit_that_only_merges_the_trees_steps_is_not_posted_again() -> None:
+    planner, ss = _arm6_query1(38)
+    stats = planner.last_run_stats()
+    assert stats["solutions_posted"] == 1 and stats["best_cost"] == pytest.approx(ss.getSolutionPath().length())
+
+
+def test_sample_checkpoint_at_the_trees_meeting_sees_what_a_run_capped_there_returns() -> None:
+    seen = []
+
+    def ptc(planner):
+        def watch() -> bool:
+            if planner.samples_drawn() == 38 and not seen:
+                seen.append(planner.last_run_stats()["progress"][-1][1])
+            return False
+        return ob.plannerOrTerminationCondition(ob.timedPlannerTerminationCondition(60.0),
+                                                ob.PlannerTerminationCondition(watch))
+
+    _arm6_query1(138, [38], ptc)
+    capped, _ = _arm6_query1(38)
+    assert seen == [capped.last_run_stats()["best_cost"]]
 
 
 def test_infinite_cost_threshold_means_first_solution() -> None:

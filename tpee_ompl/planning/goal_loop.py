@@ -83,15 +83,21 @@ class GoalLoop:
         self._last_log = -math.inf
         runs[0].turn_end = GOAL_TURN
 
-    def record(self, now: float) -> None:
-        """A progress row: (seconds since the solve began, best cost found, samples)."""
-        self.stats["progress"].append((now - self.t0, self.poster.found_cost, self.drawn))
+    def record(self, now: float, drawn: int | None = None) -> None:
+        """A progress row: (seconds since the solve began, best cost found, samples; ``drawn``: within a pass)."""
+        self.stats["progress"].append((now - self.t0, self.poster.found_cost, self.drawn if drawn is None else drawn))
+
+    def _shorter(self, cost: float) -> bool:
+        """Whether a path of this cost is worth offering: shorter than the best found by more than rounding (a
+        fit that only merged the connect trees' collinear steps is the posted path again, its length summed
+        another way)."""
+        return cost < self.poster.found_cost * (1.0 - 1e-12)
 
     def run(self, ptc: ob.PlannerTerminationCondition) -> None:
         """Offer the runs' initial paths, loop, post what is pending."""
         poster = self.poster
         for run in self.runs:
-            if run.best < poster.found_cost:
+            if self._shorter(run.best):
                 poster.offer(run.search.W, run.best, time.perf_counter())
         self.record(time.perf_counter())
         cap = self.limits.cap
@@ -168,7 +174,7 @@ class GoalLoop:
         self.waiting.append(run.goal)
         self.runs[self.turn] = fresh
         self.tried += 1
-        if math.isfinite(fresh.best) and fresh.best < self.poster.found_cost:  # its initial path is valid
+        if math.isfinite(fresh.best) and self._shorter(fresh.best):  # its initial path is valid
             self.poster.offer(fresh.search.W, fresh.best, time.perf_counter())
             self.record(time.perf_counter())
         log.info("DimensionRRT: no path to a goal state after %d samples; the next of the goal states beyond "
@@ -203,18 +209,19 @@ class GoalLoop:
         refined: GroupedSpace = run.grouped.refined(self.q0, run.goal)
         run.restart(refined, self.new_search(refined, run.goal, None, run.search.unfitted))
         run.best = run.search.cost if run.search.valid else math.inf
-        if run.best < self.poster.found_cost:
+        if self._shorter(run.best):
             self.poster.offer(run.search.W, run.best, time.perf_counter())
             self.record(time.perf_counter())
         log.info("DimensionRRT: no path after %d samples, h raised to %d", run.done, run.grouped.h)
 
-    def _found(self, W: np.ndarray, cost: float) -> None:
-        """A valid path the search found before it fits it to its steps (the connect trees' path, every motion
-        checked): offered at once, so that a first path is posted as soon as RRTConnect's would be."""
-        if cost < self.poster.found_cost:
+    def _found(self, W: np.ndarray, cost: float, drawn: int) -> None:
+        """A valid path the search found after ``drawn`` samples, before it fits it to its steps (the connect
+        trees' path, every motion checked): offered at once, so that a first path is posted as soon as
+        RRTConnect's would be."""
+        if self._shorter(cost):
             now = time.perf_counter()
             self.poster.offer(W, cost, now)
-            self.record(now)
+            self.record(now, drawn)
 
     def _pass(self, run: GoalRun, ptc: ob.PlannerTerminationCondition) -> None:
         """Samples until the next limit (a batch, the cap, the stall, the release, a stop, the goal's turn); a
@@ -232,16 +239,22 @@ class GoalLoop:
         before = search.samples
 
         def stop() -> bool:  # asked within a call too (between connect-tree samples): the count as it is then
-            self.on_drawn(self.drawn + search.samples - before)
+            n = self.drawn + search.samples - before
+            self.on_drawn(n)
+            if n in lim.stops:  # asked once this pass has ended there, so that it sees what a run capped there returns
+                return self.poster.satisfied
             return self.poster.satisfied or bool(ptc())
 
-        accepted = search.iterate(max(1, limit), stop, self._found)
+        def found(W: np.ndarray, cost: float) -> None:
+            self._found(W, cost, self.drawn + search.samples - before)
+
+        accepted = search.iterate(max(1, limit), stop, found)
         self.drawn += search.samples - before
         self.on_drawn(self.drawn)
         now = time.perf_counter()
         if accepted and search.valid and search.cost < run.best:
             run.best, run.improved_at = search.cost, search.samples
-            if search.cost < self.poster.found_cost:
+            if self._shorter(search.cost):
                 self.poster.offer(search.W, search.cost, now)
                 self.record(now)
                 self._last_log = now
