@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from helpers.library_standins import sampler
-from helpers.planning_spaces import LengthTimes100, locked_dimension_space
+from helpers.planning_spaces import LengthTimes100
 from ompl import base as ob
 from ompl import geometric as og
 
@@ -148,6 +148,8 @@ def test_bad_settings_raise_value_error_naming_them(robot, library, kwargs, matc
     ({"range_": [0.1, 0.1]}, "range_"),
     ({"h": 9}, "h must be 7"),  # these two were accepted and every planned solve dropped Table 3's row (helper review)
     ({"groups": [[2, 3], [0, 1]]}, r"first group must be \[0, 1\]"),
+    # accepted too, and every cross-sector solve dropped Table 3's row (no restarts on a prescribed row)
+    ({"restart_after": 1}, "restart_after: restarts are for problems without a prescribed group"),
 ])
 def test_settings_the_refining_planner_would_refuse_are_refused_when_the_pipeline_is_made(robot, library, kwargs,
                                                                                           match):

@@ -67,7 +67,7 @@ class LibraryDimensionRRT(PythonPlanner):
     dimension-RRT path in :class:`DimensionRRT`); the problem definition keeps the cheaper.  A goal that
     is not one state (``GoalStates``, a sampleable region) is planned by :class:`DimensionRRT` alone (on the
     given pair's Table 3 row): the library's paths end at one state.  Bad ``options`` (groups, ``h``,
-    ``range_``) and a space without usable bounds raise ValueError here, not at the first solve.
+    ``range_``, a ``restart_after``: no restarts on Table 3's rows) and a space without usable bounds raise ValueError here, not at the first solve.
     """
 
     def __init__(
@@ -102,7 +102,7 @@ class LibraryDimensionRRT(PythonPlanner):
             raise ValueError(f"options must be a DimensionRRTOptions, got {type(opts).__name__}")
         opts = dataclasses.replace(opts, name=name, **overrides)
         DimensionRRT.checked_setup(si, opts)  # the refining planner is built at solve time: its settings are checked now
-        tpee_options(opts)  # groups and h that tpee_dimension_rrt refuses at solve time, refused now
+        tpee_options(opts)  # groups, h and restart_after that tpee_dimension_rrt refuses at solve time, refused now
         super().__init__(si, name)
         self._library, self._pair, self._options = library, pair, opts
         self._inner: DimensionRRT | None = None
