@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 from ompl import base as ob
 
@@ -39,3 +40,34 @@ print(status, sorted(m for m in ("pinocchio", "coal", "hppfcl") if m in sys.modu
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert out.returncode == 0, out.stderr
     assert out.stdout.split("\n")[0] == "Exact solution []"
+
+
+def _wall_planner() -> object:
+    """DimensionRRT (a PythonPlanner) on a 2-D wall problem."""
+    from tpee_ompl import DimensionRRT
+
+    sp = ob.RealVectorStateSpace(2)
+    sp.setBounds(0, 1)
+    si = ob.SpaceInformation(sp)
+    si.setStateValidityChecker(lambda s: not (0.4 < s[0] < 0.6 and s[1] < 0.8))
+    si.setup()
+    a, b = si.allocState(), si.allocState()
+    a[0], a[1], b[0], b[1] = 0.1, 0.2, 0.9, 0.2
+    pdef = ob.ProblemDefinition(si)
+    pdef.setStartAndGoalStates(a, b)
+    planner = DimensionRRT(si, seed=1)
+    planner.setProblemDefinition(pdef)
+    return planner
+
+
+@pytest.mark.parametrize("ptc", ["x", None, True, [1.0]])
+def test_solve_refuses_what_is_neither_a_termination_condition_nor_seconds_naming_ptc(ptc: object) -> None:
+    """A str was called as the condition inside the run: CRASH, with "'str' object is not callable" logged."""
+    with pytest.raises(TypeError, match="ptc must be an ompl.base.PlannerTerminationCondition or a number of seconds"):
+        _wall_planner().solve(ptc)
+
+
+@pytest.mark.parametrize("ptc", [1, 1.0, np.float32(1.0), "condition"])
+def test_solve_takes_seconds_of_any_number_type_or_a_termination_condition(ptc: object) -> None:
+    ptc = ob.timedPlannerTerminationCondition(1.0) if ptc == "condition" else ptc
+    assert _wall_planner().solve(ptc) == ob.PlannerStatus.EXACT_SOLUTION

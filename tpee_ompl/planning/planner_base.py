@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import logging
 import math
+import numbers
 import sys
 from collections.abc import Callable
 from typing import Any
@@ -121,9 +122,13 @@ class PythonPlanner(ob.Planner):
         self._stats = self._empty_stats()
 
     def solve(self, ptc: ob.PlannerTerminationCondition | float) -> ob.PlannerStatus:
-        """Run ``_solve`` under ``ptc`` (or that many seconds); an exception is logged and becomes CRASH."""
-        if isinstance(ptc, (int, float)):  # p.solve(1.0) from Python reaches here with a float
+        """Run ``_solve`` under ``ptc`` (or that many seconds); an exception is logged and becomes CRASH.  A ``ptc``
+        that is neither is the caller's error: TypeError, as OMPL's own planners raise."""
+        if isinstance(ptc, numbers.Real) and not isinstance(ptc, bool):  # p.solve(1.0) from Python
             ptc = ob.timedPlannerTerminationCondition(float(ptc))
+        elif not isinstance(ptc, ob.PlannerTerminationCondition):  # (a str was called as the condition: CRASH)
+            raise TypeError("ptc must be an ompl.base.PlannerTerminationCondition or a number of seconds, "
+                            f"got {type(ptc).__name__} {ptc!r:.80}")
         self._start_run()
         try:
             if self.getProblemDefinition() is None:
