@@ -256,6 +256,15 @@ def test_default_planner_refuses_a_time_limit_ompl_cannot_keep(robot, kw):
         make_default_planner(robot, library=None, **kw)
 
 
+@pytest.mark.parametrize(("kw", "match"), [({"library": 5}, "library must be 'default', a library file's path"),
+                                          ({"library": ""}, "library must be"),
+                                          ({"robot": None}, "robot must be a WearerArm")])
+def test_default_planner_refuses_a_library_or_robot_of_the_wrong_kind_naming_it(robot, kw, match):
+    """library=5 was a TypeError "expected str, bytes or os.PathLike object", robot=None an AttributeError."""
+    with pytest.raises(ValueError, match=match):
+        make_default_planner(**{"robot": robot, **kw})
+
+
 def test_the_default_planner_leaves_ompls_log_level_and_seeds_ompl_at_each_call(robot, monkeypatch, caplog):
     """OMPL reseeds after a later setSeed too (it only logs an error, silenced here): each call's seed takes effect,
     where a second seed used to be refused with a warning that it "changes nothing"."""

@@ -328,7 +328,7 @@ def make_default_planner(
     A cross-sector motion goes to :class:`~tpee_ompl.library.planner.LibraryDimensionRRT` (the DMP
     library's validated path, refined by dimension-RRT) for ``library_time`` seconds; ``library`` is
     the packaged default library (``"default"``; skipped for a robot of another model, which it was not built
-    for), a file, a loaded :class:`PathLibrary`, or None to skip this step.  Otherwise, and for same-sector re-aims: Table 3's straight motion
+    for), a file, a loaded :class:`PathLibrary`, or None to skip this step (anything else: ValueError).  Otherwise, and for same-sector re-aims: Table 3's straight motion
     (:func:`tpee_ompl.model.queries.straight_motion`; within a sector a straight joint motion) when
     collision-free, else OMPL RRTConnect on :func:`tpee_ompl.planning.setup.make_simple_setup` for
     at most ``timeout`` seconds, simplified.  Every path is checked at ``step`` (default the tracker's default step,
@@ -347,6 +347,12 @@ def make_default_planner(
     from ..planning.setup import make_simple_setup, quieter_ompl, seed_ompl
     from .planner import LibraryDimensionRRT
 
+    if not isinstance(robot, WearerArm):
+        raise ValueError(f"robot must be a WearerArm, got {type(robot).__name__}")
+    if not (library is None or isinstance(library, PathLibrary)
+            or isinstance(library, (str, os.PathLike)) and os.fspath(library)):
+        raise ValueError("library must be 'default', a library file's path, a PathLibrary or None, "
+                         f"got {library!r:.80}")
     timeout = check_number("timeout (seconds)", timeout, low=0.0, low_open=True, high=MAX_SECONDS)
     library_time = check_number("library_time (seconds)", library_time, low=0.0, low_open=True, high=MAX_SECONDS)
     if seed is not None:
