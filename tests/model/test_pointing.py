@@ -12,6 +12,7 @@ from tpee_ompl.model.pointing import (
     UnreachableTargetError,
     aim,
     aim_batch,
+    aim_checked,
     aim_errors,
     check_target,
     default_geometry,
@@ -192,3 +193,16 @@ def test_aiming_another_robot_is_a_value_error_naming_what_it_lacks(tmp_path):
                     '<limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>')
     with pytest.raises(ValueError, match=r"aiming needs the wearer arm .* this robot has the joints \['shoulder'\]"):
         PointingGeometry.from_robot(RobotChecker(urdf))
+
+
+@pytest.mark.parametrize("call", [
+    lambda robot: aim_checked(None, [[5.0, 2.0, 1.5]], 3),
+    lambda robot: aim_checked(None, [[5.0, 2.0, 1.5]], 3, geometry=PointingGeometry.from_robot(robot)),
+    lambda robot: aim_errors("r", np.zeros(4), [5.0, 2.0, 1.5]),
+    lambda robot: check_target([5.0, 2.0, 1.5], "r"),
+    lambda robot: PointingGeometry.from_robot(None),
+], ids=["aim_checked", "aim_checked_with_geometry", "aim_errors", "check_target", "from_robot"])
+def test_a_robot_that_is_not_a_wearer_arm_is_a_value_error_naming_it(robot, call):
+    """It was an AttributeError from inside ("'NoneType' object has no attribute 'model'")."""
+    with pytest.raises(ValueError, match="robot must be a WearerArm, got (NoneType|str)"):
+        call(robot)
