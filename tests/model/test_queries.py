@@ -90,6 +90,14 @@ def test_a_query_set_for_another_model_is_refused_with_the_robot(robot, tmp_path
         load_queries(f, robot)
 
 
+@pytest.mark.parametrize("load", [load_queries, load_query_set])
+@pytest.mark.parametrize("robot_arg", ["r", 5])
+def test_a_robot_that_is_not_a_wearer_arm_is_refused_naming_it(load, robot_arg):
+    """robot="r" was an AttributeError ("'str' object has no attribute 'model_hash'") after the file was read."""
+    with pytest.raises(ValueError, match="robot must be None or a WearerArm, got (str|int)"):
+        load("planning_necessary", robot_arg)
+
+
 @pytest.mark.parametrize("value", [["1", "2", "3", "4"], [1, 2, 3, True], [1, 2, 3], "1234", None])
 def test_query_from_dict_takes_only_json_numbers(value):
     d = load_queries("planning_necessary")[0].to_dict()

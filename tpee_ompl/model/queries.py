@@ -222,6 +222,8 @@ def query_entries(p: Path, doc: dict, from_dict: Callable[[object], Any]) -> lis
 
 def load_query_set(name_or_path: str | os.PathLike, robot: WearerArm | None = None) -> tuple[list[Query], dict]:
     """Queries and the file's header (everything but ``queries``); see :func:`load_queries`."""
+    if robot is not None and not isinstance(robot, WearerArm):  # (checked before the file is read)
+        raise ValueError(f"robot must be None or a WearerArm, got {type(robot).__name__}")
     p, doc = read_query_document(name_or_path)
     if not isinstance(doc, dict):
         raise QuerySetError(f"{p}: expected a JSON object at the top level, got {type(doc).__name__}")
@@ -258,5 +260,7 @@ def load_queries(name_or_path: str | os.PathLike, robot: WearerArm | None = None
         No such set or file.
     QuerySetError (a ValueError)
         Not JSON (e.g. truncated), wrong ``format_version``, malformed queries, or another model.
+    ValueError
+        ``robot`` is neither None nor a WearerArm.
     """
     return load_query_set(name_or_path, robot)[0]
