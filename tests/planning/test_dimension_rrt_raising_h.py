@@ -123,3 +123,12 @@ def test_h_is_not_raised_while_the_connect_trees_have_not_met() -> None:
     planner, status = _solve(ss, h=3, max_h=10_000, max_samples=2500)
     assert status == ob.PlannerStatus.TIMEOUT
     assert planner.last_run_stats()["h"] == 3 and planner.last_run_stats()["samples"] == 2500
+
+
+def test_stall_counts_from_the_connect_trees_path_when_it_cannot_be_fitted() -> None:
+    ss = _two_walls()
+    planner, status = _solve(ss, h=3, max_samples=3000, stall_samples=400)
+    assert status == ob.PlannerStatus.EXACT_SOLUTION
+    st = planner.last_run_stats()
+    first = next(n for _, cost, n in st["progress"] if math.isfinite(cost))
+    assert st["solutions_posted"] == 1 and st["samples"] == first + 400 < 3000

@@ -245,7 +245,8 @@ class GoalLoop:
                 return self.poster.satisfied
             return self.poster.satisfied or bool(ptc())
 
-        def found(W: np.ndarray, cost: float) -> None:
+        def found(W: np.ndarray, cost: float) -> None:  # ``stall`` counts from here (``best`` is its search's path)
+            run.improved_at = search.samples
             self._found(W, cost, self.drawn + search.samples - before)
 
         accepted = search.iterate(max(1, limit), stop, found)
