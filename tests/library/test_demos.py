@@ -83,3 +83,75 @@ def test_demo_planner_falls_back_to_the_robots_margin_when_the_wide_one_rejects_
     plan = DemoPlanner(robot, margins=(0.03,), max_samples=300, timeout=5.0)
     W = plan(q.start, q.goal, q.from_sector, q.to_sector)
     assert W is not None and plan.last_margin == robot.security_margin and plan.counts == {"margin_20mm": 1}
+
+
+def _shifted_plan(robot: WearerArm, row: int, dof: int, by: float):
+    """The straight stand-in plan with waypoint ``row``'s DOF ``dof`` moved by ``by`` rad (no motion check)."""
+    from helpers.library_standins import straight_plan
+
+    plan = straight_plan(robot)
+
+    def shifted(start, goal, i, j):
+        W = plan(start, goal, i, j)
+        if W is None:
+            return None
+        W = W.copy()
+        W[row, dof] += by
+        return W
+
+    return shifted
+
+
+@pytest.mark.parametrize("row, dof, by, match", [
+    (3, 2, 10.0, "plan returned a path for pair 1->2 that leaves the robot's joint limits"),
+    (-1, 3, 0.01, "plan returned a path for pair 1->2 that does not run from the query's start to its goal"),
+    (0, 0, 0.05, "plan returned a path for pair 1->2 that does not start at sector 1's Table-1 preset"),
+])
+def test_a_plan_path_a_library_file_could_not_hold_is_refused_naming_plan(robot: WearerArm, row, dof, by,
+                                                                           match: str) -> None:
+    """Such paths were stored: save() wrote the library and load() then refused it."""
+    from helpers.library_standins import sampler
+
+    with pytest.raises(ValueError, match=match):
+        PathLibrary.build(robot, sampler(robot), _shifted_plan(robot, row, dof, by), pairs=((1, 2),), per_pair=2)
+
+
+@pytest.mark.parametrize("which, dof, by, match", [
+    (0, 0, 0.05, "sample_query returned a query for pair 1->2 that does not start at sector 1's Table-1 preset"),
+    (1, 1, -0.05, "sample_query returned a query for pair 1->2 that does not end at sector 2's Table-1 preset"),
+    (1, 3, 50.0, "sample_query returned a query for pair 1->2 that leaves the robot's joint limits"),
+])
+def test_a_query_off_its_presets_or_limits_is_refused_naming_sample_query(robot: WearerArm, which, dof, by,
+                                                                        match: str) -> None:
+    from helpers.library_standins import sampler, straight_plan
+
+    base = sampler(robot)
+
+    def sample(rng, i, j):
+        q = [np.array(v) for v in base(rng, i, j)]
+        q[which][dof] += by
+        return q[0], q[1]
+
+    with pytest.raises(ValueError, match=match):
+        PathLibrary.build(robot, sample, straight_plan(robot), pairs=((1, 2),), per_pair=2)
+
+
+@pytest.mark.parametrize("answer, match", [
+    (None, r"sample_query must return \(start, goal\)"), ((np.zeros(4),), r"sample_query must return \(start, goal\)"),
+    ((np.zeros(3), np.zeros(4)), "sample_query must return a start and a goal of 4 finite numbers"),
+    ((np.full(4, np.nan), np.zeros(4)), "sample_query must return a start and a goal of 4 finite numbers"),
+    ((np.zeros(4) + 1j, np.zeros(4)), r"sample_query must return \(start, goal\).*real numbers"),
+])
+def test_a_sample_query_answer_that_is_no_query_is_named(robot: WearerArm, answer, match: str) -> None:
+    from helpers.library_standins import straight_plan
+
+    with pytest.raises(ValueError, match=match):
+        PathLibrary.build(robot, lambda rng, i, j: answer, straight_plan(robot), pairs=((1, 2),), per_pair=1)
+
+
+def test_a_plan_answer_holding_nan_is_named(robot: WearerArm) -> None:
+    from helpers.library_standins import sampler
+
+    with pytest.raises(ValueError, match="plan returned a path for pair 1->2 that holds NaN or inf"):
+        PathLibrary.build(robot, sampler(robot), lambda s, g, i, j: np.full((7, 4), np.nan), pairs=((1, 2),),
+                          per_pair=1)

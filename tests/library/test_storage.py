@@ -123,6 +123,29 @@ def test_a_library_its_loader_would_refuse_is_not_saved(robot: WearerArm, librar
     assert not (tmp_path / "lib.npz").exists() and not list(tmp_path.iterdir())
 
 
+@pytest.mark.parametrize("array, row, dof, by, match", [
+    ("waypoints", 3, 2, 10.0, r"pair 1->2: array 'p12_waypoints' leaves the robot's joint limits: not saved"),
+    ("starts", 0, 0, 0.05, r"pair 1->2: array 'p12_starts' does not start at sector 1's Table-1 preset .*not saved"),
+    ("goals", 1, 3, 0.01, r"pair 1->2: array 'p12_waypoints' does not run from the query's start to its goal: not "
+                          r"saved"),
+    ("waypoints", 2, 3, np.nan, r"pair 1->2: array 'p12_waypoints' holds NaN or inf: not saved"),
+])
+def test_demonstrations_its_loader_would_refuse_are_not_saved(robot: WearerArm, library: PathLibrary, tmp_path, array,
+                                                              row, dof, by, match: str) -> None:
+    """save() wrote demonstrations off the joint limits or the presets; load() then refused the file."""
+    pd = library.pairs[(1, 2)]
+    x = getattr(pd, array)
+    kept = x.copy()
+    try:
+        x[row, ..., dof] += by
+        with pytest.raises(ValueError, match=match):
+            library.save(tmp_path / "lib.npz")
+    finally:
+        x[...] = kept
+    assert not list(tmp_path.iterdir())
+    assert len(PathLibrary.load(library.save(tmp_path / "lib.npz"), robot)) == len(library)
+
+
 def _add_member(path, name: str, shape: tuple[int, ...]) -> None:
     """Append to the .npz file at ``path`` a member ``name`` whose header declares ``shape`` (float64) over 8 bytes."""
     import io

@@ -23,7 +23,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..model.sectors import PRESET_TOLERANCE, posture_preset
 from ..model.wearer_arm import WearerArm
+from ..validation import as_float_array
 from .dmp import DMP
 
 __all__ = [
@@ -38,6 +40,7 @@ __all__ = [
     "SampleQuery",
     "check_demo_margins",
     "collect_pair",
+    "demo_problem",
     "dimension_rrt_planner",
     "query_sampler",
 ]
@@ -252,6 +255,59 @@ def _key(start: np.ndarray, goal: np.ndarray) -> np.ndarray:
     return np.concatenate([start[2:], goal[2:]])
 
 
+def demo_problem(
+    robot: WearerArm | None, i: int, j: int, starts: np.ndarray, goals: np.ndarray, waypoints: np.ndarray
+) -> tuple[str, str] | None:
+    """What a library file may not hold in pair (i, j)'s demonstrations: ``(array, why)`` for the first problem,
+    ``array`` one of "starts", "goals", "waypoints", or None when there is none.
+
+    ``starts``, ``goals`` (M, 4) and ``waypoints`` (M, 7, 4) are finite radians.  Checked, within
+    :data:`~tpee_ompl.model.sectors.PRESET_TOLERANCE`: every value inside ``robot``'s joint limits (not checked
+    when ``robot`` is None), DOF1/DOF2 of each start and first waypoint at sector i's Table-1 preset and of each
+    goal and last waypoint at sector j's, each path running from its start to its goal.  Loading and saving a
+    library (:mod:`tpee_ompl.library.storage`) and :func:`collect_pair` use this one check.
+    """
+    tol = PRESET_TOLERANCE
+    if robot is not None:  # demonstrations are planned inside the limits; a DMP learned off them cannot be used
+        for name, x in (("starts", starts), ("goals", goals), ("waypoints", waypoints)):
+            if x.size and not (np.all(x >= robot.lower - tol) and np.all(x <= robot.upper + tol)):
+                return name, "leaves the robot's joint limits"
+    for name, k, rows in (("starts", i, starts), ("goals", j, goals),
+                          ("waypoints", i, waypoints[:, 0]), ("waypoints", j, waypoints[:, -1])):
+        if rows.size and not np.allclose(rows[:, :2], posture_preset(k), rtol=0.0, atol=tol):
+            return name, f"does not {'start' if k == i else 'end'} at sector {k}'s Table-1 preset in DOF1/DOF2"
+    if not (np.allclose(waypoints[:, 0], starts, rtol=0.0, atol=tol)
+            and np.allclose(waypoints[:, -1], goals, rtol=0.0, atol=tol)):
+        return "waypoints", "does not run from the query's start to its goal"
+    return None
+
+
+def _sampled(query: object, i: int, j: int) -> tuple[np.ndarray, np.ndarray]:
+    """``sample_query``'s answer as (start, goal), each four finite numbers, else ValueError naming sample_query."""
+    try:
+        start, goal = query  # type: ignore[misc]
+        start, goal = as_float_array(start, "start"), as_float_array(goal, "goal")
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"sample_query must return (start, goal) for pair {i}->{j}, got {query!r} ({exc})"[:400]) from None
+    if start.shape != (4,) or goal.shape != (4,) or not (np.all(np.isfinite(start)) and np.all(np.isfinite(goal))):
+        raise ValueError(f"sample_query must return a start and a goal of 4 finite numbers for pair {i}->{j}, "
+                         f"got {start.tolist()!r} and {goal.tolist()!r}"[:400])
+    return start, goal
+
+
+def _planned(W: object, i: int, j: int) -> np.ndarray:
+    """``plan``'s answer as a (7, 4) array of finite numbers, else ValueError naming plan."""
+    try:
+        W = as_float_array(W, "waypoints")
+    except ValueError as exc:
+        raise ValueError(f"plan returned no path for pair {i}->{j}: {exc}") from None
+    if W.shape != (N_FAKE_TIME_STEPS, 4):
+        raise ValueError(f"plan returned shape {W.shape}; expected ({N_FAKE_TIME_STEPS}, 4)")
+    if not np.all(np.isfinite(W)):
+        raise ValueError(f"plan returned a path for pair {i}->{j} that holds NaN or inf")
+    return W
+
+
 def collect_pair(
     sample_query: SampleQuery,
     plan: Plan,
@@ -261,6 +317,8 @@ def collect_pair(
     per_pair: int,
     min_difference: float,
     max_attempts: int,
+    *,
+    robot: WearerArm | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, Counter[str]]:
     """Draw, filter and plan the demonstrations of one pair (section 4.2.2).
 
@@ -270,6 +328,10 @@ def collect_pair(
     Returns starts (M, 4), goals (M, 4), waypoints (M, 7, 4), margins (M,) (``plan.last_margin``
     when the planner has one, else NaN) and counters ("sampled", "rejected_similar",
     "plan_failed", "stored", "stored_at_<margin>mm").
+
+    Every query and path is checked as a library file's are (:func:`demo_problem`; the joint limits of
+    ``robot`` only when it is given): ValueError naming ``sample_query`` or ``plan``, whichever answered
+    what a library could not save.
     """
     rng = np.random.default_rng(child)
     stats: Counter[str] = Counter()
@@ -278,7 +340,12 @@ def collect_pair(
         if len(starts) >= per_pair:
             break
         stats["sampled"] += 1
-        start, goal = (np.asarray(q, dtype=float) for q in sample_query(rng, i, j))
+        start, goal = _sampled(sample_query(rng, i, j), i, j)
+        ends = np.stack([start, goal])[None]  # the straight "path" (start, goal): checks the query alone
+        problem = demo_problem(robot, i, j, start[None], goal[None], ends)
+        if problem is not None:
+            raise ValueError(f"sample_query returned a query for pair {i}->{j} that {problem[1]}: start "
+                             f"{np.round(start, 4).tolist()}, goal {np.round(goal, 4).tolist()}")
         key = _key(start, goal)
         if keys and np.min(np.linalg.norm(np.array(keys) - key, axis=1)) < min_difference:
             stats["rejected_similar"] += 1
@@ -287,9 +354,10 @@ def collect_pair(
         if W is None:
             stats["plan_failed"] += 1
             continue
-        W = np.asarray(W, dtype=float)
-        if W.shape != (N_FAKE_TIME_STEPS, 4):
-            raise ValueError(f"plan returned shape {W.shape}; expected ({N_FAKE_TIME_STEPS}, 4)")
+        W = _planned(W, i, j)
+        problem = demo_problem(robot, i, j, start[None], goal[None], W[None])
+        if problem is not None:
+            raise ValueError(f"plan returned a path for pair {i}->{j} that {problem[1]}")
         margin = getattr(plan, "last_margin", None)
         starts.append(start)
         goals.append(goal)

@@ -151,14 +151,16 @@ class PathLibrary:
         has it stored per demonstration.  ``options`` (default :class:`LibraryBuildOptions`) with
         keyword ``overrides`` of its fields (``per_pair=4, seed=7``); the fields of the default
         sampler and planner (max_samples, timeout, require_planning, demo_margins, workers) are
-        not used.
+        not used.  A query or path that a library file could not hold (outside ``robot``'s joint limits,
+        off the pair's Table-1 presets, a path not from its start to its goal) is a ValueError naming
+        ``sample_query`` or ``plan`` (:func:`~tpee_ompl.library.demos.collect_pair`).
         """
         opts = LibraryBuildOptions.resolve(options, overrides)
         stats: Counter[str] = Counter()
         collected = {}
         for (i, j), child in zip(opts.pairs, np.random.SeedSequence(opts.seed).spawn(len(opts.pairs))):
             collected[(i, j)] = collect_pair(sample_query, plan, i, j, child, opts.per_pair, opts.min_difference,
-                                             opts.draws_per_pair)
+                                             opts.draws_per_pair, robot=robot)
             stats.update(collected[(i, j)][4])
         return cls._learn(robot, collected, stats, opts.per_step, opts.dmp_options, plan)
 

@@ -22,10 +22,10 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..files import OutputExistsError, atomic_path
-from ..model.sectors import SECTOR_PAIRS, posture_preset
+from ..model.sectors import SECTOR_PAIRS
 from ..model.wearer_arm import WearerArm
 from ..validation import check_int
-from .demos import MAX_PER_STEP, N_FAKE_TIME_STEPS, PairDemos, max_query_stride
+from .demos import MAX_PER_STEP, N_FAKE_TIME_STEPS, PairDemos, demo_problem, max_query_stride
 from .dmp import DMP, DMPOptions
 
 if TYPE_CHECKING:
@@ -87,10 +87,12 @@ def write_library(library: PathLibrary, path: str | Path, *, force: bool = True)
         for name, dmps in (("fwd", pd.forward), ("rev", pd.reverse)):
             arrays[p + name + "_weights"] = np.array([d.weights for d in dmps]).reshape(len(dmps), 2, n_basis)
             arrays[p + name + "_scaled"] = np.array([d.scaled for d in dmps], dtype=bool).reshape(len(dmps), 2)
-    for key, x in arrays.items():  # what read_library would refuse is not written
-        too_big = _beyond_limit(key.partition("_")[2], x)
-        if too_big:
-            raise ValueError(f"path library {path}: array {key!r} {too_big}: not saved (its loader would refuse it)")
+    for (i, j) in sorted(library.pairs):  # what read_library would refuse is not written
+        p = f"p{i}{j}_"
+        problem = _pair_problem(i, j, {name: arrays[p + name] for name in _PAIR_ARRAYS}, n_basis, library.robot)
+        if problem is not None:
+            raise ValueError(f"path library {path}: pair {i}->{j}: array {p + problem[0]!r} {problem[1]}: not saved "
+                             "(its loader would refuse it)")
     with atomic_path(path, force=force) as tmp, open(tmp, "wb") as fh:
         np.savez_compressed(fh, **arrays)
     return path
@@ -150,9 +152,43 @@ _MAX_ABS = {**dict.fromkeys(_ANGLES, 100.0), "fwd_weights": 1e9, "rev_weights": 
 (the packaged library: 3.3 rad, weights 2.1e4), short of what overflows the DMP's arithmetic."""
 
 
+def _pair_shapes(m: int, n_basis: int) -> dict[str, tuple[int, ...]]:
+    """The shape of each array of a pair of ``m`` demonstrations whose DMPs have ``n_basis`` basis functions."""
+    return {"starts": (m, 4), "goals": (m, 4), "waypoints": (m, N_FAKE_TIME_STEPS, 4), "margins": (m,),
+            "fwd_weights": (m, 2, n_basis), "rev_weights": (m, 2, n_basis), "fwd_scaled": (m, 2), "rev_scaled": (m, 2)}
+
+
+def _pair_problem(i: int, j: int, a: dict[str, np.ndarray], n_basis: int, robot: WearerArm) -> tuple[str, str] | None:
+    """What a library file may not hold in pair (i, j)'s arrays ``a`` (keyed as :data:`_PAIR_ARRAYS`): ``(array,
+    why)`` for the first problem, else None.  Checked: shapes, dtypes and values (finite, within :data:`_MAX_ABS`,
+    and the demonstrations as :func:`~tpee_ompl.library.demos.demo_problem` checks them: inside the robot's joint
+    limits, starting and ending at the pair's Table-1 presets).  Reading and writing a library use this one check."""
+    a = {name: np.asarray(x) for name, x in a.items()}
+    first = a["starts"].shape
+    if len(first) != 2:
+        return "starts", f"has shape {first}, expected (m, 4) for m demonstrations"
+    for name, shape in _pair_shapes(first[0], n_basis).items():
+        if a[name].shape != shape:
+            return name, f"has shape {a[name].shape}, expected {shape}"
+    for name in _PAIR_ARRAYS:
+        x = a[name]
+        if name.endswith("_scaled"):
+            if x.dtype != bool:
+                return name, f"must be booleans, got {x.dtype}"
+            continue
+        if x.dtype.kind != "f":
+            return name, f"must be floats, got {x.dtype}"
+        if name != "margins" and not np.all(np.isfinite(x)):
+            return name, "holds NaN or inf"
+        too_big = _beyond_limit(name, x)
+        if too_big:
+            return name, too_big
+    return demo_problem(robot, i, j, a["starts"], a["goals"], a["waypoints"])
+
+
 def _pair_arrays(archive: _Archive, i: int, j: int, n_basis: int, robot: WearerArm) -> dict[str, np.ndarray]:
-    """Pair (i, j)'s arrays: declared shapes checked before unpacking, then dtypes and values (finite, inside the
-    robot's joint limits, starting and ending at the pair's Table-1 presets); LibraryFileError naming the array."""
+    """Pair (i, j)'s arrays: declared shapes checked before unpacking, then :func:`_pair_problem`'s checks;
+    LibraryFileError naming the array."""
     p, path = f"p{i}{j}_", archive.path
     missing = [p + n for n in _PAIR_ARRAYS if p + n not in archive.keys]
     if missing:
@@ -161,40 +197,15 @@ def _pair_arrays(archive: _Archive, i: int, j: int, n_basis: int, robot: WearerA
     if len(first) != 2:
         raise LibraryFileError(f"path library {path}: array {p + 'starts'!r} has shape {first}, expected (m, 4) for "
                                "m demonstrations")
-    m = first[0]
-    shapes = {"starts": (m, 4), "goals": (m, 4), "waypoints": (m, N_FAKE_TIME_STEPS, 4), "margins": (m,),
-              "fwd_weights": (m, 2, n_basis), "rev_weights": (m, 2, n_basis), "fwd_scaled": (m, 2), "rev_scaled": (m, 2)}
+    shapes = _pair_shapes(first[0], n_basis)
     for name, shape in shapes.items():
         declared = archive.shape(p + name)
         if declared != shape:
             raise LibraryFileError(f"path library {path}: array {p + name!r} has shape {declared}, expected {shape}")
     a = {name: archive.read(p + name) for name in shapes}
-    for name, x in a.items():
-        if name.endswith("_scaled"):
-            if x.dtype != bool:
-                raise LibraryFileError(f"path library {path}: array {p + name!r} must be booleans, got {x.dtype}")
-            continue
-        if x.dtype.kind != "f":
-            raise LibraryFileError(f"path library {path}: array {p + name!r} must be floats, got {x.dtype}")
-        if name != "margins" and not np.all(np.isfinite(x)):
-            raise LibraryFileError(f"path library {path}: array {p + name!r} holds NaN or inf")
-        too_big = _beyond_limit(name, x)
-        if too_big:
-            raise LibraryFileError(f"path library {path}: array {p + name!r} {too_big}")
-    tol = 1e-6
-    for name in _ANGLES:  # demonstrations are planned inside the limits; a DMP learned off them cannot be used
-        x = a[name]
-        if x.size and not (np.all(x >= robot.lower - tol) and np.all(x <= robot.upper + tol)):
-            raise LibraryFileError(f"path library {path}: array {p + name!r} leaves the robot's joint limits")
-    for name, k, rows in (("starts", i, a["starts"]), ("goals", j, a["goals"]),
-                          ("waypoints", i, a["waypoints"][:, 0]), ("waypoints", j, a["waypoints"][:, -1])):
-        if rows.size and not np.allclose(rows[:, :2], posture_preset(k), rtol=0.0, atol=tol):
-            raise LibraryFileError(f"path library {path}: array {p + name!r} holds a demonstration of pair {i}->{j} "
-                                   f"whose DOF1/DOF2 end is not sector {k}'s Table-1 preset")
-    if not (np.allclose(a["waypoints"][:, 0], a["starts"], rtol=0.0, atol=tol)
-            and np.allclose(a["waypoints"][:, -1], a["goals"], rtol=0.0, atol=tol)):
-        raise LibraryFileError(f"path library {path}: array {p + 'waypoints'!r} does not run from its demonstration's "
-                               "start to its goal")
+    problem = _pair_problem(i, j, a, n_basis, robot)
+    if problem is not None:
+        raise LibraryFileError(f"path library {path}: array {p + problem[0]!r} {problem[1]}")
     return a
 
 
