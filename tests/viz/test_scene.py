@@ -65,6 +65,28 @@ def test_bad_scene_inputs_raise_with_a_message(robot, aimed):
         render_scene(robot, q, azim=float("inf"))  # as save_scene: a non-finite angle drew an empty picture
 
 
+@pytest.mark.parametrize(("kw", "match"), [
+    ({"q": [1e300, 0.0, 0.0, 0.0]}, r"q holds 1e\+300, beyond the \+/-1000 rad"),  # drew a 2901-px-wide title
+    ({"q": [0.0, 0.0, 0.0, -1001.0]}, "q holds 1001"),
+    ({"sectors": "yes"}, "sectors must be True or False"),
+    ({"max_extent": 0.0}, "max_extent"),
+    ({"max_extent": float("nan")}, "max_extent"),
+    ({"robot": None}, "robot must be a WearerArm"),  # was an AttributeError ('check_config')
+])
+def test_a_scene_refuses_a_q_beyond_any_joint_and_bad_settings_naming_them(robot, tmp_path, kw, match):
+    args = {"robot": robot, "q": np.zeros(4), **kw}
+    with pytest.raises(ValueError, match=match):
+        save_scene(args.pop("robot"), args.pop("q"), tmp_path / "scene.png", **args)
+    assert not (tmp_path / "scene.png").exists()
+
+
+def test_the_sectors_picture_refuses_a_robot_that_is_not_a_wearer_arm(tmp_path):
+    from tpee_ompl.viz import render_sectors
+
+    with pytest.raises(ValueError, match="robot must be a WearerArm, got NoneType"):
+        render_sectors(None, tmp_path / "sectors.png")
+
+
 def test_a_figure_name_without_an_image_suffix_is_refused_before_any_folder_is_made(robot, tmp_path):
     with pytest.raises(ValueError, match="image suffix"):
         save_scene(robot, np.zeros(4), tmp_path / "new" / "scene.txt")

@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..model.sectors import SECTORS, posture_preset
+from ..validation import MAX_JOINT_VALUE, check_bool, check_number
 from ._common import (check_target_off_muzzle, check_view, check_waypoints, clip_segment, draw_floor, image_suffixes,
                       new_axes, optional_target, output_path, set_view, write_figure)
 from .animation import muzzle_trace, resample_path
@@ -53,6 +54,15 @@ def draw_pointing_range(ax: Axes, dirs: np.ndarray, reachable: np.ndarray, color
         )
 
 
+def _check_wearer(robot: Any) -> WearerArm:
+    """``robot`` if it is a WearerArm (the pictures draw the wearer and the muzzle); ValueError naming it."""
+    from ..model.wearer_arm import WearerArm
+
+    if not isinstance(robot, WearerArm):
+        raise ValueError(f"robot must be a WearerArm, got {type(robot).__name__}")
+    return robot
+
+
 # ---------------------------------------------------------------------------- scene
 def render_scene(
     robot: WearerArm,
@@ -73,7 +83,8 @@ def render_scene(
     ----------
     robot : WearerArm
     q : array_like, shape (4,), radians
-        (DOF1, DOF2, pan, tilt).  Drawn red if invalid (outside limits or colliding).
+        (DOF1, DOF2, pan, tilt).  Drawn red if invalid (outside limits or colliding); beyond the
+        +/-``MAX_JOINT_VALUE`` rad any joint takes (as a ``path``): ValueError.
     target : array_like, shape (3,), metres, optional
         Drawn as a star; the segment muzzle -> target is dashed green if the line of sight is
         clear (:meth:`WearerArm.line_of_sight_clear`), red if blocked.  A target at the muzzle has no
@@ -94,6 +105,7 @@ def render_scene(
     title : str, optional
         Default: q in degrees, validity, line-of-sight state.
     max_extent : float, metres
+        Positive: how far from the scene centre a target or path point may be and still be zoomed to.
 
     Returns
     -------
@@ -103,7 +115,11 @@ def render_scene(
 
     t0 = time.perf_counter()
     check_view(elev, azim)
-    q = robot.check_config(q)
+    q = _check_wearer(robot).check_config(q)
+    if np.abs(q).max() > MAX_JOINT_VALUE:  # as a path's (check_waypoints): 1e300 drew a 2901-px title
+        raise ValueError(f"q holds {np.abs(q).max():g}, beyond the +/-{MAX_JOINT_VALUE:g} rad any joint takes")
+    sectors = check_bool("sectors", sectors)
+    max_extent = check_number("max_extent (metres)", max_extent, low=0.0, low_open=True)
     tgt = optional_target(target)
     W = check_waypoints(robot, path) if path is not None else None
     check_target_off_muzzle(robot, q, tgt)
@@ -199,6 +215,7 @@ def render_sectors(
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
     check_view(elev, azim, dpi)
+    _check_wearer(robot)
     out = None if out_path is None else output_path(out_path, image_suffixes(), force)  # before the drawing
     mesh = scene_mesh(robot)
     fig = Figure(figsize=(11.0, 10.0), dpi=dpi)
