@@ -246,3 +246,49 @@ def test_the_unsettled_error_advises_what_fixes_it_more_samples_not_a_larger_alp
     assert not fails(50, DMPOptions())  # the advice does
     with pytest.raises(ValueError, match="increase alpha_y"):  # too soft for any grid: then alpha_y is the fix
         DMP.from_weights(np.zeros((1, 24)), [0.0], [1.0], [True], 50, DMPOptions(alpha_y=5.0))
+
+
+def _blend_pair() -> tuple:
+    t = np.linspace(0.0, 1.0, 60)
+    demo = np.stack([np.sin(np.pi * t), t**2], axis=1)
+    return learn_dmp(demo), learn_dmp(demo[::-1])
+
+
+@pytest.mark.parametrize("start, goal, match", [
+    (np.array([1j, 0.0]), [1.0, 1.0], "start must be real numbers"),  # was cast with a ComplexWarning only
+    ([0.0, 0.0], [1.0, 1.0j], "goal must be real numbers"),
+    ([0.0, 0.0, 0.0], [1.0, 1.0, 1.0], r"start and goal must have shape \(2,\) or \(B, 2\)"),  # numpy's broadcast
+    (np.zeros((3, 2)), np.ones((4, 2)), r"start and goal batches differ: shapes \(3, 2\) and \(4, 2\)"),
+])
+def test_generate_blended_checks_start_and_goal_as_generate_does_naming_them(start, goal, match: str) -> None:
+    forward, reverse = _blend_pair()
+    with pytest.raises(ValueError, match=match):
+        generate_blended(forward, reverse, start, goal)
+
+
+def test_generate_blended_takes_one_start_with_a_batch_of_goals_as_generate_does() -> None:
+    """A (D,) start with (B, D) goals failed with "forward and reverse shapes differ"."""
+    forward, reverse = _blend_pair()
+    goals = np.array([[1.0, 1.0], [0.5, -0.5], [0.0, 2.0]])
+    out = generate_blended(forward, reverse, [0.0, 0.0], goals)
+    assert out.shape == (3, 60, 2)
+    for b, g in enumerate(goals):
+        assert np.array_equal(out[b], generate_blended(forward, reverse, [0.0, 0.0], g))
+
+
+@pytest.mark.parametrize("name", ["forward", "reverse"])
+def test_generate_blended_names_an_argument_that_is_no_dmp(name: str) -> None:
+    """A non-DMP was an AttributeError ("'str' object has no attribute 'n_steps'")."""
+    forward, reverse = _blend_pair()
+    args = {"forward": forward, "reverse": reverse, name: "dmp"}
+    with pytest.raises(ValueError, match=f"^{name} must be a DMP, got str"):
+        generate_blended(args["forward"], args["reverse"], [0.0, 0.0], [1.0, 1.0])
+    with pytest.raises(ValueError, match="^dmp must be a DMP, got NoneType"):
+        generate(None, [0.0, 0.0], [1.0, 1.0])
+
+
+@pytest.mark.parametrize("options", ["x", {"alpha_y": 48.0}, 5])
+def test_learn_dmp_names_options_that_are_no_dmp_options(options) -> None:
+    """learn_dmp(demo, "x") was an AttributeError ("'str' object has no attribute 'alpha_y'")."""
+    with pytest.raises(ValueError, match="^options must be a DMPOptions, got "):
+        learn_dmp(np.zeros((60, 2)), options)

@@ -41,6 +41,7 @@ from __future__ import annotations
 
 import functools
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -174,7 +175,7 @@ class DMP:
         options: DMPOptions | None = None,
     ) -> DMP:
         """Rebuild a DMP from stored parameters (recomputes the response profiles)."""
-        options = options or DMPOptions()
+        options = DMPOptions() if options is None else _require("options", options, DMPOptions)
         weights = np.atleast_2d(np.asarray(weights, dtype=float))
         start, goal = np.asarray(start, dtype=float).ravel(), np.asarray(goal, dtype=float).ravel()
         scaled = np.asarray(scaled, dtype=bool).ravel()
@@ -358,7 +359,7 @@ def learn_dmp(demo: np.ndarray, options: DMPOptions | None = None) -> DMP:
     minimum-norm change of w that makes the rollout of the demo end exactly at its goal (one
     linear equality per DOF: r(T) = a(T) S_demo / S); (iv) the response profiles.
     """
-    options = options or DMPOptions()
+    options = DMPOptions() if options is None else _require("options", options, DMPOptions)
     demo = as_float_array(demo, "demo")  # a complex demo lost its imaginary part with a warning
     if demo.ndim == 1:
         demo = demo[:, None]
@@ -416,11 +417,7 @@ def generate(dmp: DMP, start: np.ndarray, goal: np.ndarray) -> np.ndarray:
     goal == start is well defined: scaled DOFs stay put (eq. 13's forcing vanishes), absolute DOFs
     replay the demo's excursion and return.
     """
-    start, goal = as_float_array(start, "start"), as_float_array(goal, "goal")
-    if start.shape[-1:] != (dmp.n_dims,) or goal.shape[-1:] != (dmp.n_dims,) or start.ndim > 2 or goal.ndim > 2:
-        raise ValueError(f"start and goal must have shape ({dmp.n_dims},) or (B, {dmp.n_dims}); got {start.shape}, {goal.shape}")
-    if not (np.all(np.isfinite(start)) and np.all(np.isfinite(goal))):
-        raise ValueError("start or goal contains NaN or inf")
+    start, goal = _ends(_require("dmp", dmp, DMP).n_dims, start, goal)
     with np.errstate(over="ignore", invalid="ignore"):  # refused below
         S = np.where(dmp.scaled, goal - start, 1.0)
         y = (
@@ -466,11 +463,36 @@ def generate_blended(forward: DMP, reverse: DMP, start: np.ndarray, goal: np.nda
     """Section 4.2.3 steps 2-3: forward DMP start -> demo goal, reverse DMP goal -> demo start, blended.
 
     ``forward`` was learned from the demo, ``reverse`` from the demo flipped in time (so
-    ``reverse.goal`` is the demo start).  Returns shape (..., P, D) from ``start`` to ``goal``.
+    ``reverse.goal`` is the demo start).  ``start`` and ``goal`` are checked as by :func:`generate` (shape (D,)
+    or (B, D), finite real numbers; one of shape (D,) goes with every row of a batch).  Returns shape (..., P, D)
+    from ``start`` to ``goal``.
     """
+    _require("forward", forward, DMP), _require("reverse", reverse, DMP)
     if forward.n_steps != reverse.n_steps or forward.n_dims != reverse.n_dims:
         raise ValueError("forward and reverse DMPs must share n_steps and n_dims")
-    start, goal = np.asarray(start, dtype=float), np.asarray(goal, dtype=float)
-    fwd = generate(forward, start, np.broadcast_to(forward.goal, start.shape))
-    rev = generate(reverse, goal, np.broadcast_to(reverse.goal, goal.shape))
+    start, goal = _ends(forward.n_dims, start, goal)
+    try:
+        shape = np.broadcast_shapes(start.shape, goal.shape)
+    except ValueError:
+        raise ValueError(f"start and goal batches differ: shapes {start.shape} and {goal.shape}") from None
+    start, goal = np.broadcast_to(start, shape), np.broadcast_to(goal, shape)
+    fwd = generate(forward, start, np.broadcast_to(forward.goal, shape))
+    rev = generate(reverse, goal, np.broadcast_to(reverse.goal, shape))
     return blend_forward_reverse(fwd, rev)
+
+
+def _require(name: str, value: object, cls: type) -> Any:
+    """``value`` if it is a ``cls``, else ValueError naming ``name``."""
+    if not isinstance(value, cls):
+        raise ValueError(f"{name} must be a {cls.__name__}, got {type(value).__name__}")
+    return value
+
+
+def _ends(n_dims: int, start: object, goal: object) -> tuple[np.ndarray, np.ndarray]:
+    """``start`` and ``goal`` as float arrays of shape (D,) or (B, D) of finite real numbers, else ValueError."""
+    start, goal = as_float_array(start, "start"), as_float_array(goal, "goal")
+    if start.shape[-1:] != (n_dims,) or goal.shape[-1:] != (n_dims,) or start.ndim > 2 or goal.ndim > 2:
+        raise ValueError(f"start and goal must have shape ({n_dims},) or (B, {n_dims}); got {start.shape}, {goal.shape}")
+    if not (np.all(np.isfinite(start)) and np.all(np.isfinite(goal))):
+        raise ValueError("start or goal contains NaN or inf")
+    return start, goal
