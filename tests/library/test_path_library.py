@@ -307,3 +307,13 @@ def test_load_names_a_robot_that_is_not_a_wearer_arm(robot) -> None:
 
     with pytest.raises(ValueError, match="^robot must be a WearerArm"):
         PathLibrary.load(default_library_path(), robot)
+
+
+@pytest.mark.parametrize("path", [None, 5, b"lib.npz", ""])
+def test_save_and_load_name_a_path_that_is_no_file_path(robot: WearerArm, library: PathLibrary, path) -> None:
+    """None was numpy's and pathlib's "expected str, bytes or os.PathLike object, not NoneType"."""
+    from tpee_ompl.library.storage import library_model_hash
+
+    for call in (lambda: library.save(path), lambda: PathLibrary.load(path, robot), lambda: library_model_hash(path)):
+        with pytest.raises(ValueError, match=r"^path must be a file path \(str or os.PathLike\), got "):
+            call()

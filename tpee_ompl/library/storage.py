@@ -12,6 +12,7 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import json
+import os
 import zipfile
 import zlib
 from dataclasses import asdict
@@ -64,7 +65,7 @@ def write_library(library: PathLibrary, path: str | Path, *, force: bool = True)
     the old file (or none), never a truncated one.  With ``force=False`` an existing file raises
     :class:`~tpee_ompl.files.OutputExistsError` and is left unchanged.
     """
-    path = Path(path)
+    path = _file_path(path)
     if path.exists() and not force:
         raise OutputExistsError(f"path library {path} exists; pass --force (in Python: force=True) to replace it")
     meta = {
@@ -96,6 +97,14 @@ def write_library(library: PathLibrary, path: str | Path, *, force: bool = True)
     with atomic_path(path, force=force) as tmp, open(tmp, "wb") as fh:
         np.savez_compressed(fh, **arrays)
     return path
+
+
+def _file_path(path: object) -> Path:
+    """``path`` as a Path, else ValueError: a library file is named by a non-empty str or os.PathLike."""
+    raw = os.fspath(path) if isinstance(path, (str, os.PathLike)) else None
+    if not isinstance(raw, str) or not raw:
+        raise ValueError(f"path must be a file path (str or os.PathLike), got {path!r}"[:300])
+    return Path(path)
 
 
 def _check_meta(meta: Any, path: Path) -> dict[str, Any]:
@@ -315,7 +324,7 @@ def library_model_hash(path: str | Path) -> str:
     Raises FileNotFoundError (no such file), PermissionError (a file it may not read) or LibraryFileError (not a
     regular file, unreadable, no model hash):
     a damaged library is said as such, never taken for one of another model."""
-    return _meta_with_model(Path(path))["model_hash"]
+    return _meta_with_model(_file_path(path))["model_hash"]
 
 
 def _meta_with_model(path: Path) -> dict[str, Any]:
@@ -331,8 +340,9 @@ def library_settings(path: str | Path) -> dict[str, Any]:
     """What a library file says of itself without a model: its model hash and its checked settings (pairs, per_step,
     n_candidates, query_stride, DMP options, build parameters and counters); the demonstrations are not read.
     Raises as :func:`library_model_hash`, or LibraryFileError naming a bad field."""
-    meta = _meta_with_model(Path(path))
-    return {"model_hash": meta["model_hash"], **_check_meta(meta, Path(path))}
+    path = _file_path(path)
+    meta = _meta_with_model(path)
+    return {"model_hash": meta["model_hash"], **_check_meta(meta, path)}
 
 
 def packaged_library_for(robot: WearerArm) -> Path | None:
@@ -359,7 +369,7 @@ def read_library(path: str | Path, robot: WearerArm) -> tuple[dict[tuple[int, in
         If the file is damaged, has another format version, was built for another model, or a field
         or array is malformed (the message names it).
     """
-    with _open_archive(Path(path)) as archive:
+    with _open_archive(_file_path(path)) as archive:
         return _read_archive(archive, robot)
 
 
