@@ -183,7 +183,7 @@ def _collect_default_pair(job: tuple, robot: WearerArm | None = None) -> Collect
     plan = DemoPlanner(robot, margins=opts.demo_margins, max_samples=opts.max_samples, seed=opts.seed,
                        timeout=opts.timeout)
     return collect_pair(query_sampler(robot, require_planning=opts.require_planning), plan, i, j, child,
-                        opts.per_pair, opts.min_difference, opts.draws_per_pair)
+                        opts.per_pair, opts.min_difference, opts.draws_per_pair, robot=robot)
 
 
 def _pair_process(collect: Callable[[tuple], Collected], job: tuple, conn: Connection, parent: int) -> None:
