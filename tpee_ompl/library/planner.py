@@ -257,6 +257,7 @@ class LibraryDimensionRRT(PythonPlanner):
                 log.error("LibraryDimensionRRT: no refinement: %s", e)
                 return planner_status(ob.PlannerStatus.EXACT_SOLUTION if have_exact else ob.PlannerStatus.ABORT)
         inner._say_start_choice = not read_ends  # noqa: SLF001 (the pipeline said which start it took)
+        inner._known_cost = stats["best_cost"] if have_exact else math.inf  # noqa: SLF001 (only shorter paths posted)
         inner.setProblemDefinition(pdef)
         self._inner = inner
         t_inner = time.perf_counter() - t0

@@ -217,6 +217,7 @@ class DimensionRRT(PythonPlanner):
         self._callback_failed = False
         self._sample_checkpoints: tuple[int, ...] = ()
         self._samples_drawn = 0
+        self._known_cost = math.inf  # set by a planner running this one after it posted a path of that cost
 
     # fixed at construction (the groups, the steps and the random generator are built from them): read-only, so that
     # an assignment cannot change settings() while the search goes on with the old value (``range_ = 0.05`` made
@@ -466,7 +467,7 @@ class DimensionRRT(PythonPlanner):
             if runs and ptc():
                 break
             runs.append(new_run(q1))
-        poster = SolutionPoster(self, si, pdef, t0, grouped.to_path, self._notify, checker.passed)
+        poster = SolutionPoster(self, si, pdef, t0, grouped.to_path, self._notify, checker.passed, self._known_cost)
         limits = LoopLimits(self.max_samples if grouped.planned else 0, self.options.max_h or 0,
                             self.options.stall_samples, self._sample_checkpoints,
                             restart=None if grouped.prescribed else self.options.restart_after)

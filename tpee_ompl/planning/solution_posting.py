@@ -50,7 +50,10 @@ class SolutionPoster:
 
     def __init__(self, planner: ob.Planner, si: ob.SpaceInformation, pdef: ob.ProblemDefinition, t0: float,
                  to_path: Callable[[ob.SpaceInformation, np.ndarray], og.PathGeometric],
-                 notify: Callable[[og.PathGeometric, float], None], passed: set[bytes] | None = None) -> None:
+                 notify: Callable[[og.PathGeometric, float], None], passed: set[bytes] | None = None,
+                 known_cost: float = math.inf) -> None:
+        """``known_cost``: a path of that cost is in the problem definition already (posted by the planner this one
+        runs inside): only shorter ones are posted."""
         self.planner, self.si, self.pdef, self.t0 = planner, si, pdef, t0
         self.to_path, self.notify = to_path, notify
         self.opt = problem_objective(pdef)
@@ -59,8 +62,8 @@ class SolutionPoster:
         if self._own_cost:
             log.warning("%s minimises path length; the objective '%s' only says when a path is good enough",
                         planner.getName(), self.opt.getDescription() or type(self.opt).__name__)
-        self.found_cost = math.inf  # best cost the search found
-        self.best_cost = math.inf  # best cost posted (checked by si.checkMotion)
+        self.found_cost = known_cost  # best cost the search found
+        self.best_cost = known_cost  # best cost posted (checked by si.checkMotion)
         self.first_time: float | None = None
         self.posted = 0
         self.satisfied = False
