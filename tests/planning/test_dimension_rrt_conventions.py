@@ -88,6 +88,18 @@ def test_progress_row_of_the_connect_trees_path_counts_the_samples_that_found_it
     assert ss.solve(60.0) == ob.PlannerStatus.TIMEOUT
 
 
+@pytest.mark.parametrize("connect", [True, False])
+def test_no_progress_row_shows_a_path_before_the_first_solution_time(connect: bool) -> None:
+    for seed in range(4):
+        ss = make_planar_arm_setup()
+        planner = DimensionRRT(ss.getSpaceInformation(), seed=seed, max_samples=400, connect=connect)
+        ss.setPlanner(planner)
+        assert ss.solve(60.0) == ob.PlannerStatus.EXACT_SOLUTION
+        stats = planner.last_run_stats()
+        first_row = next(t for t, cost, _ in stats["progress"] if math.isfinite(cost))
+        assert first_row >= stats["first_solution_time"]
+
+
 def test_a_fit_that_only_merges_the_trees_steps_is_not_posted_again() -> None:
     planner, ss = _arm6_query1(38)
     stats = planner.last_run_stats()

@@ -219,9 +219,8 @@ class GoalLoop:
         trees' path, every motion checked): offered at once, so that a first path is posted as soon as
         RRTConnect's would be."""
         if self._shorter(cost):
-            now = time.perf_counter()
-            self.poster.offer(W, cost, now)
-            self.record(now, drawn)
+            self.poster.offer(W, cost, time.perf_counter())
+            self.record(time.perf_counter(), drawn)  # (after the post: no row shows a path before it is posted)
 
     def _pass(self, run: GoalRun, ptc: ob.PlannerTerminationCondition) -> None:
         """Samples until the next limit (a batch, the cap, the stall, the release, a stop, the goal's turn); a
@@ -257,8 +256,8 @@ class GoalLoop:
             run.best, run.improved_at = search.cost, search.samples
             if self._shorter(search.cost):
                 self.poster.offer(search.W, search.cost, now)
-                self.record(now)
-                self._last_log = now
+                self._last_log = time.perf_counter()
+                self.record(self._last_log)
                 return
         if now - self._last_log >= PROGRESS_PERIOD:
             self.record(now)
