@@ -68,9 +68,11 @@ def pad_aborted_runs(bench: ot.Benchmark, records: dict, run_count: int, error: 
 
 
 PER_QUERY_SETTINGS = ("seed", "pair")
-"""Planner settings that change from query to query (the process seed, the sector pair).  Kept out of
-the planner's configuration, so one planner has one configuration across queries: the seeds are in the
-``experiments`` table (``process_seed``) and the pair in its query columns."""
+"""Planner settings that change from query to query (the seed, the sector pair).  Kept out of the planner's
+configuration, so one planner has one configuration across queries: the pair is in the ``experiments`` table's
+query columns, and a planner's seed is ``sub_seed(campaign seed, query position, planner's index in the
+comparison, cap or budget in ms)`` (:func:`tpee_ompl.validation.sub_seed`; the campaign seed is in
+``campaign.json``, and the experiments table's ``process_seed`` is the campaign seed plus the query position)."""
 
 
 SAMPLED_SPACE_SETTINGS = ("projection.cellsize",)
