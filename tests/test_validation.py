@@ -6,8 +6,9 @@ import pytest
 
 from dataclasses import dataclass
 
+from tpee_ompl.library.dmp import DMPOptions
 from tpee_ompl.planning.dimension_rrt_options import DimensionRRTOptions
-from tpee_ompl.validation import MAX_SEED, as_float_array, check_name, check_seed, resolve_options
+from tpee_ompl.validation import MAX_SEED, as_float_array, check_name, check_seed, check_type, resolve_options
 
 
 @pytest.mark.parametrize("seed", [0, -5, MAX_SEED + 1, 10**20, 1.5, True, "3", None])
@@ -51,3 +52,10 @@ def test_names_with_control_characters_are_refused_naming_the_argument(value):
     with pytest.raises(ValueError, match="name must be printable text"):
         DimensionRRTOptions(name=value)
     assert check_name("name", "Dimension RRT (é)") == "Dimension RRT (é)"
+
+
+def test_check_type_returns_an_instance_and_names_the_argument_and_the_type_given_otherwise() -> None:
+    opts = DMPOptions()
+    assert check_type("options", opts, DMPOptions) is opts
+    with pytest.raises(ValueError, match=r"^options must be a DMPOptions, got str$"):
+        check_type("options", "x", DMPOptions)

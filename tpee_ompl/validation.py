@@ -15,11 +15,12 @@ from typing import Any, Literal, TypeVar, overload
 import numpy as np
 
 __all__ = ["MAX_COUNT", "MAX_JOINT_VALUE", "MAX_SECONDS", "MAX_SEED", "MOTION_VALIDATORS", "as_config_batch",
-           "as_float_array", "check_bool", "check_int", "check_name", "check_number", "check_seed", "resolve_options",
-           "sub_seed"]
+           "as_float_array", "check_bool", "check_int", "check_name", "check_number", "check_seed", "check_type",
+           "resolve_options", "sub_seed"]
 
 
 _Options = TypeVar("_Options")
+_T = TypeVar("_T")
 
 
 def resolve_options(cls: type[_Options], options: _Options | None, overrides: Mapping[str, Any]) -> _Options:
@@ -79,6 +80,13 @@ def check_bool(name: str, value: Any) -> bool:
     if not isinstance(value, (bool, np.bool_)):
         raise ValueError(f"{name} must be True or False, got {value!r}")
     return bool(value)
+
+
+def check_type(name: str, value: Any, cls: type[_T]) -> _T:
+    """``value`` if it is a ``cls`` (a robot, a DMP, options), else ValueError naming the argument and the type given."""
+    if not isinstance(value, cls):
+        raise ValueError(f"{name} must be a {cls.__name__}, got {type(value).__name__}")
+    return value
 
 
 def check_name(name: str, value: Any) -> str:

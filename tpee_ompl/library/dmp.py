@@ -41,11 +41,10 @@ from __future__ import annotations
 
 import functools
 from dataclasses import dataclass, field
-from typing import Any
 
 import numpy as np
 
-from ..validation import as_float_array, check_int, check_number
+from ..validation import as_float_array, check_int, check_number, check_type
 
 __all__ = [
     "DMP",
@@ -175,7 +174,7 @@ class DMP:
         options: DMPOptions | None = None,
     ) -> DMP:
         """Rebuild a DMP from stored parameters (recomputes the response profiles)."""
-        options = DMPOptions() if options is None else _require("options", options, DMPOptions)
+        options = DMPOptions() if options is None else check_type("options", options, DMPOptions)
         weights = np.atleast_2d(np.asarray(weights, dtype=float))
         start, goal = np.asarray(start, dtype=float).ravel(), np.asarray(goal, dtype=float).ravel()
         scaled = np.asarray(scaled, dtype=bool).ravel()
@@ -359,7 +358,7 @@ def learn_dmp(demo: np.ndarray, options: DMPOptions | None = None) -> DMP:
     minimum-norm change of w that makes the rollout of the demo end exactly at its goal (one
     linear equality per DOF: r(T) = a(T) S_demo / S); (iv) the response profiles.
     """
-    options = DMPOptions() if options is None else _require("options", options, DMPOptions)
+    options = DMPOptions() if options is None else check_type("options", options, DMPOptions)
     demo = as_float_array(demo, "demo")  # a complex demo lost its imaginary part with a warning
     if demo.ndim == 1:
         demo = demo[:, None]
@@ -417,7 +416,7 @@ def generate(dmp: DMP, start: np.ndarray, goal: np.ndarray) -> np.ndarray:
     goal == start is well defined: scaled DOFs stay put (eq. 13's forcing vanishes), absolute DOFs
     replay the demo's excursion and return.
     """
-    start, goal = _ends(_require("dmp", dmp, DMP).n_dims, start, goal)
+    start, goal = _ends(check_type("dmp", dmp, DMP).n_dims, start, goal)
     with np.errstate(over="ignore", invalid="ignore"):  # refused below
         S = np.where(dmp.scaled, goal - start, 1.0)
         y = (
@@ -467,7 +466,7 @@ def generate_blended(forward: DMP, reverse: DMP, start: np.ndarray, goal: np.nda
     or (B, D), finite real numbers; one of shape (D,) goes with every row of a batch).  Returns shape (..., P, D)
     from ``start`` to ``goal``.
     """
-    _require("forward", forward, DMP), _require("reverse", reverse, DMP)
+    check_type("forward", forward, DMP), check_type("reverse", reverse, DMP)
     if forward.n_steps != reverse.n_steps or forward.n_dims != reverse.n_dims:
         raise ValueError("forward and reverse DMPs must share n_steps and n_dims")
     start, goal = _ends(forward.n_dims, start, goal)
@@ -479,13 +478,6 @@ def generate_blended(forward: DMP, reverse: DMP, start: np.ndarray, goal: np.nda
     fwd = generate(forward, start, np.broadcast_to(forward.goal, shape))
     rev = generate(reverse, goal, np.broadcast_to(reverse.goal, shape))
     return blend_forward_reverse(fwd, rev)
-
-
-def _require(name: str, value: object, cls: type) -> Any:
-    """``value`` if it is a ``cls``, else ValueError naming ``name``."""
-    if not isinstance(value, cls):
-        raise ValueError(f"{name} must be a {cls.__name__}, got {type(value).__name__}")
-    return value
 
 
 def _ends(n_dims: int, start: object, goal: object) -> tuple[np.ndarray, np.ndarray]:

@@ -26,7 +26,7 @@ from ..model.pointing import AimingError, BlindAreaError, PointingGeometry, aim_
 from ..model.sectors import SECTORS, check_sector, in_pointing_sector, infer_sector, posture_preset, posture_sector
 from ..model.wearer_arm import WearerArm
 from ..planning.paths import MIN_JOINT_STEP, motion_is_valid, motion_states, motion_step, planned_waypoints
-from ..validation import MAX_SECONDS, as_float_array, check_bool, check_number
+from ..validation import MAX_SECONDS, as_float_array, check_bool, check_number, check_type
 from .path_library import CHECK_STEP, PathLibrary
 
 __all__ = [
@@ -347,8 +347,7 @@ def make_default_planner(
     from ..planning.setup import make_simple_setup, quieter_ompl, seed_ompl
     from .planner import LibraryDimensionRRT
 
-    if not isinstance(robot, WearerArm):
-        raise ValueError(f"robot must be a WearerArm, got {type(robot).__name__}")
+    check_type("robot", robot, WearerArm)
     if not (library is None or isinstance(library, PathLibrary)
             or isinstance(library, (str, os.PathLike)) and os.fspath(library)):
         raise ValueError("library must be 'default', a library file's path, a PathLibrary or None, "

@@ -43,7 +43,7 @@ import coal
 import numpy as np
 import pinocchio as pin
 
-from ..validation import as_float_array, check_bool
+from ..validation import as_float_array, check_bool, check_type
 from .urdf_loading import ARM_JOINTS
 from .robot_checker import RobotChecker
 from .wearer_arm import MAX_TARGET_DISTANCE, MUZZLE_FRAME, WearerArm, check_target_point, default_robot
@@ -133,7 +133,7 @@ class PointingGeometry:
     @classmethod
     def from_robot(cls, robot: WearerArm) -> PointingGeometry:
         """Read the constants from a loaded model; raise ValueError if its pointing system is not pan-offset-tilt."""
-        if not isinstance(robot, RobotChecker):
+        if not isinstance(robot, RobotChecker):  # (another RobotChecker is refused below: not pan-offset-tilt)
             raise ValueError(f"robot must be a WearerArm, got {type(robot).__name__}")
         m = robot.model
         names = tuple(m.names[1:])
@@ -357,13 +357,6 @@ def aim(
     return aim_batch(t[None], posture, geometry=geometry, pan_reference=pan_reference)[0]
 
 
-def _wearer(robot: object) -> WearerArm:
-    """``robot`` if it is a WearerArm (what aiming and its checks need: the muzzle, the wearer); ValueError naming it."""
-    if not isinstance(robot, WearerArm):
-        raise ValueError(f"robot must be a WearerArm, got {type(robot).__name__}")
-    return robot
-
-
 def aim_errors(robot: WearerArm, q: np.ndarray, target: np.ndarray) -> tuple[float, float, float]:
     """How well q aims at target, by Pinocchio FK.
 
@@ -376,7 +369,7 @@ def aim_errors(robot: WearerArm, q: np.ndarray, target: np.ndarray) -> tuple[flo
     angle : float, radians
         Angle between the barrel's +x axis and the muzzle-to-target direction.
     """
-    p, u = _wearer(robot).muzzle(q)
+    p, u = check_type("robot", robot, WearerArm).muzzle(q)
     d = np.asarray(target, dtype=float) - p
     along = float(d @ u)
     perp = float(np.linalg.norm(d - along * u))
@@ -394,7 +387,7 @@ def check_target(target: np.ndarray, robot: WearerArm | None = None) -> np.ndarr
     except ValueError as exc:
         raise UnreachableTargetError(str(exc)) from None
     if robot is not None:
-        _wearer(robot)
+        check_type("robot", robot, WearerArm)
         point = coal.Sphere(1e-6)
         tf = coal.Transform3s(np.eye(3), t)
         req, res = coal.DistanceRequest(), coal.DistanceResult()
@@ -422,7 +415,7 @@ def aim_checked(
     check) and the muzzle-to-target segment is clear of the wearer and the boom.  Rows that fail
     the IK are NaN.
     """
-    robot = _wearer(robot)
+    robot = check_type("robot", robot, WearerArm)
     g = geometry or PointingGeometry.from_robot(robot)
     Q = aim_batch(targets, posture, geometry=g, pan_reference=pan_reference, strict=False)
     ok = np.all(np.isfinite(Q), axis=1)

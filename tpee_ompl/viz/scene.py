@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..model.sectors import SECTORS, posture_preset
-from ..validation import MAX_JOINT_VALUE, check_bool, check_number
+from ..validation import MAX_JOINT_VALUE, check_bool, check_number, check_type
 from ._common import (check_target_off_muzzle, check_view, check_waypoints, clip_segment, draw_floor, image_suffixes,
                       new_axes, optional_target, output_path, set_view, write_figure)
 from .animation import muzzle_trace, resample_path
@@ -52,15 +52,6 @@ def draw_pointing_range(ax: Axes, dirs: np.ndarray, reachable: np.ndarray, color
         ax.scatter(
             *pts[~reachable].T, s=6, marker="x", color="0.3", alpha=0.7, linewidths=0.7, depthshade=False, label="blind"
         )
-
-
-def _check_wearer(robot: Any) -> WearerArm:
-    """``robot`` if it is a WearerArm (the pictures draw the wearer and the muzzle); ValueError naming it."""
-    from ..model.wearer_arm import WearerArm
-
-    if not isinstance(robot, WearerArm):
-        raise ValueError(f"robot must be a WearerArm, got {type(robot).__name__}")
-    return robot
 
 
 # ---------------------------------------------------------------------------- scene
@@ -113,9 +104,11 @@ def render_scene(
     """
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
+    from ..model.wearer_arm import WearerArm
+
     t0 = time.perf_counter()
     check_view(elev, azim)
-    q = _check_wearer(robot).check_config(q)
+    q = check_type("robot", robot, WearerArm).check_config(q)
     if np.abs(q).max() > MAX_JOINT_VALUE:  # as a path's (check_waypoints): 1e300 drew a 2901-px title
         raise ValueError(f"q holds {np.abs(q).max():g}, beyond the +/-{MAX_JOINT_VALUE:g} rad any joint takes")
     sectors = check_bool("sectors", sectors)
@@ -214,8 +207,10 @@ def render_sectors(
     from matplotlib.figure import Figure
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
+    from ..model.wearer_arm import WearerArm
+
     check_view(elev, azim, dpi)
-    _check_wearer(robot)
+    check_type("robot", robot, WearerArm)
     out = None if out_path is None else output_path(out_path, image_suffixes(), force)  # before the drawing
     mesh = scene_mesh(robot)
     fig = Figure(figsize=(11.0, 10.0), dpi=dpi)
