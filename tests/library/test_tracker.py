@@ -291,3 +291,16 @@ def test_the_first_re_aim_from_the_initial_configuration_takes_the_time_joint_sp
     assert [e.kind for e in result.events] == ["aim"]
     move = float(np.max(np.abs(result.configurations[0] - q0)))
     assert move > 1.0 and result.times[0] == pytest.approx(2.0 + move / tracker.options.joint_speed)
+
+
+def test_a_planned_re_aim_inside_the_sector_is_an_aim_event_not_a_posture_switch(robot, planner, monkeypatch):
+    """It was logged as a "cross-sector" event 3->3 (a reviewer's reading of the code)."""
+    tracker = Tracker(robot, planner, initial_sector=3)
+    monkeypatch.setattr(tracker, "_motion_free", lambda a, b: False)  # every direct re-aim motion "collides"
+    target = sector_origin() + np.r_[6.0 * _direction(40.0, 0.0)[:2], 0.5]
+    assert posture_sector(target) == 3
+    result = tracker.run([(0.0, target)])
+    assert result.count("cross-sector") == 0 and result.count("aim") == 1
+    (event,) = result.events
+    assert event.sector == 3 and event.detail.startswith("planned: re-aim motion collides")
+    _assert_safe_and_aimed(robot, result)

@@ -76,7 +76,8 @@ class TrackerOptions:
 class TrackEvent:
     """Something the tracker did or could not do.
 
-    kind is one of ``"aim"`` (re-aimed inside the sector), ``"cross-sector"`` (switched posture),
+    kind is one of ``"aim"`` (re-aimed inside the sector; ``detail`` starts with "planned" when the direct
+    re-aim motion collided and the planner found one), ``"cross-sector"`` (switched posture),
     ``"blind-area"`` (the target was in the current posture's blind cylinder), ``"unreachable"``
     (no sector can aim at it, or the planner found no path to those that can: the arm holds still).
     """
@@ -95,9 +96,9 @@ class TrackResult:
     ----------
     times : ndarray (M,), seconds
     configurations : ndarray (M, 4), radians
-    targets : ndarray (M, 3), metres: the target the row aims at, NaN inside cross-sector motions
+    targets : ndarray (M, 3), metres: the target the row aims at, NaN inside planned motions
         and while holding still on an unreachable target
-    sectors : ndarray (M,), int: the posture sector in use (0 inside cross-sector motions)
+    sectors : ndarray (M,), int: the posture sector in use (0 inside planned motions: cross-sector, or a re-aim)
     events : list of TrackEvent
     """
 
@@ -225,7 +226,10 @@ class Tracker:
             raise ValueError(f"planner path {self.sector}->{k} collides or leaves the joint limits (checked every "
                              f"{self.check_step:g} rad; a planner must check its paths at least this finely: "
                              "make_default_planner(step=...))")
-        self.events.append(TrackEvent(t, "cross-sector", k, f"{self.sector}->{k}: {why}, {len(waypoints)} waypoints"))
+        if k == self.sector:  # a re-aim, planned: the posture stays
+            self.events.append(TrackEvent(t, "aim", k, f"planned: {why}, {len(waypoints)} waypoints"))
+        else:
+            self.events.append(TrackEvent(t, "cross-sector", k, f"{self.sector}->{k}: {why}, {len(waypoints)} waypoints"))
         clock = t
         for i in range(1, len(waypoints)):
             a, b = waypoints[i - 1], waypoints[i]
