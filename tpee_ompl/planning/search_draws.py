@@ -45,6 +45,14 @@ class _Ahead(NamedTuple):
     live: np.ndarray  # indices into C of the samples shorter at some step whose state is not known to collide
 
 
+def _swept_box(vals: np.ndarray, circ: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+    """The least and greatest of each column of vals (m, k); for an angle (``circ``) the ends of the arc the
+    path sweeps, across +-pi, not the values' min and max."""
+    if circ is not None:
+        vals = np.where(circ, np.unwrap(vals, axis=0, period=2 * math.pi), vals)
+    return vals.min(axis=0), vals.max(axis=0)
+
+
 class SampleDraws:
     """The sample draws of :class:`~tpee_ompl.planning.dimension_search.Search` (module docstring); the
     subclass sets ``W``, ``L``, ``dist``, ``checker``, ``_fdims`` and ``_fbounds`` (the feasibility phase's DOFs)."""
@@ -140,17 +148,20 @@ class SampleDraws:
                     t = 1 + np.minimum((U[narrow, 0] - _UNIFORM_FRACTION) / (1 - _UNIFORM_FRACTION) * m, m - 1).astype(int)
                     vlo = vhi = vals[t]
                 else:
-                    if circ is not None:  # the angles the path sweeps: across +-pi, not the values' min and max
-                        vals = np.where(circ, np.unwrap(vals, axis=0, period=2 * math.pi), vals)
-                    vlo, vhi = vals.min(axis=0), vals.max(axis=0)
-                nlo, nhi = np.maximum(lo, vlo - pad), np.minimum(hi, vhi + pad)
-                if circ is not None:  # an angle's box wraps round +-pi instead of stopping there
-                    arc = circ & (vhi - vlo + 2 * pad < span)
-                    nlo, nhi = np.where(arc, vlo - pad, nlo), np.where(arc, vhi + pad, nhi)
-                C[narrow] = nlo + U[narrow, 1:] * (nhi - nlo)
-                if circ is not None:  # back into [-pi, pi)
-                    C[narrow] = self.g.layout.wrap(C[narrow], self._dims[gi])
+                    vlo, vhi = _swept_box(vals, circ)
+                C[narrow] = self._padded_box_draws(U[narrow, 1:], vlo, vhi, pad, lo, hi, circ, self._dims[gi])
         return C, n0
+
+    def _padded_box_draws(self, U: np.ndarray, vlo: np.ndarray, vhi: np.ndarray, pad: np.ndarray | float,
+                          lo: np.ndarray, hi: np.ndarray, circ: np.ndarray | None, dims: np.ndarray) -> np.ndarray:
+        """Samples from the uniforms U (m, k): uniform in the box [vlo, vhi] of DOFs ``dims`` padded by ``pad``
+        and cut at the bounds [lo, hi]; an angle's box (``circ``) wraps round +-pi instead of stopping there."""
+        nlo, nhi = np.maximum(lo, vlo - pad), np.minimum(hi, vhi + pad)
+        if circ is not None:
+            arc = circ & (vhi - vlo + 2 * pad < hi - lo)
+            nlo, nhi = np.where(arc, vlo - pad, nlo), np.where(arc, vhi + pad, nhi)
+        C = nlo + U * (nhi - nlo)
+        return C if circ is None else self.g.layout.wrap(C, dims)  # back into [-pi, pi)
 
     def _scale(self, k: np.ndarray) -> np.ndarray:
         """``narrowing ** (k / 100)`` for ascending offsets k >= 0, memoised (``np.power`` is not bit-identical) up to
