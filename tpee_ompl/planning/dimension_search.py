@@ -191,6 +191,8 @@ class Search(SampleDraws):
         return bool(self.checker.states(S[1:-1][moved]).all()) and not self._check_segments(S)
 
     def _layered(self, W: np.ndarray, V: np.ndarray, E: np.ndarray) -> LayeredTrees:
+        if self.g.prescribed:  # without, the planar arms and point problems gained on some and lost on others
+            self._feasibility_region(W)
         return LayeredTrees(W, V, E, self._fdims, self._hold, functools.partial(self.delta, dims=self._fdims))
 
     def _connect_samples(self, limit: int, stop: Callable[[], bool] | None,

@@ -4,7 +4,11 @@
 several planned groups each gets :data:`GROUP_BLOCK` consecutive samples in turn; after ``narrow_after``
 samples of a group, 90 % are drawn from the bounding box of the current path's values of that group
 (released: of one waypoint's), padded by ``max(range_, span * narrowing ** (m / 100))``, the rest
-uniformly over the bounds.  On a valid path most samples are shorter at no step; :meth:`SampleDraws._pass_rejected`
+uniformly over the bounds.  Before a path, the layered trees' samples of all planned DOFs are drawn the same
+way around the path they start from (the straight or prescribed line, a first guess or a connect path):
+90 % from the box it sweeps padded by :data:`FEASIBILITY_PAD` of each DOF's range, doubled every
+:data:`FEASIBILITY_DOUBLING` samples, so that a detour stays near the blocked line while one is enough,
+and the rest uniformly (a departure from the paper's uniform samples: ``docs/dimension_rrt.md``).  On a valid path most samples are shorter at no step; :meth:`SampleDraws._pass_rejected`
 passes over them with one vectorised cost test, run ahead over up to :data:`AHEAD` samples and kept while
 the path stays the same, and with a group of every DOF also over the samples whose state the look-ahead
 found colliding (:meth:`SampleDraws._hit_states`): the same samples, and the same paths, as drawing them
@@ -22,10 +26,15 @@ import numpy as np
 from .grouped_space import GroupedSpace
 from .search_checker import Checker
 
-__all__ = ["AHEAD", "GROUP_BLOCK", "SampleDraws"]
+__all__ = ["AHEAD", "FEASIBILITY_DOUBLING", "FEASIBILITY_PAD", "GROUP_BLOCK", "SampleDraws"]
 
 _UNIFORM_FRACTION = 0.1  # share of samples drawn uniformly over the bounds once the region has narrowed
 _NARROWING_UNIT = 100  # the narrowing factor applies per this many samples
+FEASIBILITY_PAD: float | None = 0.25
+"""The layered trees' samples (no path yet) are drawn, all but the uniform share, from the box their first path
+sweeps padded by this fraction of each DOF's range, the padding doubled every :data:`FEASIBILITY_DOUBLING` samples.
+None: uniform over the bounds, as the paper.  Chosen on 36 held-out queries (``experiments/feasibility_region.py``)."""
+FEASIBILITY_DOUBLING = 16
 GROUP_BLOCK = 100
 """With several planned groups, each gets this many consecutive samples in turn."""
 AHEAD = 256
@@ -87,6 +96,17 @@ class SampleDraws:
         self._scales = np.zeros(0)
         self._cut: int | None = None  # the offset from which every group's padding is its range_
         self._floor: float | None = None  # the smallest scale any padding needs (:meth:`_scale`; only once narrowing)
+        self._fregion: tuple[np.ndarray, np.ndarray, np.ndarray | None, int] | None = None  # :meth:`_feasibility_region`
+
+    def _feasibility_region(self, W: np.ndarray) -> None:
+        """Draw the feasibility phase's samples around W (h, n), the path the layered trees start from: the box
+        its planned DOFs sweep, padded as :data:`FEASIBILITY_PAD` says (module docstring)."""
+        if FEASIBILITY_PAD is None:  # uniform over the bounds, as the paper (a switch for experiments)
+            self._fregion = None
+            return
+        circ = self.g.layout.circular[self._fdims]
+        circ = circ if circ.any() else None
+        self._fregion = (*_swept_box(W[:, self._fdims], circ), circ, self.samples)
 
     def _refill(self, k: int) -> None:
         """A fresh buffer of 1024 samples' randomness (one uniform picking narrowed or uniform, then k values)."""
@@ -107,10 +127,16 @@ class SampleDraws:
 
     def draw(self, gi: int | None) -> np.ndarray:
         """One sample: for group gi (narrowed or uniform), or with gi None for the feasibility phase's
-        joint planned DOFs (uniform over their bounds); see the module docstring."""
+        joint planned DOFs (around the layered trees' first path, or uniform over their bounds); see the
+        module docstring."""
         if gi is None:
             lo, hi = self._fbounds
-            return lo + self._next_random(len(self._fdims))[1:] * (hi - lo)
+            u = self._next_random(len(self._fdims))
+            if self._fregion is None or u[0] < _UNIFORM_FRACTION:
+                return lo + u[1:] * (hi - lo)
+            vlo, vhi, circ, s0 = self._fregion
+            pad = FEASIBILITY_PAD * 2.0 ** min((self.samples - s0) / FEASIBILITY_DOUBLING, 8.0) * (hi - lo)
+            return self._padded_box_draws(u[None, 1:], vlo, vhi, pad, lo, hi, circ, self._fdims)[0]
         drawn, self._drawn = self._drawn, None
         if drawn is not None and drawn[:2] == (self._ui, gi):  # drawn already by :meth:`_pass_rejected`
             self._ui += 1
