@@ -283,9 +283,9 @@ def _run_experiment(cfg: dict, task: dict, spec: dict, ladder=None, only: list[s
     setup = _make_setup(cfg, task, spec)
     name = experiment_name(task["query_set"], spec)
     bench = _make_benchmark(cfg, task, spec, setup, name)
-    wrappers = _add_planners(cfg, task, spec, setup, bench, ladder, only)
+    wrappers, seeds = _add_planners(cfg, task, spec, setup, bench, ladder, only)
     records: dict[str, list[dict]] = {n: [] for n in wrappers}
-    _set_run_events(bench, setup, wrappers, records)
+    _set_run_events(bench, setup, wrappers, records, seeds)
     error = _benchmark(bench, _request(cfg, spec), name)
     if error is not None:
         pad_aborted_runs(bench, records, int(cfg["runs"]), error)
@@ -322,17 +322,20 @@ def _make_benchmark(cfg: dict, task: dict, spec: dict, setup: _Setup, name: str)
 
 
 def _add_planners(cfg: dict, task: dict, spec: dict, setup: _Setup, bench: ot.Benchmark, ladder,
-                  only: list[str] | None) -> dict:
-    """Add the comparison's planners (only those in ``only``, if given) to ``bench``; returns their wrappers by name.
+                  only: list[str] | None) -> tuple[dict, dict[str, int]]:
+    """Add the comparison's planners (only those in ``only``, if given) to ``bench``; returns their wrappers and
+    their seeds by name.
 
     A planner's seed depends on its position in the comparison's full list, so it is the same with ``only``; OMPL's
-    seed generator is set to it before the planner is made (:func:`_seed_planner`).
+    seed generator is set to it before the planner is made (:func:`_seed_planner`), and to a seed drawn from it
+    before each of its runs (:func:`_set_run_events`).
     """
     cap, budget = spec["cap"], spec["budget"]
     planners = cfg["iteration_planners"] if spec["comparison"] == "iterations" else cfg["anytime_planners"]
     tag = cap if cap is not None else int(round(budget * 1000))
     tag = spec.get("seed_tag", tag)  # a separate run with a ladder's planner seeds (tests/bench/test_ladder.py)
     wrappers: dict = {}
+    seeds: dict[str, int] = {}
     for k, pname in enumerate(planners):
         if only is not None and pname not in only:
             continue
@@ -340,8 +343,9 @@ def _add_planners(cfg: dict, task: dict, spec: dict, setup: _Setup, bench: ot.Be
                              problem=setup.problem.name)
         w = _wrap_planner(pname, ctx, spec, setup, ladder, wrappers)
         wrappers[w.getName()] = w
+        seeds[w.getName()] = ctx.seed
         bench.addPlanner(w)
-    return wrappers
+    return wrappers, seeds
 
 
 def _wrap_planner(pname: str, ctx: PlannerContext, spec: dict, setup: _Setup, ladder, earlier: dict) -> ob.Planner:
@@ -365,15 +369,25 @@ def _wrap_planner(pname: str, ctx: PlannerContext, spec: dict, setup: _Setup, la
     return ladder.wrap(setup.si, inner, spec["cap"], pname, ctx, checker=setup.checker, read=read, renew=renew)
 
 
-def _set_run_events(bench: ot.Benchmark, setup: _Setup, wrappers: dict, records: dict[str, list[dict]]) -> None:
-    """Set ``bench``'s run events: before each run, reset the objective's cost threshold and note the collision
-    checks so far; after it, append its properties and progress (:func:`_run_properties`) to ``records``."""
+def _set_run_events(bench: ot.Benchmark, setup: _Setup, wrappers: dict, records: dict[str, list[dict]],
+                    seeds: dict[str, int]) -> None:
+    """Set ``bench``'s run events: before each run, set OMPL's seed generator from the planner's seed and the run's
+    index, reset the objective's cost threshold and note the collision checks so far; after it, append its
+    properties and progress (:func:`_run_properties`) to ``records``.
+
+    The seed before each run: an OMPL planner allocates its sampler (and that sampler's random numbers) when it
+    first solves after ``clear()``, so without it a planner's samples depended on what ran before it in the
+    process, OMPL's path simplification of the previous planner's path included (it draws seeds from the
+    generator as the path asks): RRT*'s rows differed between a ladder and a separate capped run once
+    dimension-RRT's path before it changed, and a retried experiment of some planners could not repeat them."""
     checks_before = {"value": 0}
     pdef = setup.ss.getProblemDefinition()
     objective = pdef.getOptimizationObjective() if pdef.hasOptimizationObjective() else None
     threshold = objective.getCostThreshold().value() if objective is not None else None
 
     def pre_run(planner) -> None:
+        name = planner.getName()
+        _seed_planner(sub_seed(seeds[name], len(records.get(name, ()))))
         checks_before["value"] = setup.checker.collision_checks
         if objective is not None:  # AORRTC lowers the shared objective's threshold to its own cost as it runs:
             objective.setCostThreshold(ob.Cost(threshold))  # the next planner (BIT*) then stopped once it beat that
