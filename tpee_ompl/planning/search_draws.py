@@ -4,11 +4,12 @@
 several planned groups each gets :data:`GROUP_BLOCK` consecutive samples in turn; after ``narrow_after``
 samples of a group, 90 % are drawn from the bounding box of the current path's values of that group
 (released: of one waypoint's), padded by ``max(range_, span * narrowing ** (m / 100))``, the rest
-uniformly over the bounds.  Before a path, the layered trees' samples of all planned DOFs are drawn the same
-way around the path they start from (the straight or prescribed line, a first guess or a connect path):
-90 % from the box it sweeps padded by :data:`FEASIBILITY_PAD` of each DOF's range, doubled every
-:data:`FEASIBILITY_DOUBLING` samples, so that a detour stays near the blocked line while one is enough,
-and the rest uniformly (a departure from the paper's uniform samples: ``docs/dimension_rrt.md``).  On a valid path most samples are shorter at no step; :meth:`SampleDraws._pass_rejected`
+uniformly over the bounds.  Before a path, with a prescribed group, the layered trees' samples of all planned
+DOFs are drawn the same way around the path they start from (the straight line between the prescribed rows, or
+a first guess): 90 % from the box it sweeps padded by :data:`FEASIBILITY_PAD` of each DOF's range, doubled every
+:data:`FEASIBILITY_DOUBLING` samples, so that a detour stays near the blocked line while one is enough, and the
+rest uniformly (a departure from the paper's uniform samples: ``docs/dimension_rrt.md``); without a prescribed
+group they stay uniform.  On a valid path most samples are shorter at no step; :meth:`SampleDraws._pass_rejected`
 passes over them with one vectorised cost test, run ahead over up to :data:`AHEAD` samples and kept while
 the path stays the same, and with a group of every DOF also over the samples whose state the look-ahead
 found colliding (:meth:`SampleDraws._hit_states`): the same samples, and the same paths, as drawing them
@@ -31,10 +32,12 @@ __all__ = ["AHEAD", "FEASIBILITY_DOUBLING", "FEASIBILITY_PAD", "GROUP_BLOCK", "S
 _UNIFORM_FRACTION = 0.1  # share of samples drawn uniformly over the bounds once the region has narrowed
 _NARROWING_UNIT = 100  # the narrowing factor applies per this many samples
 FEASIBILITY_PAD: float | None = 0.25
-"""The layered trees' samples (no path yet) are drawn, all but the uniform share, from the box their first path
-sweeps padded by this fraction of each DOF's range, the padding doubled every :data:`FEASIBILITY_DOUBLING` samples.
-None: uniform over the bounds, as the paper.  Chosen on 36 held-out queries (``experiments/feasibility_region.py``)."""
+"""With a prescribed group, the layered trees' samples (no path yet) are drawn, all but the uniform share, from the
+box the path they start from sweeps, padded by this fraction of each DOF's range.  None: uniform over the bounds, as
+the paper.  Chosen with :data:`FEASIBILITY_DOUBLING` on the 36 held-out queries of each set
+(``experiments/feasibility_region.py``)."""
 FEASIBILITY_DOUBLING = 16
+"""Samples after which that padding doubles (after about 2 x this many the box covers the bounds)."""
 GROUP_BLOCK = 100
 """With several planned groups, each gets this many consecutive samples in turn."""
 AHEAD = 256
@@ -127,8 +130,8 @@ class SampleDraws:
 
     def draw(self, gi: int | None) -> np.ndarray:
         """One sample: for group gi (narrowed or uniform), or with gi None for the feasibility phase's
-        joint planned DOFs (around the layered trees' first path, or uniform over their bounds); see the
-        module docstring."""
+        joint planned DOFs (with a prescribed group around the path the layered trees start from, else
+        uniform over their bounds); see the module docstring."""
         if gi is None:
             lo, hi = self._fbounds
             u = self._next_random(len(self._fdims))
