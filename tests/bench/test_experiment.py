@@ -170,3 +170,31 @@ def test_an_ompl_planners_runs_do_not_depend_on_the_planners_run_before_it(robot
         rows[only is None] = [tuple(run[c] for c in columns) for run in extras[name]]
     assert rows[True] == rows[False]  # with dimension-RRT run before it, or alone
     assert rows[True][0] != rows[True][1]  # each run its own seed
+
+
+def test_a_renewed_single_use_planner_is_made_from_its_runs_seed(monkeypatch: pytest.MonkeyPatch):
+    """AORRTC gets a fresh instance for each run after the first; it was made at ``clear()``, before the run was
+    seeded, so its own random numbers came from whatever the run before left (its path's simplification draws
+    seeds as that path asks: dimension-RRT's at 1500 samples here).  Made after the seed now: the same whether OMPL
+    simplified the path or not."""
+    from helpers import bench_standins
+
+    from tpee_ompl.bench import experiment
+    from tpee_ompl.bench.campaign import query_rows, stratified_subset
+
+    name = "helpers.bench_standins:make_construction_recorder"
+    monkeypatch.setattr(experiment, "SINGLE_USE_PLANNERS", (name,))
+    _, queries = query_rows("planning_necessary")
+    draws = {}
+    for simplify in (True, False):
+        cfg = dataclasses.asdict(CampaignConfig(sample_caps=(1500,), anytime_budgets=(), checkers=("batched",), runs=3,
+                                                iteration_planners=(name,), simplify=simplify))
+        task = {"config": cfg, "query": stratified_subset(queries, 2)[1], "qpos": 0,
+                "query_set": "planning_necessary", "seed": 11, "n_threads": 1}
+        bench_standins.CONSTRUCTION_DRAWS.clear()
+        _, _, error = experiment._run_experiment(cfg, task, {"comparison": "iterations", "checker": "batched",
+                                                             "cap": 1500, "budget": None})
+        assert error is None
+        draws[simplify] = list(bench_standins.CONSTRUCTION_DRAWS)
+    assert draws[True][1:3] == draws[False][1:3]
+    assert len(draws[True]) == 3 and len(set(draws[True])) == 3  # made once, renewed twice, each its own seed

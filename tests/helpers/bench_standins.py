@@ -288,3 +288,19 @@ def make_self_killer(si, ctx: PlannerContext):
 def make_broken_factory(si, ctx: PlannerContext):
     """A planner factory that raises (its query's task fails in the worker: a runtime failure, not bad input)."""
     raise RuntimeError("this planner factory always fails")
+
+
+CONSTRUCTION_DRAWS: list[float] = []
+"""The first number each :func:`make_construction_recorder` planner drew from OMPL's seed generator when made."""
+
+
+def make_construction_recorder(si, ctx: PlannerContext):
+    """The problem's dimension-RRT, after noting the first number a new OMPL ``RNG`` draws at that moment (it takes the
+    generator's next seed, as a native planner's own RNGs do when it is made): as a single-use stand-in it shows which
+    seed a renewed planner got."""
+    from ompl import util as ou
+
+    from tpee_ompl.bench.problems import get_problem
+
+    CONSTRUCTION_DRAWS.append(ou.RNG().uniform01())
+    return get_problem(ctx.problem).build_dimension_rrt(si, ctx)

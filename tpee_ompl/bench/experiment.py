@@ -2,9 +2,9 @@
 
 Each (query, comparison, cap/budget, motion validator) is one OMPL experiment, on one
 ``SimpleSetup`` per experiment (same validity checker, motion-check resolution and objective for every
-planner; each planner's seed, and OMPL's seed generator when it is made, from the campaign seed, the query,
-its position in the list and the cap or budget (a ladder's one run: its largest cap's), so a retried or
-resumed experiment draws the samples of an uninterrupted run):
+planner; each planner's seed, and OMPL's seed generator when it is made and before each of its runs, from the
+campaign seed, the query, its position in the list and the cap or budget (a ladder's one run: its largest cap's),
+so a retried or resumed experiment draws the samples of an uninterrupted run, whatever ran before it):
 
 * **iterations** (paper Table 4): every planner is capped at N samples/iterations.  dimension-RRT
   gets ``max_samples=N``; OMPL's planners (default settings) are stopped after exactly N
@@ -327,7 +327,7 @@ def _add_planners(cfg: dict, task: dict, spec: dict, setup: _Setup, bench: ot.Be
     their seeds by name.
 
     A planner's seed depends on its position in the comparison's full list, so it is the same with ``only``; OMPL's
-    seed generator is set to it before the planner is made (:func:`_seed_planner`), and to a seed drawn from it
+    seed generator is set to it before the planner is made (:func:`_seed_planner`), and to ``sub_seed(seed, run)``
     before each of its runs (:func:`_set_run_events`).
     """
     cap, budget = spec["cap"], spec["budget"]
@@ -371,9 +371,10 @@ def _wrap_planner(pname: str, ctx: PlannerContext, spec: dict, setup: _Setup, la
 
 def _set_run_events(bench: ot.Benchmark, setup: _Setup, wrappers: dict, records: dict[str, list[dict]],
                     seeds: dict[str, int]) -> None:
-    """Set ``bench``'s run events: before each run, set OMPL's seed generator from the planner's seed and the run's
-    index, reset the objective's cost threshold and note the collision checks so far; after it, append its
-    properties and progress (:func:`_run_properties`) to ``records``.
+    """Set ``bench``'s run events: before each run, reset the objective's cost threshold, note the collision checks
+    so far, set OMPL's seed generator from the planner's seed and the run's index and renew a used single-use
+    planner (:meth:`~tpee_ompl.bench.planners.RecordingPlanner.renew_if_used`); after it, append its properties
+    and progress (:func:`_run_properties`) to ``records``.
 
     The seed before each run: an OMPL planner allocates its sampler (and that sampler's random numbers) when it
     first solves after ``clear()``, so without it a planner's samples depended on what ran before it in the
@@ -386,8 +387,6 @@ def _set_run_events(bench: ot.Benchmark, setup: _Setup, wrappers: dict, records:
     threshold = objective.getCostThreshold().value() if objective is not None else None
 
     def pre_run(planner) -> None:
-        name = planner.getName()
-        _seed_planner(sub_seed(seeds[name], len(records.get(name, ()))))
         checks_before["value"] = setup.checker.collision_checks
         if objective is not None:  # AORRTC lowers the shared objective's threshold to its own cost as it runs:
             objective.setCostThreshold(ob.Cost(threshold))  # the next planner (BIT*) then stopped once it beat that
@@ -402,7 +401,16 @@ def _set_run_events(bench: ot.Benchmark, setup: _Setup, wrappers: dict, records:
             rec = {"props": failed_run_properties(repr(exc)), "progress": []}
         records.setdefault(planner.getName(), []).append(rec)
 
-    bench.setPreRunEvent(lambda p: _guarded(pre_run, p))
+    def seed_run(planner) -> None:  # apart from pre_run: a failure here must not skip the threshold's reset
+        name = planner.getName()
+        _seed_planner(sub_seed(seeds[name], len(records.get(name, ()))))
+        wrappers[name].renew_if_used()  # a single-use planner's fresh instance draws from the run's seed
+
+    def before_run(planner) -> None:
+        _guarded(pre_run, planner)
+        _guarded(seed_run, planner)
+
+    bench.setPreRunEvent(before_run)
     bench.setPostRunEvent(post_run)
 
 

@@ -227,6 +227,7 @@ class CheckpointPlanner(RecordingPlanner):
         return snap
 
     def solve(self, ptc):  # noqa: D102 (OMPL override)
+        self.renew_if_used()  # (before the inner planner is read below)
         self.start_checks.append(self._checks())
         self._run = {"t0": time.perf_counter(), "calls": 0, "todo": set(self.checkpoints), "snaps": {}, "motions0": None}
         with contextlib.suppress(Exception):  # nothing may escape to OMPL (it would abort the benchmark)

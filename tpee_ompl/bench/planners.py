@@ -203,8 +203,8 @@ class RecordingPlanner(ob.Planner):
         The problem's checker: its counter as ``solve`` returns is recorded (``checks_end``), so a
         run's checks exclude what OMPL's ``Benchmark`` does after it (simplification, path checks).
     renew : callable, optional
-        ``() -> ob.Planner``: a fresh inner planner, built and set up at ``clear()`` after a run instead of
-        clearing the one that ran (:data:`SINGLE_USE_PLANNERS`).
+        ``() -> ob.Planner``: a fresh inner planner, built and set up before the next run (:meth:`renew_if_used`)
+        instead of clearing the one that ran (:data:`SINGLE_USE_PLANNERS`).
     deadline : float, optional
         Seconds after ``solve`` began at which the inner planner is told to stop (an anytime run's budget).
         ``ot.Benchmark`` checks its own deadline in a thread only every 0.1 s, so without it a run with a
@@ -263,19 +263,29 @@ class RecordingPlanner(ob.Planner):
 
     def clear(self) -> None:  # noqa: D102 (OMPL override)
         super().clear()
+        if self.renew is not None and self._ran:
+            return  # a used single-use planner is replaced before its next run (:meth:`renew_if_used`)
         try:
-            if self.renew is not None and self._ran:
-                self.inner = self.renew()
-                self._ran = False
-                self._setup_inner()  # Benchmark sets the wrapper up once, before the first run
-            else:
-                self.inner.clear()
-        except Exception as exc:  # noqa: BLE001
+            self.inner.clear()
+        except Exception:  # noqa: BLE001
             log.exception("planner %s: clear failed", self.inner.getName())
-            if self._ran:  # never solve a used single-use planner again: the run is recorded as a crash
-                self._setup_error = repr(exc)
+
+    def renew_if_used(self) -> None:
+        """Replace a used single-use inner planner (``renew``) with a fresh one, set up.  ``ot.Benchmark``'s pre-run
+        event calls it after seeding OMPL for the run (``bench/experiment.py``), so the new planner's random numbers
+        come from that seed and not from what ran before; :meth:`solve` calls it when nothing did."""
+        if self.renew is None or not self._ran:
+            return
+        try:
+            self.inner = self.renew()
+            self._ran = False
+            self._setup_inner()  # Benchmark sets the wrapper up once, before the first run
+        except Exception as exc:  # noqa: BLE001
+            log.exception("planner %s: renewing it failed", self.inner.getName())
+            self._setup_error = repr(exc)  # never solve a used single-use planner again: the run is a crash
 
     def solve(self, ptc: ob.PlannerTerminationCondition) -> ob.PlannerStatus:  # noqa: D102 (OMPL override)
+        self.renew_if_used()
         inner, cap = self.inner, self.max_iterations
         pdef = self.getProblemDefinition()
         t0 = time.perf_counter()
