@@ -2,12 +2,14 @@
 
     PYTHONPATH=. .venv/bin/python experiments/feasibility_region.py                 # both named sets, ~1.5 min
     PYTHONPATH=. .venv/bin/python experiments/feasibility_region.py --queries /tmp/heldout/planning_necessary.json \
-        --settings uniform 0.35:32 0.25:32 0.35:inf 0.25:16        # how the package's values were chosen
+        --settings uniform 0.35:32 0.25:32 0.35:inf 0.5:32 0.25:16     # how the package's values were chosen,
+    PYTHONPATH=. .venv/bin/python experiments/feasibility_region.py --queries /tmp/heldout/planning_necessary.json \
+        /tmp/heldout/paper_random.json --ompl-seed 2 --settings uniform 0.35:32 0.25:32 0.25:16 0.15:16  # twice
     PYTHONPATH=. .venv/bin/python experiments/feasibility_region.py --planner library
 
 Every setting (``uniform``: the paper's samples, uniform over the planned DOFs' bounds; ``PAD:DOUBLING``: all
 but 10 % of them from the box the trees' first path sweeps, padded by PAD of each DOF's range, the padding
-doubled every DOUBLING samples, ``inf`` never; ``search_draws.FEASIBILITY_PAD`` and ``FEASIBILITY_DOUBLING``,
+growing as 2^(n / DOUBLING) with the samples n, ``inf`` never; ``search_draws.FEASIBILITY_PAD`` and ``FEASIBILITY_DOUBLING``,
 the package's being 0.25:16) and RRTConnect run to their first exact path on every query of each set, on the
 wearer's ``make_simple_setup``, alternating per query, ``--reps`` runs each (dimension-RRT seeded with the
 query index and the repetition, OMPL seeded with ``--ompl-seed``). Prints per setting the median, mean and p95

@@ -75,3 +75,18 @@ def test_without_a_prescribed_group_the_layered_trees_keep_uniform_samples() -> 
                     range_={0: np.full(2, 0.04)})
     search.iterate()
     assert search.trees is not None and search._fregion is None
+
+
+def test_an_angles_region_covers_the_whole_circle_once_the_padded_arc_is_as_long() -> None:
+    """The path 3.0 -> -3.0 sweeps [3.0, 3.28] unwrapped; at 16 samples the padding (pi) makes the arc longer than
+    the circle, and the box was cut at pi: only the uniform tenth of the samples fell in [-pi, -0.5)."""
+    si = free_so2_space(2)
+    grouped = GroupedSpace(si, [[0], [1]], 7, {1: np.zeros((7, 1))})
+    search = Search(grouped, Checker(si, grouped.layout, True), np.random.default_rng(5), np.array([3.0, 0.0]),
+                    np.array([-3.0, 0.0]), settings=SearchSettings(narrow_after=200, narrowing=0.5),
+                    range_={0: np.full(1, 0.04)})
+    search._feasibility_region(np.array([[3.0, 0.0], [3.1, 0.0], [-3.1, 0.0], [-3.0, 0.0]]))
+    search.samples = search_draws.FEASIBILITY_DOUBLING
+    a = _draws(search, 2000)[:, 0]
+    far = ((a >= -math.pi) & (a < -0.5)).mean()
+    assert abs(far - (math.pi - 0.5) / (2 * math.pi)) < 0.05

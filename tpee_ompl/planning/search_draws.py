@@ -184,11 +184,13 @@ class SampleDraws:
     def _padded_box_draws(self, U: np.ndarray, vlo: np.ndarray, vhi: np.ndarray, pad: np.ndarray | float,
                           lo: np.ndarray, hi: np.ndarray, circ: np.ndarray | None, dims: np.ndarray) -> np.ndarray:
         """Samples from the uniforms U (m, k): uniform in the box [vlo, vhi] of DOFs ``dims`` padded by ``pad``
-        and cut at the bounds [lo, hi]; an angle's box (``circ``) wraps round +-pi instead of stopping there."""
+        and cut at the bounds [lo, hi]; an angle's box (``circ``) wraps round +-pi instead of stopping there, and
+        is the whole circle once the padded arc is as long (its unwrapped ends may lie beyond +-pi: cut at the
+        bounds, it lost the part of the circle past them)."""
         nlo, nhi = np.maximum(lo, vlo - pad), np.minimum(hi, vhi + pad)
         if circ is not None:
             arc = circ & (vhi - vlo + 2 * pad < hi - lo)
-            nlo, nhi = np.where(arc, vlo - pad, nlo), np.where(arc, vhi + pad, nhi)
+            nlo, nhi = np.where(arc, vlo - pad, np.where(circ, lo, nlo)), np.where(arc, vhi + pad, np.where(circ, hi, nhi))
         C = nlo + U * (nhi - nlo)
         return C if circ is None else self.g.layout.wrap(C, dims)  # back into [-pi, pi)
 
