@@ -190,7 +190,9 @@ class SampleDraws:
         nlo, nhi = np.maximum(lo, vlo - pad), np.minimum(hi, vhi + pad)
         if circ is not None:
             arc = circ & (vhi - vlo + 2 * pad < hi - lo)
-            nlo, nhi = np.where(arc, vlo - pad, np.where(circ, lo, nlo)), np.where(arc, vhi + pad, np.where(circ, hi, nhi))
+            whole = circ & ~arc
+            nlo = np.where(arc, vlo - pad, np.where(whole, lo, nlo))
+            nhi = np.where(arc, vhi + pad, np.where(whole, hi, nhi))
         C = nlo + U * (nhi - nlo)
         return C if circ is None else self.g.layout.wrap(C, dims)  # back into [-pi, pi)
 
