@@ -237,8 +237,9 @@ def test_only_si_check_motion_probes_a_free_motion_the_batched_call_does_not(rob
 
 def test_a_colliding_motion_found_at_a_middle_state_checks_none_of_its_other_uncovered_states(robot, monkeypatch):
     """What no ball covers is checked plainly, each block's middle state first: a motion with a colliding middle gets
-    no second call (before 2026-11-27 every uncovered state of a colliding motion was checked, on RRTConnect's first
-    paths at home 639 -> 515 checks, mean, ``experiments/colliding_motions.py --switch middles``).  The verdicts stay the dense ones."""
+    no second call (before 2026-11-27 every uncovered state of a colliding motion was checked: RRTConnect's first
+    paths at home took 639 checks against 515, mean, ``experiments/colliding_motions.py --switch middles``).  The
+    verdicts stay the dense ones."""
     screen, step = robot.ball_screen(), robot.max_joint_step()
     A, B = _random_motions(robot, 300, 41)
     chunks = [motion_states(a, b, step) for a, b in zip(A, B)]
