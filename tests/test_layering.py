@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 PACKAGE = Path(__file__).resolve().parents[1] / "tpee_ompl"
-FLOORS = {"_version": 0, "validation": 0, "resources": 0, "files": 0, "signals": 0, "model": 1, "planning": 2, "viz": 2, "library": 3, "examples": 3,
+FLOORS = {"_version": 0, "validation": 0, "resources": 0, "files": 0, "signals": 0, "progress": 0, "model": 1, "planning": 2, "viz": 2, "library": 3, "examples": 3,
           "bench": 4, "cli": 5, "__init__": 5, "_launch": 6, "__main__": 7}
 MAX_LINES = 500
 

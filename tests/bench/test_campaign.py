@@ -243,3 +243,13 @@ def test_a_campaign_json_edited_to_endless_runs_is_refused_on_resume(query_file,
     path.write_text(json.dumps(meta))
     with pytest.raises(ValueError, match=r"campaign.json has a bad config \(runs must be .*10000000"):
         load_campaign(res.directory)
+
+
+def test_a_campaign_logged_to_a_file_shows_its_progress_as_lines(query_file, tmp_path, capsys):
+    """A campaign's log held its progress bar as one line of carriage returns with every state redrawn in it."""
+    cfg = tiny_config(query_file, tmp_path, sample_caps=(30,), anytime_budgets=())
+    run_campaign(cfg, report=False, progress_bar=True)
+    err = capsys.readouterr().err  # (not a terminal: tpee_ompl.progress writes lines)
+    assert "\r" not in err
+    assert [line for line in err.splitlines() if line.startswith("smoke queries: ")][-1].startswith(
+        "smoke queries: 2/2 query (100 %)")

@@ -298,7 +298,7 @@ def _execute(directory: Path, meta: dict, executor, on_task_done, report: bool, 
         return _execute_locked(directory, meta, executor, on_task_done, report, progress_bar, workers)
 
 
-def _execute_locked(directory: Path, meta: dict, executor, on_task_done, report: bool, progress_bar: bool,
+def _execute_locked(directory: Path, meta: dict, executor, on_task_done, report: bool, show_progress: bool,
                     workers: int) -> CampaignResult:
     cfg = meta["config"]
     log_dir = directory / "logs"
@@ -308,8 +308,7 @@ def _execute_locked(directory: Path, meta: dict, executor, on_task_done, report:
     t0 = time.perf_counter()
     with sigterm_as_keyboard_interrupt():
         try:
-            from tqdm import tqdm
-
+            from ..progress import progress_bar
             from .executors import make_executor, run_task_in_subprocess
 
             for part in log_dir.glob("*.part"):  # left by a process killed while writing
@@ -332,7 +331,8 @@ def _execute_locked(directory: Path, meta: dict, executor, on_task_done, report:
                 meta["executor"] = executor.description
             log.info("campaign %s: %d queries, %d experiments (%d to run) on %s", directory, len(meta["query_data"]),
                      meta["expected_experiments"], sum(len(t["specs"]) for t in tasks), executor.description)
-            with tqdm(total=len(tasks), desc=f"{cfg['name']} queries", unit="query", disable=not progress_bar) as bar:
+            with progress_bar(total=len(tasks), desc=f"{cfg['name']} queries", unit="query",
+                              enabled=show_progress) as bar:
                 for res in executor.run(fn, tasks):
                     written = _store_task_result(directory, res)
                     if res.get("failed"):

@@ -315,9 +315,8 @@ def _scripted_targets(name: str, duration: float, rate: float) -> list[tuple]:
 
 def cmd_track(args: argparse.Namespace) -> int:
     """Run the Fig. 10 tracking strategy on a scripted target stream and report its events."""
-    from tqdm import tqdm
-
     from ..library.tracker import MAX_TIME, Tracker, make_default_planner
+    from ..progress import progress_bar
 
     if not args.duration <= MAX_TIME:  # the tracker takes sample times within +/- MAX_TIME
         raise CliError(f"--duration {args.duration:g} s is beyond the tracker's {MAX_TIME:g} s")
@@ -360,8 +359,8 @@ def cmd_track(args: argparse.Namespace) -> int:
         planner = make_default_planner(robot, seed=args.seed, library=args.library)
     stream = _scripted_targets(args.script, args.duration, args.rate)
     # on stderr, only when the run lasts more than 2 s (a long --duration x --rate ran a minute without a word)
-    result = Tracker(robot, planner).run(tqdm(stream, desc="track", unit="sample", delay=2.0,
-                                              disable=args.no_progress))
+    result = Tracker(robot, planner).run(progress_bar(stream, desc="track", unit="sample", delay=2.0,
+                                                      enabled=not args.no_progress))
     kinds = ("aim", "cross-sector", "blind-area", "unreachable")
     summary = {k: result.count(k) for k in kinds}
     if args.output:

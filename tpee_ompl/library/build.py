@@ -297,10 +297,11 @@ def collect_default_demos(
     children = np.random.SeedSequence(opts.seed).spawn(len(opts.pairs))
     model = (robot.files.urdf, robot.files.srdf, robot.security_margin, dict(robot.link_margins), robot.n_threads)
     jobs = [(model, i, j, child, opts) for (i, j), child in zip(opts.pairs, children)]
-    from tqdm import tqdm
     from tqdm.contrib.logging import logging_redirect_tqdm
 
-    with tqdm(total=len(jobs), desc="library pairs", unit="pair", disable=not opts.progress) as bar:
+    from ..progress import progress_bar
+
+    with progress_bar(total=len(jobs), desc="library pairs", unit="pair", enabled=opts.progress) as bar:
         if opts.workers > 1 and len(jobs) > 1:
             # a warning (a pair run again) on a line of its own, not glued to the bar's
             with logging_redirect_tqdm() if opts.progress else contextlib.nullcontext():

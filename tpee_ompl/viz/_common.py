@@ -93,11 +93,11 @@ class Progress:
     ``enabled=False``: every call does nothing.  Use it as a context manager (the bar is closed on leaving)."""
 
     def __init__(self, desc: str, total: float, enabled: bool) -> None:
-        from tqdm import tqdm
+        from ..progress import progress_bar
 
         self.enabled = bool(enabled)
-        self._bar = tqdm(total=total, desc=desc, delay=PROGRESS_DELAY, disable=not self.enabled,
-                         bar_format="{desc}: {percentage:3.0f}%|{bar}| {elapsed}<{remaining}{postfix}")
+        self._bar = progress_bar(total=total, desc=desc, delay=PROGRESS_DELAY, enabled=self.enabled, counts=False,
+                                 bar_format="{desc}: {percentage:3.0f}%|{bar}| {elapsed}<{remaining}{postfix}")
 
     def __enter__(self) -> Progress:
         return self
