@@ -61,3 +61,20 @@ def test_a_bar_of_estimated_work_gives_the_share_done_only():
         bar.update(2.5e6)
     last = out.getvalue().splitlines()[-1]
     assert last.startswith("animate: 100 %,") and last.endswith("encoding") and "e+06" not in last
+
+
+def test_progress_off_a_terminal_writes_a_line_per_interval_while_the_work_goes_on(monkeypatch):
+    import time
+
+    import tpee_ompl.progress as progress
+
+    monkeypatch.setattr(progress, "LOG_INTERVAL", 0.05)
+    out = io.StringIO()
+    with progress_bar(total=40, desc="pairs", stream=out) as bar:
+        for _ in range(40):
+            time.sleep(0.01)
+            bar.update(1)
+    lines = out.getvalue().splitlines()
+    assert 3 <= len(lines) <= 2 + 0.4 / 0.05 + 1  # the first, one per interval of the 0.4 s at most, the last
+    done = [int(line.split("/")[0].split()[-1]) for line in lines]
+    assert done == sorted(done) and done[-1] == 40

@@ -74,6 +74,8 @@ def progress_bar(iterable: Any = None, *, total: float | None = None, desc: str,
         return tqdm(iterable, total=total, desc=desc, unit=unit, disable=not enabled, delay=delay,
                     bar_format=bar_format, file=out)
     known = total is not None or hasattr(iterable, "__len__")
+    # miniters=1: every update asks the clock (tqdm's adaptive count, set from a 30-s interval, held lines back until
+    # its monitor thread redrew the bar, which then printed two lines at once)
     return _LogBar(iterable, total=total, desc=desc, unit=unit, delay=delay, file=_Lines(out), ascii=True,
-                   mininterval=0.0, maxinterval=LOG_INTERVAL,
+                   mininterval=0.0, miniters=1,
                    bar_format=(_LOG_FORMAT if counts else _LOG_FORMAT_SHARE) if known else _LOG_FORMAT_OPEN)
