@@ -67,8 +67,8 @@ def progress_bar(iterable: Any = None, *, total: float | None = None, desc: str,
                  stream: TextIO | None = None) -> Any:
     """A tqdm progress bar on ``stream`` (default stderr): in a terminal redrawn in place (``bar_format`` as tqdm
     takes it), elsewhere a line at most every :data:`LOG_INTERVAL` s and one when it closes.  ``enabled=False``:
-    a bar that shows nothing (the commands' ``--no-progress``); ``delay``: seconds before it first shows; ``counts=False``:
-    the units are estimates of work (not things done), so a log line gives the share done only."""
+    a bar that shows nothing (the commands' ``--no-progress``); ``delay``: seconds before it first shows;
+    ``counts=False``: the units are estimates of work (not things done), so a log line gives the share done only."""
     out = sys.stderr if stream is None else stream
     if not enabled or _is_terminal(out):
         return tqdm(iterable, total=total, desc=desc, unit=unit, disable=not enabled, delay=delay,
