@@ -64,7 +64,7 @@ def _is_terminal(stream: TextIO) -> bool:
 
 def progress_bar(iterable: Any = None, *, total: float | None = None, desc: str, unit: str = "it",
                  enabled: bool = True, delay: float = 0.0, bar_format: str | None = None, counts: bool = True,
-                 stream: TextIO | None = None) -> Any:
+                 stream: TextIO | None = None) -> tqdm:
     """A tqdm progress bar on ``stream`` (default stderr): in a terminal redrawn in place (``bar_format`` as tqdm
     takes it), elsewhere a line at most every :data:`LOG_INTERVAL` s and one when it closes.  ``enabled=False``:
     a bar that shows nothing (the commands' ``--no-progress``); ``delay``: seconds before it first shows;

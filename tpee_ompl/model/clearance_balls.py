@@ -282,11 +282,13 @@ def _blocks_valid(robot: RobotChecker, screen: BallScreen, S: np.ndarray, starts
         return ok
     # what no ball covers, in two calls: each block's middle state (beside a ball that failed: the likeliest to
     # collide), then the other states of the lines still valid, so a colliding line stops there
-    mids = [a + (m - 1) // 2 for a, m, _ in blocks] if MIDDLES_FIRST else [-1] * len(blocks)
     if MIDDLES_FIRST:
+        mids = [a + (m - 1) // 2 for a, m, _ in blocks]
         for (_, _, k), free in zip(blocks, robot.collision_free(S[mids]).tolist()):
             if not free:
                 ok[k] = False
+    else:
+        mids = [-1] * len(blocks)  # (no middle checked first)
     rows: list[int] = []
     owner: list[int] = []  # the line of each row
     for (a, m, k), c in zip(blocks, mids):
