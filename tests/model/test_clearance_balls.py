@@ -11,9 +11,9 @@ from ompl import geometric as og
 from ompl import util as ou
 
 from tests.helpers.panda import needs_panda
-from tpee_ompl.model.clearance_balls import screened_all_valid
+from tpee_ompl.model.clearance_balls import screened_all_valid, screened_lines_valid
 from tpee_ompl.model.queries import load_queries
-from tpee_ompl.planning.paths import motion_states, state_to_array
+from tpee_ompl.planning.paths import batched_motion_states, motion_states, state_to_array
 from tpee_ompl.planning.setup import BatchedMotionValidator, make_simple_setup
 
 
@@ -265,3 +265,29 @@ def test_a_colliding_motion_found_at_a_middle_state_checks_none_of_its_other_unc
     calls.clear()
     np.testing.assert_array_equal(screened_all_valid(robot, screen, chunks, step), dense)  # all lines in one batch
     assert len(calls) == 2
+
+
+def test_a_paths_motions_screened_as_one_polyline_get_the_dense_verdicts_with_fewer_checks(robot, rng):
+    """A ball reaches across a waypoint: a path's motions (each starting where the last ended) are covered as one
+    polyline.  The library's paths are 60 motions of 1-9 states each: line by line, most states were left over
+    for plain checks beside a ball or two.  Chains broken anywhere, and lines outside the limits, keep their
+    dense verdicts."""
+    screen, step = robot.ball_screen(), robot.max_joint_step()
+    checks = {True: 0, False: 0}
+    verdicts = set()
+    for _ in range(30):
+        W = np.clip(rng.uniform(robot.lower, robot.upper) + np.cumsum(rng.normal(scale=0.04, size=(25, 4)), axis=0),
+                    robot.lower - 0.02, robot.upper)  # a few waypoints below the lower limits
+        A, B = W[:-1], W[1:]
+        S, counts = batched_motion_states(A, B, step)
+        spacing = np.linalg.norm(B - A, axis=1) / counts
+        dense = np.array([robot.are_valid(c).all() for c in np.split(S, np.cumsum(counts)[:-1])])
+        for chained in (np.ones(len(A) - 1, dtype=bool), None, rng.random(len(A) - 1) < 0.7):
+            before = robot.collision_checks
+            got = screened_lines_valid(robot, screen, S, counts, spacing, step, chained=chained)
+            np.testing.assert_array_equal(got, dense)
+            if chained is None or chained.all():
+                checks[chained is not None] += robot.collision_checks - before
+        verdicts.update(dense.tolist())
+    assert verdicts == {True, False}
+    assert checks[True] < 0.9 * checks[False]

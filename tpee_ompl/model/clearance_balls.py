@@ -17,6 +17,7 @@ changes, only its cost):
 
 from __future__ import annotations
 
+import bisect
 import math
 import time
 from collections.abc import Iterable
@@ -208,14 +209,17 @@ def screened_all_valid(robot: RobotChecker, screen: BallScreen, chunks: list[np.
 
 def screened_lines_valid(robot: RobotChecker, screen: BallScreen, S: np.ndarray, sizes: np.ndarray,
                          spacing: np.ndarray, step: float, levels: tuple[float, ...] = SCREEN_LEVELS,
-                         probes: int = 0) -> np.ndarray:
+                         probes: int = 0, chained: np.ndarray | None = None) -> np.ndarray:
     """:func:`screened_all_valid` for K lines given as one array: S (sum of ``sizes``, nq) holds line k's
     ``sizes[k]`` states, evenly ``spacing[k]`` apart along a straight segment, after line k - 1's.
 
-    Each line starts as one block of states to cover.  At each level h, every block is cut into
-    blocks of at most 2H+1 consecutive states (H: how many states a ball of radius h*``step`` reaches
-    either side); the middle state of each block of 3 or more is checked by :meth:`BallScreen.clear`,
-    and a block whose middle passes is covered.  One batched call per level over all lines; the states
+    ``chained`` (K - 1,) bool: line k + 1 goes on from line k's last state (a path's motions, each starting
+    where the last ended); chained lines are covered as one polyline, so a ball reaches across a waypoint.
+    Each line (or chain) starts as one block of states to cover.  At each level h, every block is cut into
+    blocks of consecutive states that a ball of radius h*``step`` round one of them covers (along the lines
+    at most that far from it: no farther in joint space; on one line 2H+1 states, H the states it reaches
+    either side); the centre state of each block of 3 or more is checked by :meth:`BallScreen.clear`,
+    and a block whose centre passes is covered.  One batched call per level over all lines; the states
     left are checked plainly (:meth:`RobotChecker.collision_free`), each block's middle state first, then, in a
     second call, the others of the lines whose middles all passed: a colliding line is mostly found by the first
     call, and its other uncovered states go unchecked (2026-11-27: RRTConnect's first paths at home 639 -> 515
@@ -233,47 +237,51 @@ def screened_lines_valid(robot: RobotChecker, screen: BallScreen, S: np.ndarray,
         within = robot.inside_limits(S[np.concatenate((offsets, offsets + sizes - 1))])
         if (within[:K] & within[K:]).all():
             return np.array(_blocks_valid(robot, screen, S, offsets.tolist(), sizes.tolist(), spacing.tolist(), step,
-                                          levels))
+                                          levels, None if chained is None else np.asarray(chained, dtype=bool).tolist()))
     live = np.flatnonzero(sizes > 0)
     E = S[np.concatenate((offsets[live], offsets[live] + sizes[live] - 1))]  # first and last states
     within = robot.inside_limits(E)
     out = np.ones(len(sizes), dtype=bool)  # an empty line has no invalid state
     out[live] = within[: len(live)] & within[len(live) :]
     live = live[out[live]]
+    links = None  # a line left out breaks its chain
+    if chained is not None and len(live):
+        links = (np.asarray(chained, dtype=bool)[live[1:] - 1] & (np.diff(live) == 1)).tolist()
     out[live] = _blocks_valid(robot, screen, S, offsets[live].tolist(), sizes[live].tolist(), spacing[live].tolist(),
-                              step, levels)
+                              step, levels, links)
     return out
 
 
 def _blocks_valid(robot: RobotChecker, screen: BallScreen, S: np.ndarray, starts: list[int], sizes: list[int],
-                  spacing: list[float], step: float, levels: tuple[float, ...]) -> list[bool]:
+                  spacing: list[float], step: float, levels: tuple[float, ...],
+                  chained: list[bool] | None = None) -> list[bool]:
     """The ball screening of :func:`screened_lines_valid` for lines already inside the joint limits, in plain
-    Python over the blocks (a few dozen per call: cheaper than array bookkeeping); one verdict per line."""
-    blocks = [(a, m, k) for k, (a, m) in enumerate(zip(starts, sizes))]  # (start, length, line) still to cover
+    Python over the blocks (a few dozen per call: cheaper than array bookkeeping); one verdict per line.
+
+    Each state's position along its chain of lines (``chained[k]``: line k + 1 goes on from line k; its states
+    are rows of S right after line k's) bounds its joint-space distance to any other state of the chain: the
+    blocks a ball covers are cut by position (:func:`_cut`)."""
+    pos = [0.0] * len(S)  # S rows outside every line keep 0 (never in a block)
+    owner = [-1] * len(S)
+    blocks: list[tuple[int, int]] = []  # (first row, end row) of each chain: the pieces still to cover
+    for k, (a, m, sp) in enumerate(zip(starts, sizes, spacing)):
+        if k and chained is not None and chained[k - 1] and blocks[-1][1] == a:
+            base = pos[a - 1]
+            blocks[-1] = (blocks[-1][0], a + m)
+        else:
+            base = 0.0
+            blocks.append((a, a + m))
+        pos[a : a + m] = [base + sp * i for i in range(1, m + 1)]
+        owner[a : a + m] = [k] * m
     for h in levels:
         if not blocks:
             break
         radius = h * step
-        reach = [int(math.floor(radius / sp * (1 + 1e-12))) if sp > 0 else 0 for sp in spacing]  # H per line
-        left: list[tuple[int, int, int]] = []  # pieces with no state to screen at this level
-        screened: list[tuple[int, int, int]] = []
+        screened: list[tuple[int, int]] = []
         centres: list[int] = []
-        for a, m, k in blocks:
-            H = reach[k]
-            if H < 1:
-                left.append((a, m, k))
-                continue
-            width = 2 * H + 1
-            full, rest = divmod(m, width)
-            end = a + full * width
-            for b in range(a, end, width):
-                screened.append((b, width, k))
-                centres.append(b + H)
-            if rest >= 3:
-                screened.append((end, rest, k))
-                centres.append(end + (rest - 1) // 2)
-            elif rest:
-                left.append((end, rest, k))
+        left: list[tuple[int, int]] = []  # pieces with no state to screen at this level
+        for a, b in blocks:
+            _cut(pos, a, b, radius * (1 + 1e-12), screened, centres, left)
         if centres:
             left += [p for p, ok in zip(screened, screen.clear(S[centres], radius).tolist()) if not ok]
         blocks = left
@@ -283,22 +291,43 @@ def _blocks_valid(robot: RobotChecker, screen: BallScreen, S: np.ndarray, starts
     # what no ball covers, in two calls: each block's middle state (beside a ball that failed: the likeliest to
     # collide), then the other states of the lines still valid, so a colliding line stops there
     if MIDDLES_FIRST:
-        mids = [a + (m - 1) // 2 for a, m, _ in blocks]
-        for (_, _, k), free in zip(blocks, robot.collision_free(S[mids]).tolist()):
+        mids = [(a + b - 1) // 2 for a, b in blocks]
+        for i, free in zip(mids, robot.collision_free(S[mids]).tolist()):
             if not free:
-                ok[k] = False
+                ok[owner[i]] = False
     else:
         mids = [-1] * len(blocks)  # (no middle checked first)
-    rows: list[int] = []
-    owner: list[int] = []  # the line of each row
-    for (a, m, k), c in zip(blocks, mids):
-        if ok[k]:
-            rows.extend(i for i in range(a, a + m) if i != c)
-            owner.extend([k] * (m - (c >= 0)))
+    rows = [i for (a, b), c in zip(blocks, mids) for i in range(a, b) if i != c and ok[owner[i]]]
     if rows:
         for i in np.flatnonzero(~robot.collision_free(S[rows])).tolist():
-            ok[owner[i]] = False
+            ok[owner[rows[i]]] = False
     return ok
+
+
+def _cut(pos: list[float], a: int, b: int, reach: float, screened: list[tuple[int, int]], centres: list[int],
+         left: list[tuple[int, int]]) -> None:
+    """Cut rows a..b-1 (positions ``pos``, ascending) into blocks that a ball of radius ``reach`` round one of their
+    rows covers: each block as far as it reaches from its first row, the last one centred on what remains.
+    Blocks of 3 or more rows go to ``screened`` with their centre in ``centres``; the others to ``left``
+    (neighbouring ones of this cut joined: rows of two chains never, their positions start again)."""
+    i, first_left = a, len(left)
+    while i < b:
+        c = bisect.bisect_right(pos, pos[i] + reach, i, b) - 1  # the farthest centre that reaches row i
+        if pos[b - 1] - pos[c] <= reach:  # one ball reaches the last row: centred on the rest
+            c = bisect.bisect_right(pos, (pos[i] + pos[b - 1]) / 2, i, c + 1) - 1
+            while pos[b - 1] - pos[c] > reach:
+                c += 1
+            e = b
+        else:
+            e = bisect.bisect_right(pos, pos[c] + reach, c, b)
+        if e - i >= 3:
+            screened.append((i, e))
+            centres.append(c)
+        elif len(left) > first_left and left[-1][1] == i:
+            left[-1] = (left[-1][0], e)
+        else:
+            left.append((i, e))
+        i = e
 
 
 PROBES = 2

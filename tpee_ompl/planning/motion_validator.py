@@ -107,6 +107,13 @@ class BatchedMotionValidator(ob.MotionValidator):
             return False
         return self._tally(bool(self.all_valid([states], clearance_balls.PROBES)[0]))
 
+    def check_motion_values(self, a: np.ndarray, b: np.ndarray, probes: int = clearance_balls.PROBES) -> bool:
+        """:meth:`checkMotion` of a -> b given as joint values (n,), with ``probes`` of its states checked plainly
+        first (its end, then the middles breadth first, up to the first invalid one): for a motion likely to collide,
+        which is mostly found there (a query's direct motion, asked about before anything else)."""
+        return bool(self._checked(np.atleast_2d(np.asarray(a, dtype=float)), np.atleast_2d(np.asarray(b, dtype=float)),
+                                  probes)[0])
+
     def check_motions(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
         """Validity of many motions A[k] -> B[k] (each excluding its start), batched together; a motion with a NaN
         or inf end is invalid."""
@@ -131,8 +138,9 @@ class BatchedMotionValidator(ob.MotionValidator):
             ok = self.all_valid(np.split(S, np.cumsum(counts)[:-1]) if len(counts) else [], probes)
         else:
             spacing = np.sqrt(((B - A) ** 2).sum(-1)) / counts  # the states are evenly spaced along each motion
+            chained = (A[1:] == B[:-1]).all(axis=1)  # a path's motions: screened as one polyline
             ok = screened_lines_valid(self.robot, self.robot.ball_screen(), S, counts, spacing, self.step,
-                                      self.screen_levels)
+                                      self.screen_levels, chained=chained)
         return self._tally(ok)
 
     def segment_counts(self, A: np.ndarray, B: np.ndarray) -> np.ndarray:
