@@ -226,6 +226,27 @@ def test_batched_motion_is_valid_agrees_with_the_setups_motion_checks(robot: Wea
     assert any(verdicts) and not all(verdicts)
 
 
+def test_an_array_gets_the_verdict_of_its_path_through_the_projects_validator(robot: WearerArm,
+                                                                             rng: np.random.Generator) -> None:
+    """An array goes to the project's validator as it is (no OMPL state per waypoint): the same verdict as its
+    PathGeometric, with the bounds' own tolerance and without the first state when told."""
+    ss = make_simple_setup(robot)
+    si = ss.getSpaceInformation()
+    si.setup()
+    high = np.array(si.getStateSpace().getBounds().high)
+    verdicts = set()
+    for k in range(60):
+        W = np.clip(rng.uniform(robot.lower, robot.upper) + np.cumsum(rng.normal(scale=0.1, size=(5, 4)), axis=0),
+                    robot.lower, robot.upper)
+        if k % 4 == 0:
+            W[2, 3] = high[3] + 1e-9 if k % 8 == 0 else np.nextafter(high[3], np.inf)  # outside; within tolerance
+        for first in (True, False):
+            want = path_passes_motion_checks(si, array_to_path(si, W), in_bounds=True, check_first=first)
+            assert path_passes_motion_checks(si, W, in_bounds=True, check_first=first) == want
+            verdicts.add(want)
+    assert verdicts == {True, False}
+
+
 # ------------------------------------------------------------------------------- lengths, resampling
 def test_path_length_and_resampling_keep_the_geometry() -> None:
     W = np.array([[0.0, 0.0], [3.0, 4.0], [3.0, 0.0]])

@@ -431,14 +431,18 @@ def generate(dmp: DMP, start: np.ndarray, goal: np.ndarray) -> np.ndarray:
     return y
 
 
+@functools.lru_cache(maxsize=16)
 def blend_weight(n_steps: int) -> np.ndarray:
-    """Weight of the forward rollout at each sample: 1 - quintic smoothstep of fake time, shape (P,).
+    """Weight of the forward rollout at each sample: 1 - quintic smoothstep of fake time, shape (P,) (read-only:
+    cached, every query of a library asks for the same).
 
     1 at the start, 0 at the end, zero slope at both ends, so the blend leaves the real start
     along the forward DMP and reaches the real goal along the reverse one (section 4.2.3).
     """
     u = np.linspace(0.0, 1.0, n_steps)
-    return 1.0 - u**3 * (10.0 - 15.0 * u + 6.0 * u**2)
+    w = 1.0 - u**3 * (10.0 - 15.0 * u + 6.0 * u**2)
+    w.setflags(write=False)
+    return w
 
 
 def blend_forward_reverse(forward: np.ndarray, reverse: np.ndarray) -> np.ndarray:

@@ -80,10 +80,15 @@ PRESET_TOLERANCE = 1e-6
 """Radians. How close DOF1/DOF2 must be to a Table-1 preset to be at it (:func:`infer_sector`, query files)."""
 
 
+_PRESETS_FLOAT = {k: (float(v[0]), float(v[1])) for k, v in POSTURE_PRESETS.items()}
+
+
 def infer_sector(q: np.ndarray) -> int | None:
     """The posture sector whose Table-1 preset (DOF1, DOF2) the configuration ``q`` is at, or None."""
+    a, b = (float(v) for v in q[:2])  # plain floats: np.allclose took 20 us a sector, in every query's first path
     for k in SECTORS:
-        if np.allclose(np.asarray(q[:2], dtype=float), POSTURE_PRESETS[k], atol=PRESET_TOLERANCE, rtol=0.0):
+        p0, p1 = _PRESETS_FLOAT[k]
+        if abs(a - p0) <= PRESET_TOLERANCE and abs(b - p1) <= PRESET_TOLERANCE:  # (False for NaN)
             return k
     return None
 

@@ -167,6 +167,17 @@ def path_passes_motion_checks(
             raise ValueError(f"waypoints must have shape (K, {n}), got {W.shape}")
         if not np.all(np.isfinite(W)):
             raise ValueError("waypoints contain NaN or inf")
+        mv = si.getMotionValidator() if si.isSetup() else None
+        if segments is None and len(W) > 1 and callable(getattr(mv, "check_motions", None)) \
+                and callable(getattr(mv, "read_state", None)):
+            # the project's validator takes the array as it is: no OMPL state per waypoint, written and read back
+            if in_bounds:
+                bounds, eps = space.getBounds(), np.finfo(float).eps  # satisfiesBounds' own tolerance
+                if not (np.all(W - eps <= np.array(bounds.high)) and np.all(W + eps >= np.array(bounds.low))):
+                    return False
+            if check_first and not si.isValid(set_state(si.allocState(), W[0])):
+                return False
+            return bool(mv.check_motions(W[:-1], W[1:]).all())
         states = [set_state(si.allocState(), w) for w in W]
     if not si.isSetup():
         si.setup()
