@@ -15,12 +15,24 @@ from tpee_ompl.model.queries import load_queries
 from tpee_ompl.model.sectors import posture_preset
 from tpee_ompl.model.wearer_arm import WearerArm
 from tpee_ompl.planning.dimension_rrt import RELEASE_AFTER, DimensionRRTOptions
-from tpee_ompl.planning.paths import path_passes_motion_checks, path_to_array, set_state
+from tpee_ompl.planning.paths import motion_is_valid, path_passes_motion_checks, path_to_array, set_state
 from tpee_ompl.planning.setup import make_simple_setup
 
 
 def _query(robot: WearerArm, i: int, j: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
     return sampler(robot)(np.random.default_rng(seed), i, j)
+
+
+def _blocked_query(robot: WearerArm, i: int, j: int, seed: int,
+                   library: PathLibrary | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """A query whose direct motion collides (a free one is the answer before the library is asked) and, given a
+    ``library``, that one of its demonstrations' paths answers."""
+    rng, sample = np.random.default_rng(seed), sampler(robot)
+    while True:
+        start, goal = sample(rng, i, j)
+        if not motion_is_valid(robot, np.stack([start, goal])) and (
+                library is None or library.query(start, goal, i, j).outcome in ("dmp", "repaired")):
+            return start, goal
 
 
 def _solve(robot, library, start, goal, ptc=None, **kw):
@@ -33,7 +45,7 @@ def _solve(robot, library, start, goal, ptc=None, **kw):
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_library_path_is_the_first_exact_solution_and_the_final_path_is_proven(robot, library: PathLibrary, seed):
-    start, goal = _query(robot, 1, 2, seed)
+    start, goal = _blocked_query(robot, 1, 2, seed, library)
     ss, planner, status = _solve(robot, library, start, goal, max_samples=150, seed=seed)
     stats = planner.last_run_stats()
     assert status == ob.PlannerStatus.EXACT_SOLUTION and ss.haveExactSolutionPath()
@@ -48,7 +60,7 @@ def test_library_path_is_the_first_exact_solution_and_the_final_path_is_proven(r
 
 
 def test_first_solution_stops_at_the_library_path_under_ompls_exact_solution_condition(robot, library):
-    start, goal = _query(robot, 1, 2, 0)
+    start, goal = _blocked_query(robot, 1, 2, 0, library)
     ss, planner, status = _solve(
         robot, library, start, goal,
         ptc=lambda ss: ob.plannerOrTerminationCondition(ob.exactSolnPlannerTerminationCondition(ss.getProblemDefinition()),
@@ -64,12 +76,27 @@ def test_with_the_time_up_only_the_closest_demonstrations_path_is_tried(robot, l
 
     checked: list[int] = []
     monkeypatch.setattr(pipeline, "path_passes_motion_checks", lambda si, path, **kw: checked.append(1) and False)
-    start, goal = _query(robot, 1, 2, 0)
+    start, goal = _blocked_query(robot, 1, 2, 0)
     ss, planner, status = _solve(robot, library, start, goal, ptc=lambda ss: ob.PlannerTerminationCondition(lambda: True))
     stats = planner.last_run_stats()
     assert status == ob.PlannerStatus.TIMEOUT and not ss.haveSolutionPath()
     assert len(checked) == 1 and stats["candidates_tried"] == 1 and stats["samples"] == 0
     assert stats["library_outcome"] == "failed" and stats["library_seconds"] is not None
+
+
+def test_a_free_direct_motion_is_the_answer_before_the_library_is_asked(robot, library):
+    """Nothing is shorter than the free direct motion (100 of the 120 ``paper_random`` queries): it is posted first,
+    without a library candidate or a sample."""
+    rng, sample = np.random.default_rng(0), sampler(robot)
+    start, goal = sample(rng, 1, 2)
+    while not motion_is_valid(robot, np.stack([start, goal])):
+        start, goal = sample(rng, 1, 2)
+    ss, planner, status = _solve(robot, library, start, goal, max_samples=150, seed=0)
+    stats = planner.last_run_stats()
+    assert status == ob.PlannerStatus.EXACT_SOLUTION and stats["library_outcome"] == "direct" and stats["direct_motion"]
+    assert stats["candidates_tried"] == 0 and stats["samples"] == 0
+    path = ss.getSolutionPath()
+    assert path.getStateCount() == 2 and path_passes_motion_checks(ss.getSpaceInformation(), path)
 
 
 def test_a_satisfied_cost_threshold_stops_at_the_library_path(robot, library):

@@ -217,6 +217,26 @@ def test_batched_check_motions_gives_each_motion_check_motions_verdict(robot, rn
     assert mv.check_motions(np.zeros((0, robot.nq)), np.zeros((0, robot.nq))).shape == (0,)  # no motion, no verdict
 
 
+def test_a_motion_given_as_joint_values_gets_check_motions_verdict_and_stops_at_a_colliding_probe(robot, rng):
+    """``check_motion_values(a, b, probes)`` checks that many of the motion's states first (its end, then the middles
+    breadth first): a planner's first question, the query's direct motion, mostly collides and is answered there."""
+    ss = make_simple_setup(robot)
+    si = ss.getSpaceInformation()
+    mv = si.getMotionValidator()
+    a, b = si.allocState(), si.allocState()
+    at_a_probe = 0
+    for _ in range(60):
+        A = rng.uniform(robot.lower, robot.upper)
+        B = np.clip(A + rng.normal(scale=0.8, size=A.shape), robot.lower, robot.upper)
+        set_state(a, A), set_state(b, B)
+        before = robot.collision_checks
+        ok = mv.check_motion_values(A, B, 15)
+        checked = robot.collision_checks - before
+        assert ok == mv.checkMotion(a, b) == bool(robot.are_valid(motion_states(A, B, mv.step)).all())
+        at_a_probe += not ok and checked <= 15
+    assert at_a_probe >= 10
+
+
 def test_an_unscreened_motion_check_stops_at_its_first_invalid_state_in_bisection_order(robot, rng):
     """Without clearance balls (robots where they do not pay) one motion's states were all checked in one batch, a
     colliding one too: 1 s for a 400-state motion of an xArm7 against 26 ms for OMPL's discrete validator."""

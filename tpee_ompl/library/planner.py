@@ -5,9 +5,10 @@ the closest demonstrations' blended DMP paths, each checked with ``si.checkMotio
 path) and reports the first valid one as an exact solution; then it keeps improving with
 dimension-RRT (section 4.1) seeded by the closest demonstration's DMP path at the fake-time steps,
 sharing the problem definition, so the best path either found is the answer.  When no library path
-is valid it tries Table 3's straight motion, then plans.  Before refining it checks the direct
-joint-space motion from start to goal: when that is free it is the shortest path in the space's
-metric, so it is posted and the run ends (on the paper's random queries, 100 of 120).  It is an ordinary ``ob.Planner``: ``og.SimpleSetup``,
+is valid it tries Table 3's straight motion, then plans.  Before all that it checks the direct
+joint-space motion from start to goal (a colliding one mostly at a few probe states, :data:`DIRECT_PROBES`):
+when that is free it is the shortest path in the space's metric, so it is posted and the run ends (on the
+paper's random queries, 100 of 120).  It is an ordinary ``ob.Planner``: ``og.SimpleSetup``,
 ``ot.Benchmark`` and the benchmark campaigns use it like any other.
 """
 
@@ -26,6 +27,7 @@ from ompl import geometric as og
 from ..model.queries import straight_motion
 from ..model.sectors import check_sector, infer_sector, posture_preset
 from ..planning.dimension_rrt import RELEASE_AFTER, DimensionRRT, DimensionRRTOptions, shortcuts_on
+from ..planning.motion_validator import BatchedMotionValidator
 from ..planning.paths import array_to_path, path_passes_motion_checks, state_to_array
 from ..planning.planner_base import (PythonPlanner, check_space_information, fixed_attribute, planner_status,
                                      problem_objective)
@@ -36,6 +38,12 @@ from .path_library import PathLibrary
 __all__ = ["LibraryDimensionRRT", "infer_sector"]
 
 log = logging.getLogger(__name__)
+
+DIRECT_PROBES = 15
+"""States of the direct motion checked plainly before the rest (its end, then the middles breadth first, up to the first
+invalid one): a colliding direct motion is mostly found there, for a few checks instead of a screened motion's 100 or
+more.  The 120 ``planning_necessary`` queries' direct motions all collide: 115 are found at one of these states
+(median 5 checked); ``paper_random``'s 20 colliding ones all within two (``experiments/library_coverage.py``)."""
 
 class LibraryDimensionRRT(PythonPlanner):
     """A validated library path in milliseconds, refined by dimension-RRT until the termination condition.
@@ -197,6 +205,11 @@ class LibraryDimensionRRT(PythonPlanner):
             stats["best_cost"] = cost
             progress.append((now, cost, 0))
 
+        # the direct joint-space motion, when free, is the shortest path there is: nothing to look up or refine
+        if self._direct_free(si, start, goal):
+            post(array_to_path(si, np.stack([start, goal])), "direct")
+            stats.update(direct_motion=True, library_seconds=time.perf_counter() - t0)
+            return planner_status(ob.PlannerStatus.EXACT_SOLUTION)
         if cross and (i, j) in lib.pairs and len(lib.pairs[(i, j)].starts):
             closest = None
             for rank, k, W in lib.candidate_paths(start, goal, i, j):
@@ -204,36 +217,37 @@ class LibraryDimensionRRT(PythonPlanner):
                     break
                 stats["candidates_tried"] += 1
                 closest = k if closest is None else closest
-                path = array_to_path(si, W)
-                if path_passes_motion_checks(si, path, in_bounds=True):
-                    post(path, "dmp" if rank == 0 else "repaired")
-                    best_path, have_exact = path, True
+                if path_passes_motion_checks(si, W, check_first=False, in_bounds=True):  # (the start: _endpoints)
+                    best_path, have_exact = array_to_path(si, W), True
+                    post(best_path, "dmp" if rank == 0 else "repaired")
                     break
             seed = lib.generate(start, goal, i, j, closest, stride=lib.per_step)
             # near the space's bounds (the joint limits) a DMP seed can leave them; it is only a head start: clip it
             bounds = si.getStateSpace().getBounds()
             seed = np.clip(seed, np.array(bounds.low, dtype=float), np.array(bounds.high, dtype=float))
-        if not have_exact and ptc():  # time is up before the straight, the direct motion and the planning
+        if not have_exact and ptc():  # time is up before the straight motion and the planning
             stats.update(library_outcome="failed", library_seconds=time.perf_counter() - t0)
             return planner_status(ob.PlannerStatus.TIMEOUT)
         if cross and not have_exact:  # Table 3's straight motion: often free when the library's paths are not
-            path = array_to_path(si, straight_motion(start, goal, i, j))
-            if path_passes_motion_checks(si, path, in_bounds=True):
-                post(path, "straight")
-                best_path, have_exact = path, True
+            W = straight_motion(start, goal, i, j)
+            if path_passes_motion_checks(si, W, check_first=False, in_bounds=True):
+                best_path, have_exact = array_to_path(si, W), True
+                post(best_path, "straight")
         stats["library_seconds"] = time.perf_counter() - t0
         if have_exact and (ptc() or (opt is not None and opt.isSatisfied(best_path.cost(opt)))):
-            return planner_status(ob.PlannerStatus.EXACT_SOLUTION)
-        # the direct joint-space motion, when free, is the shortest path there is: nothing to refine
-        direct = array_to_path(si, np.stack([start, goal]))
-        if path_passes_motion_checks(si, direct, in_bounds=True):
-            if not have_exact or direct.length() < stats["best_cost"]:
-                post(direct, "direct")
-            stats["direct_motion"] = True
             return planner_status(ob.PlannerStatus.EXACT_SOLUTION)
         if stats["library_outcome"] is None:
             stats["library_outcome"] = "planned"
         return self._refine(ptc, t0, (i, j) if cross else None, seed, have_exact)
+
+    @staticmethod
+    def _direct_free(si: ob.SpaceInformation, start: np.ndarray, goal: np.ndarray) -> bool:
+        """Whether the direct motion start -> goal (valid ends within the bounds) passes ``si.checkMotion``: through the
+        project's validator with :data:`DIRECT_PROBES` of its states checked first."""
+        mv = si.getMotionValidator()
+        if isinstance(mv, BatchedMotionValidator):
+            return mv.check_motion_values(start, goal, DIRECT_PROBES)
+        return path_passes_motion_checks(si, array_to_path(si, np.stack([start, goal])), check_first=False)
 
     def _refine(self, ptc: ob.PlannerTerminationCondition, t0: float, pair: tuple[int, int] | None,
                 seed: np.ndarray | None, have_exact: bool, read_ends: bool = True) -> ob.PlannerStatus:
