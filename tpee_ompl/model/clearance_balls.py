@@ -29,7 +29,7 @@ import pinocchio as pin
 if TYPE_CHECKING:
     from .robot_checker import RobotChecker
 
-__all__ = ["BallScreen", "SCREEN_COST_LIMIT", "SCREEN_LEVELS", "separated_pairs", "screened_all_valid",
+__all__ = ["BallScreen", "CHAINS", "SCREEN_COST_LIMIT", "SCREEN_LEVELS", "separated_pairs", "screened_all_valid",
            "screened_lines_valid"]
 
 SEPARATION_TOLERANCE = 1e-5
@@ -47,6 +47,10 @@ MIDDLES_FIRST = True
 """What no ball covers is checked plainly in two calls, each remaining block's middle state first, then the other
 states of the lines whose middles passed (False: all of them in one call, before 2026-11-27; a switch for
 ``experiments/colliding_motions.py --switch middles``).  The same verdicts either way."""
+CHAINS = True
+"""A path's motions (each starting where the last ended, ``chained`` in :func:`screened_lines_valid`) are covered as one
+polyline, a ball reaching across a waypoint (False: each motion a line of its own, before 2026-11-27; a switch for
+``experiments/chained_paths.py``).  The same verdicts either way."""
 SCREEN_COST_LIMIT = 4.0
 """The screen is used where its inflated check of a state costs at most this many plain checks
 (:meth:`BallScreen.pays`).  A ball of 4 steps covers up to 9 states; near contact, Coal's mesh-mesh checks at
@@ -258,56 +262,95 @@ def _blocks_valid(robot: RobotChecker, screen: BallScreen, S: np.ndarray, starts
     """The ball screening of :func:`screened_lines_valid` for lines already inside the joint limits, in plain
     Python over the blocks (a few dozen per call: cheaper than array bookkeeping); one verdict per line.
 
-    Each state's position along its chain of lines (``chained[k]``: line k + 1 goes on from line k; its states
-    are rows of S right after line k's) bounds its joint-space distance to any other state of the chain: the
-    blocks a ball covers are cut by position (:func:`_cut`)."""
-    pos = [0.0] * len(S)  # S rows outside every line keep 0 (never in a block)
-    owner = [-1] * len(S)
-    blocks: list[tuple[int, int]] = []  # (first row, end row) of each chain: the pieces still to cover
-    for k, (a, m, sp) in enumerate(zip(starts, sizes, spacing)):
-        if k and chained is not None and chained[k - 1] and blocks[-1][1] == a:
-            base = pos[a - 1]
-            blocks[-1] = (blocks[-1][0], a + m)
-        else:
-            base = 0.0
-            blocks.append((a, a + m))
-        pos[a : a + m] = [base + sp * i for i in range(1, m + 1)]
-        owner[a : a + m] = [k] * m
+    A line of its own is cut by index (:func:`_cut_line`).  Lines chained to each other (``chained[k]``: line k + 1
+    goes on from line k; its states are rows of S right after line k's) are cut by each state's position along the
+    chain, which bounds its joint-space distance to any other state of the chain (:func:`_cut`)."""
+    blocks: list[tuple[int, int, int]] = []  # (first row, end row, line; -1: a chain of lines) still to cover
+    joined = [False] * len(starts)
+    for k, (a, m) in enumerate(zip(starts, sizes)):
+        joined[k] = bool(k and CHAINS and chained is not None and chained[k - 1] and blocks[-1][1] == a)
+        blocks.append((blocks.pop()[0], a + m, -1) if joined[k] else (a, a + m, k))
+    pos: list[float] = []
+    if any(joined):  # positions along the chains (rows of lines of their own stay 0, never read)
+        pos = [0.0] * len(S)
+        for k, (a, m, sp) in enumerate(zip(starts, sizes, spacing)):
+            base = pos[a - 1] if joined[k] else 0.0
+            pos[a : a + m] = [base + sp * i for i in range(1, m + 1)]
     for h in levels:
         if not blocks:
             break
         radius = h * step
-        screened: list[tuple[int, int]] = []
+        screened: list[tuple[int, int, int]] = []
         centres: list[int] = []
-        left: list[tuple[int, int]] = []  # pieces with no state to screen at this level
-        for a, b in blocks:
-            _cut(pos, a, b, radius * (1 + 1e-12), screened, centres, left)
+        left: list[tuple[int, int, int]] = []  # pieces with no state to screen at this level
+        for a, b, k in blocks:
+            if k < 0:
+                _cut(pos, a, b, radius * (1 + 1e-12), screened, centres, left)
+            else:
+                H = int(math.floor(radius / spacing[k] * (1 + 1e-12))) if spacing[k] > 0 else 0  # states reached
+                _cut_line(a, b, k, H, screened, centres, left)
         if centres:
             left += [p for p, ok in zip(screened, screen.clear(S[centres], radius).tolist()) if not ok]
         blocks = left
     ok = [True] * len(starts)
     if not blocks:
         return ok
+
+    def line(i: int, k: int) -> int:  # the line of row i in a block of line k (-1: of a chain)
+        return k if k >= 0 else bisect.bisect_right(starts, i) - 1
+
     # what no ball covers, in two calls: each block's middle state (beside a ball that failed: the likeliest to
     # collide), then the other states of the lines still valid, so a colliding line stops there
     if MIDDLES_FIRST:
-        mids = [(a + b - 1) // 2 for a, b in blocks]
-        for i, free in zip(mids, robot.collision_free(S[mids]).tolist()):
+        mids = [(a + b - 1) // 2 for a, b, _ in blocks]
+        for (_, _, k), i, free in zip(blocks, mids, robot.collision_free(S[mids]).tolist()):
             if not free:
-                ok[owner[i]] = False
+                ok[line(i, k)] = False
     else:
         mids = [-1] * len(blocks)  # (no middle checked first)
-    rows = [i for (a, b), c in zip(blocks, mids) for i in range(a, b) if i != c and ok[owner[i]]]
+    rows: list[int] = []
+    owner: list[int] = []  # the line of each row
+    for (a, b, k), c in zip(blocks, mids):
+        if k >= 0:  # a line of its own
+            if ok[k]:
+                rows.extend(i for i in range(a, b) if i != c)
+                owner.extend([k] * (b - a - (c >= 0)))
+            continue
+        for i in range(a, b):
+            if i != c and ok[j := line(i, k)]:
+                rows.append(i)
+                owner.append(j)
     if rows:
         for i in np.flatnonzero(~robot.collision_free(S[rows])).tolist():
-            ok[owner[rows[i]]] = False
+            ok[owner[i]] = False
     return ok
 
 
-def _cut(pos: list[float], a: int, b: int, reach: float, screened: list[tuple[int, int]], centres: list[int],
-         left: list[tuple[int, int]]) -> None:
-    """Cut rows a..b-1 (positions ``pos``, ascending) into blocks that a ball of radius ``reach`` round one of their
-    rows covers: each block as far as it reaches from its first row, the last one centred on what remains.
+def _cut_line(a: int, b: int, k: int, H: int, screened: list[tuple[int, int, int]], centres: list[int],
+              left: list[tuple[int, int, int]]) -> None:
+    """Cut rows a..b-1 of line k, evenly spaced, into blocks of 2H+1 (a ball reaching H states either side of the
+    middle one), the rest into one centred block: blocks of 3 or more rows go to ``screened`` with their centre in
+    ``centres``, the others to ``left``."""
+    if H < 1:
+        left.append((a, b, k))
+        return
+    width = 2 * H + 1
+    full, rest = divmod(b - a, width)
+    end = a + full * width
+    for s in range(a, end, width):
+        screened.append((s, s + width, k))
+        centres.append(s + H)
+    if rest >= 3:
+        screened.append((end, b, k))
+        centres.append(end + (rest - 1) // 2)
+    elif rest:
+        left.append((end, b, k))
+
+
+def _cut(pos: list[float], a: int, b: int, reach: float, screened: list[tuple[int, int, int]], centres: list[int],
+         left: list[tuple[int, int, int]]) -> None:
+    """Cut rows a..b-1 of a chain (positions ``pos``, ascending) into blocks that a ball of radius ``reach`` round one
+    of their rows covers: each block as far as it reaches from its first row, the last one centred on what remains.
     Blocks of 3 or more rows go to ``screened`` with their centre in ``centres``; the others to ``left``
     (neighbouring ones of this cut joined: rows of two chains never, their positions start again)."""
     i, first_left = a, len(left)
@@ -321,12 +364,12 @@ def _cut(pos: list[float], a: int, b: int, reach: float, screened: list[tuple[in
         else:
             e = bisect.bisect_right(pos, pos[c] + reach, c, b)
         if e - i >= 3:
-            screened.append((i, e))
+            screened.append((i, e, -1))
             centres.append(c)
         elif len(left) > first_left and left[-1][1] == i:
-            left[-1] = (left[-1][0], e)
+            left[-1] = (left[-1][0], e, -1)
         else:
-            left.append((i, e))
+            left.append((i, e, -1))
         i = e
 
 
