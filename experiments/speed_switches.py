@@ -7,6 +7,7 @@
     PYTHONPATH=. .venv/bin/python experiments/speed_switches.py hit-states --samples 20000 --reps 1
     PYTHONPATH=. .venv/bin/python experiments/speed_switches.py screen-order --samples 20000 --reps 1
     PYTHONPATH=. .venv/bin/python experiments/speed_switches.py pair-checks --planner paper --samples 2500
+    PYTHONPATH=. .venv/bin/python experiments/speed_switches.py broadphase --planner paper --samples 2500
 
 Switches (scratch settings of the installed code; the first value is the reference):
 
@@ -31,6 +32,9 @@ Switches (scratch settings of the installed code; the first value is the referen
   failure) checks its rows two at a time, one per thread (``robot_checker.FIRST_INVALID_PAIRS``, the
   package), or one at a time on one thread (before 2026-11-26).  The same answers, so the same paths; the
   checks count both rows of the last pair.
+* ``broadphase`` (``on``, ``off``): the robot's batched and single checks and its clearance balls' screens through
+  Pinocchio's tree broadphase (``collision_pools.BROADPHASE``, the package), or every active pair narrow-phased
+  (before 2026-11-28).  The same verdicts, so the same paths and checks.
 
 Each run is capped at ``--samples``, so every setting draws the same samples; the paths must be the same
 (their states' bytes compared, and printed).  Settings alternate per query.  Prints the total time, the collision checks and
@@ -51,7 +55,7 @@ from ompl import util as ou
 
 from tpee_ompl import make_simple_setup
 from tpee_ompl.library.planner import LibraryDimensionRRT
-from tpee_ompl.model import robot_checker
+from tpee_ompl.model import collision_pools, robot_checker
 from tpee_ompl.planning import search_checker, search_draws
 from tpee_ompl.planning.paths import path_to_array
 from tpee_ompl.planning.tpee import tpee_dimension_rrt
@@ -92,12 +96,32 @@ def _pair_checks(value: str) -> None:
     robot_checker.FIRST_INVALID_PAIRS = value == "on"
 
 
+_ROBOT: list = []  # the run's robot, for the switches that rebuild its pools
+_POOLS: dict[str, tuple] = {}
+
+
+def _broadphase(value: str) -> None:
+    """The robot's pools, single check and ball screen built with the broadphase on or off (each kept once built)."""
+    robot = _ROBOT[0]
+    if value not in _POOLS:
+        collision_pools.BROADPHASE = value == "on"
+        _POOLS[value] = (collision_pools.new_pool(robot.model, robot.gmodel, robot.gdata, robot.n_threads),
+                         collision_pools.single_check(robot.model, robot.data, robot.gmodel, robot.gdata), None)
+        collision_pools.BROADPHASE = True
+    if robot._ball_screen is not None:
+        old = next(k for k, v in _POOLS.items() if v[0] is robot.pool)
+        _POOLS[old] = (*_POOLS[old][:2], robot._ball_screen)
+    robot.pool, robot._collides, robot._ball_screen = _POOLS[value]
+    collision_pools.BROADPHASE = value == "on"  # a ball screen built from here on takes the same kind of pools
+
+
 SWITCHES: dict[str, tuple[Callable[[str], None], list[str]]] = {
     "look-ahead": (_look_ahead, ["on", "off"]),
     "candidate-stride": (_candidate_stride, ["4", "16"]),
     "hit-states": (_hit_states, ["on", "off"]),
     "screen-order": (_screen_order, ["nearest", "bisect"]),
     "pair-checks": (_pair_checks, ["on", "off"]),
+    "broadphase": (_broadphase, ["on", "off"]),
 }
 
 
@@ -117,6 +141,8 @@ def main(argv: list[str] | None = None) -> None:
     values = args.values or default
     ou.setLogLevel(ou.LOG_NONE)
     robot, lib, rows = wearer_library_queries(args.queries, args.max_queries)
+    _ROBOT[:] = [robot]
+    _POOLS["on"] = (robot.pool, robot._collides, None)  # the package's own (its ball screen is kept on switching)
     setups = [make_simple_setup(robot, np.array(q["start"]), np.array(q["goal"])) for q in rows]
     total = dict.fromkeys(values, 0.0)
     checks = dict.fromkeys(values, 0)

@@ -26,6 +26,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pinocchio as pin
 
+from .collision_pools import CollisionPool, new_pool
+
 if TYPE_CHECKING:
     from .robot_checker import RobotChecker
 
@@ -119,7 +121,7 @@ class BallScreen:
     def __init__(self, robot: RobotChecker) -> None:
         self.robot = robot
         self._lever_norms = np.linalg.norm(robot.pair_lever_arms(), axis=1)
-        self._pools: dict[float, pin.GeometryPool] = {}
+        self._pools: dict[float, CollisionPool] = {}
         self._pays: dict[float, bool] = {}
 
     def pays(self, radius: float) -> bool:
@@ -169,15 +171,14 @@ class BallScreen:
             robot.collision_checks = kept[0]
             robot.stall_guard.restore(kept[1])
 
-    def _pool(self, radius: float) -> pin.GeometryPool:
+    def _pool(self, radius: float) -> CollisionPool:
         pool = self._pools.get(radius)
         if pool is None:
             robot = self.robot
             gd = robot.new_check_data()
             for k, req in enumerate(gd.collisionRequests):
                 req.security_margin += radius * self._lever_norms[k] + SEPARATION_TOLERANCE
-            pool = pin.GeometryPool(robot.model, robot.gmodel, robot.n_threads)
-            pool.update(gd)
+            pool = new_pool(robot.model, robot.gmodel, gd, robot.n_threads)
             self._pools[radius] = pool
         return pool
 

@@ -2,7 +2,8 @@
 
 One :class:`RobotChecker` loads a URDF (+ SRDF) once, adds the obstacles, prunes the pairs that
 can never come close, and answers what every planner asks: is this configuration valid (one at a
-time or a batch in one ``pin.computeCollisionsInParallel`` call), how far is it from collision,
+time or a batch in one ``pin.computeCollisionsInParallel`` call, both through Pinocchio's tree broadphase:
+:mod:`~tpee_ompl.model.collision_pools`), how far is it from collision,
 and how large a joint step keeps every point of the robot within a given displacement
 (:meth:`RobotChecker.max_joint_step`, the motion-check guarantee of :mod:`tpee_ompl.planning.setup`).
 """
@@ -20,6 +21,7 @@ import pinocchio as pin
 
 from ..validation import as_config_batch, as_float_array, check_bool, check_int, check_number
 from .clearance_balls import BallScreen, separated_pairs
+from .collision_pools import CollisionPool, new_pool, single_check
 from .lever_arms import joint_lever_arms, pair_lever_arms
 from .obstacles import Obstacle
 from .pair_diagnostics import warn_always_colliding
@@ -251,8 +253,8 @@ class RobotChecker:
         (:func:`~tpee_ompl.model.clearance_balls.separated_pairs`); :meth:`clearance` still measures them."""
         self.gdata = self.new_check_data()
         self._distance_data = pin.GeometryData(self.gmodel)
-        self.pool = pin.GeometryPool(self.model, self.gmodel, self.n_threads)
-        self.pool.update(self.gdata)
+        self.pool = new_pool(self.model, self.gmodel, self.gdata, self.n_threads)
+        self._collides = single_check(self.model, self.data, self.gmodel, self.gdata)
 
     # ------------------------------------------------------------------ facts
     @property
@@ -388,7 +390,7 @@ class RobotChecker:
         if not self.inside_limits(q[None])[0]:
             return False
         self.collision_checks += 1
-        return not pin.computeCollisions(self.model, self.data, self.gmodel, self.gdata, q, True)
+        return not self._collides(q, True)
 
     def is_valid_values(self, values: Sequence[float]) -> bool:
         """:meth:`is_valid` for nq plain floats (an OMPL state's values), without the input checks.
@@ -403,7 +405,7 @@ class RobotChecker:
             if not lo <= v <= hi:
                 return False
         self.collision_checks += 1
-        return not pin.computeCollisions(self.model, self.data, self.gmodel, self.gdata, np.array(values), True)
+        return not self._collides(np.array(values), True)
 
     def are_valid(self, Q: np.ndarray) -> np.ndarray:
         """Batched :meth:`is_valid` for Q of shape (N, nq): one Pinocchio call; returns bool (N,)."""
@@ -456,7 +458,7 @@ class RobotChecker:
         """Times the checker went on one thread after stalled calls (:class:`~tpee_ompl.model.stall_guard.StallGuard`)."""
         return self.stall_guard.stalls
 
-    def collision_free(self, Q: np.ndarray, pool: pin.GeometryPool | None = None) -> np.ndarray:
+    def collision_free(self, Q: np.ndarray, pool: CollisionPool | None = None) -> np.ndarray:
         """:meth:`are_valid` for a float array Q (N >= 1, nq) already known finite and inside the joint
         limits (a motion's states between two checked ends): the collision check alone, no input checks.
         ``pool``: another pool of this model with other margins (default: the checks' own)."""
