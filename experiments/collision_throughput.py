@@ -89,15 +89,12 @@ def main(argv: list[str] | None = None) -> dict[str, float]:
 
 
 def _robot(name: str, broadphase: bool):
-    collision_pools.BROADPHASE = broadphase
-    try:
+    with collision_pools.broadphase(broadphase):
         if name == "wearer":
             return WearerArm()
         from tpee_ompl.model import robots
 
         return robots.panda_shelf() if name == "panda" else robots.kinova_posts()
-    finally:
-        collision_pools.BROADPHASE = True
 
 
 def broadphase_table(names: list[str], n: int, repeats: int, seed: int) -> dict[str, float]:

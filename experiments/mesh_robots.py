@@ -99,9 +99,8 @@ def main(argv: list[str] | None = None) -> None:
                 t = time.perf_counter()
                 rc = RobotChecker(urdf, srdf, package_dirs=dirs, convex_meshes=convex)
                 build = time.perf_counter() - t
-                collision_pools.BROADPHASE = False
-                loop = RobotChecker(urdf, srdf, package_dirs=dirs, convex_meshes=convex)
-                collision_pools.BROADPHASE = True
+                with collision_pools.broadphase(False):
+                    loop = RobotChecker(urdf, srdf, package_dirs=dirs, convex_meshes=convex)
                 Q = np.random.default_rng(0).uniform(rc.lower, rc.upper, (300, rc.nq))
                 times: dict[int, list[float]] = {0: [], 1: []}
                 for _ in range(3):

@@ -79,9 +79,8 @@ def _broadphase_ab(args: argparse.Namespace, problem, queries: list) -> None:
 
     checkers = {}
     for kind in ("broadphase", "pair loop"):  # the problem keeps one checker per process: two built here
-        collision_pools.BROADPHASE = kind == "broadphase"
-        checkers[kind] = robots.panda_shelf() if args.problem == "panda-shelf" else robots.kinova_posts()
-    collision_pools.BROADPHASE = True
+        with collision_pools.broadphase(kind == "broadphase"):
+            checkers[kind] = robots.panda_shelf() if args.problem == "panda-shelf" else robots.kinova_posts()
     times: dict[tuple[str, str], list[float]] = {}
     for k, query in enumerate(queries[: args.queries]):
         setups = {kind: make_simple_setup(c, query["start"], query["goal"], motion_validator="batched")

@@ -104,10 +104,9 @@ def _broadphase(value: str) -> None:
     """The robot's pools, single check and ball screen built with the broadphase on or off (each kept once built)."""
     robot = _ROBOT[0]
     if value not in _POOLS:
-        collision_pools.BROADPHASE = value == "on"
-        _POOLS[value] = (collision_pools.new_pool(robot.model, robot.gmodel, robot.gdata, robot.n_threads),
-                         collision_pools.single_check(robot.model, robot.data, robot.gmodel, robot.gdata), None)
-        collision_pools.BROADPHASE = True
+        with collision_pools.broadphase(value == "on"):
+            _POOLS[value] = (collision_pools.new_pool(robot.model, robot.gmodel, robot.gdata, robot.n_threads),
+                             collision_pools.single_check(robot.model, robot.data, robot.gmodel, robot.gdata), None)
     if robot._ball_screen is not None:
         old = next(k for k, v in _POOLS.items() if v[0] is robot.pool)
         _POOLS[old] = (*_POOLS[old][:2], robot._ball_screen)

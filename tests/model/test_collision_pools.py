@@ -30,13 +30,6 @@ def _near_contact(robot: RobotChecker, n: int, seed: int) -> np.ndarray:
     return np.clip(S, robot.lower, robot.upper)
 
 
-def _pair_loop_twin(make, monkeypatch) -> RobotChecker:
-    monkeypatch.setattr(collision_pools, "BROADPHASE", False)
-    twin = make()
-    monkeypatch.setattr(collision_pools, "BROADPHASE", True)
-    return twin
-
-
 def _agree(robot: RobotChecker, twin: RobotChecker, S: np.ndarray) -> None:
     assert type(twin.pool) is pin.GeometryPool  # (the broadphase pool's bindings derive from it)
     assert type(robot.pool) is not pin.GeometryPool
@@ -50,18 +43,20 @@ def _agree(robot: RobotChecker, twin: RobotChecker, S: np.ndarray) -> None:
         assert (robot.ball_screen().clear(S, radius) == twin.ball_screen().clear(S, radius)).all()
 
 
-def test_broadphase_gives_the_pair_loops_verdicts_next_to_the_wearer(monkeypatch):
+def test_broadphase_gives_the_pair_loops_verdicts_next_to_the_wearer():
     robot = WearerArm()
-    twin = _pair_loop_twin(WearerArm, monkeypatch)
+    with collision_pools.broadphase(False):
+        twin = WearerArm()
     _agree(robot, twin, _near_contact(robot, 300, seed=3))
 
 
 @needs_panda
-def test_broadphase_gives_the_pair_loops_verdicts_on_the_panda_shelf(monkeypatch):
+def test_broadphase_gives_the_pair_loops_verdicts_on_the_panda_shelf():
     from tpee_ompl.model.robots import panda_shelf
 
     robot = panda_shelf()
-    twin = _pair_loop_twin(panda_shelf, monkeypatch)
+    with collision_pools.broadphase(False):
+        twin = panda_shelf()
     _agree(robot, twin, _near_contact(robot, 150, seed=4))
 
 
@@ -81,9 +76,10 @@ def test_a_model_the_broadphase_refuses_is_checked_pair_by_pair(robot, monkeypat
     assert [not collides(q, True) for q in Q] == expected.tolist()
 
 
-@pytest.mark.parametrize("broadphase", [True, False])
-def test_fresh_check_data_gets_a_pool_either_way(robot, monkeypatch, broadphase):
-    monkeypatch.setattr(collision_pools, "BROADPHASE", broadphase)
+@pytest.mark.parametrize("on", [True, False])
+def test_fresh_check_data_gets_a_pool_either_way(robot, on):
     for _ in range(5):  # a fresh GeometryData's placements are not initialised: Coal refused most boxes built from them
-        pool = collision_pools.new_pool(robot.model, robot.gmodel, robot.new_check_data(), 2)
-        assert (type(pool) is pin.GeometryPool) != broadphase
+        with collision_pools.broadphase(on):
+            pool = collision_pools.new_pool(robot.model, robot.gmodel, robot.new_check_data(), 2)
+        assert (type(pool) is pin.GeometryPool) != on
+    assert collision_pools.BROADPHASE

@@ -10,7 +10,8 @@ clearance balls.  Measured side by side (``experiments/collision_throughput.py``
 README): a collision-free configuration about twice as fast on the wearer, 3x on the Panda shelf, 4-5x on
 the Kinova arm among posts; a single configuration 1.3x / 2x / 4x.
 
-:data:`BROADPHASE` switches it off (every pair in turn, as before 2026-11-28) for side-by-side runs.  A
+:data:`BROADPHASE` switches it off (every pair in turn, as before 2026-11-28) for side-by-side runs
+(:func:`broadphase` sets it for what is built inside a ``with`` block).  A
 model the broadphase refuses (Coal raises on a bounding box of negative volume, as it does for a fresh
 ``GeometryData`` whose placements were never computed: :func:`_place` computes them first) falls back to the
 pair loop, with the same verdicts.
@@ -18,14 +19,15 @@ pair loop, with the same verdicts.
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import logging
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 
 import numpy as np
 import pinocchio as pin
 
-__all__ = ["BROADPHASE", "CollisionPool", "new_pool", "single_check"]
+__all__ = ["BROADPHASE", "CollisionPool", "broadphase", "new_pool", "single_check"]
 
 log = logging.getLogger(__name__)
 
@@ -35,6 +37,18 @@ BROADPHASE = True
 
 CollisionPool = pin.GeometryPool | pin.TreeBroadPhaseManagerPool_DynamicAABBTreeCollisionManager
 """What ``pin.computeCollisionsInParallel`` is given: a pool of per-thread collision data."""
+
+
+@contextlib.contextmanager
+def broadphase(on: bool) -> Iterator[None]:
+    """Checkers, pools and ball screens built inside take the broadphase (``on``) or the pair loop; :data:`BROADPHASE`
+    is restored after (for side-by-side runs and tests: the same verdicts either way)."""
+    global BROADPHASE
+    saved, BROADPHASE = BROADPHASE, bool(on)
+    try:
+        yield
+    finally:
+        BROADPHASE = saved
 
 
 def new_pool(model: pin.Model, gmodel: pin.GeometryModel, gdata: pin.GeometryData, n_threads: int) -> CollisionPool:
