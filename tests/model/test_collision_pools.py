@@ -13,7 +13,8 @@ from tpee_ompl.model.wearer_arm import WearerArm
 
 
 def _near_contact(robot: RobotChecker, n: int, seed: int) -> np.ndarray:
-    """States within 1e-6..1e-2 rad of where straight lines between a valid and a colliding state first collide."""
+    """States next to contact: on straight lines from a valid to a colliding state, 1e-6..1e-2 of the line's length
+    either side of where it first collides, plus 1e-4 rad of noise."""
     rng = np.random.default_rng(seed)
     Q = rng.uniform(robot.lower, robot.upper, (8 * n, robot.nq))
     ok = robot.are_valid(Q)
