@@ -54,9 +54,11 @@ def first_path_time(ss: og.SimpleSetup, planner: ob.Planner, limit: float) -> fl
     return dt if ss.haveExactSolutionPath() else None
 
 
-def wearer_library_queries(queries: str, max_queries: int) -> tuple[WearerArm, PathLibrary, list[dict]]:
-    """The wearer, its default path library and the stratified ``max_queries`` of a query set (name or JSON file)."""
-    robot = WearerArm()
+def wearer_library_queries(queries: str, max_queries: int,
+                           n_threads: int | None = None) -> tuple[WearerArm, PathLibrary, list[dict]]:
+    """The wearer (``n_threads`` for its checks, default the checker's), its default path library and the stratified
+    ``max_queries`` of a query set (name or JSON file)."""
+    robot = WearerArm() if n_threads is None else WearerArm(n_threads=n_threads)
     library = PathLibrary.load(default_library_path(), robot)
     _, rows = query_rows(queries, robot)
     return robot, library, stratified_subset(rows, max_queries)

@@ -39,3 +39,17 @@ def test_the_single_motion_script_runs_with_the_validator_it_swaps_in():
     done = _run("single_motion_checks.py", "--queries", "1", "--reps", "1", "--limit", "1")
     assert done.returncode == 0, done.stderr[-2000:]
     assert "bisection / all at once:" in done.stdout
+
+
+@pytest.mark.slow
+def test_the_convergence_script_repeats_one_run_and_sets_the_pipeline_beside_aorrtc():
+    """Issue 17's in-process comparison and the same run repeated (the samples a run reaches depend on the
+    machine's speed at the time): both modes run, and ``--repeat`` without exactly one ``--only`` query is refused."""
+    refused = _run("pipeline_convergence.py", "--repeat", "2")
+    assert refused.returncode == 2 and "--repeat" in refused.stderr.splitlines()[-1]
+    done = _run("pipeline_convergence.py", "--only", "1", "--repeat", "2", "--budgets", "0.01")
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert "query 1 at 0.01 s, seed 1, 2 times: samples" in done.stdout
+    done = _run("pipeline_convergence.py", "--aorrtc", "--only", "1", "--budgets", "0.01")
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert "AORRTC 1 s: median cost" in done.stdout and "pipeline 0.01 s: median cost" in done.stdout
