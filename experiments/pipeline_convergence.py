@@ -3,7 +3,7 @@
     PYTHONPATH=. .venv/bin/python experiments/pipeline_convergence.py                 # 0.1, 1, 10 s: ~4.5 min
     PYTHONPATH=. .venv/bin/python experiments/pipeline_convergence.py --budgets 0.1 1
     PYTHONPATH=. .venv/bin/python experiments/pipeline_convergence.py --only 1 9 --seeds 6 --budgets 0.1 1   # the median's two queries
-    PYTHONPATH=. .venv/bin/python experiments/pipeline_convergence.py --aorrtc --seeds 3 --budgets 0.1 0.15 0.2 0.3  # ~7 min
+    PYTHONPATH=. .venv/bin/python experiments/pipeline_convergence.py --aorrtc --seeds 3 --budgets 0.1 0.15 0.2 0.3  # ~4 min
     PYTHONPATH=. .venv/bin/python experiments/pipeline_convergence.py --only 9 --repeat 10 --budgets 0.1   # one run, again
 
 ``LibraryDimensionRRT`` (its defaults: rows released, shortcuts) on the stratified 24 queries of a
