@@ -15,8 +15,8 @@ converges), to set beside AORRTC's median in the anytime campaign.  ``--only`` r
 printing every run's cost and samples: the spread between runs of one query.
 
 ``--aorrtc``: issue 17's comparison in one process instead of a campaign: each query and seed (``--seeds``) runs
-the pipeline at every budget and OMPL's AORRTC (its defaults) for 1 s, one after the other on one checker thread (a
-campaign worker's); prints each budget's median cost over all runs against AORRTC's, and the median over the
+the pipeline at every budget and OMPL's AORRTC (its defaults; OMPL seeded with 100 * s + position + 1 before it) for
+1 s, one after the other on one checker thread (a campaign worker's); prints each budget's median cost over all runs against AORRTC's, and the median over the
 queries of each query's median ratio.  ``--repeat N`` with one ``--only`` query: the same run (the same seed, so the
 same samples in the same order) N times per budget, printing the samples each reached and its CPU time: how far
 what a run reaches within its budget depends on how fast the machine is at that moment.
@@ -34,6 +34,7 @@ from ompl import util as ou
 
 from tpee_ompl import make_simple_setup
 from tpee_ompl.library.planner import LibraryDimensionRRT
+from tpee_ompl.planning.setup import seed_ompl
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -84,9 +85,7 @@ def main(argv: list[str] | None = None) -> None:
 
 def _spread(args: argparse.Namespace, ap: argparse.ArgumentParser) -> None:
     """Every run of the chosen queries x seeds x budgets: per query and budget the cost range, then each run."""
-    robot, lib, rows = wearer_library_queries(args.queries, args.max_queries)
-    if args.only and not all(0 <= k < len(rows) for k in args.only):
-        ap.error(f"--only takes positions 0..{len(rows) - 1} of the stratified set, got {args.only}")
+    robot, lib, rows = _checked_rows(args, ap)
     for k in args.only if args.only else range(len(rows)):
         q = rows[k]
         ss = make_simple_setup(robot, np.array(q["start"]), np.array(q["goal"]))
@@ -128,6 +127,7 @@ def _versus_aorrtc(args: argparse.Namespace, ap: argparse.ArgumentParser) -> Non
                 planner = LibraryDimensionRRT(ss.getSpaceInformation(), lib, q["from_sector"], q["to_sector"],
                                               seed=100 * s + k)
                 cost[b][s, i] = length_after(ss, planner, b)
+            seed_ompl(100 * s + k + 1)  # AORRTC's own stream (OMPL refuses 0)
             ao[s, i] = length_after(ss, og.AORRTC(ss.getSpaceInformation()), 1.0)
         print(f"seed {s + 1} of {args.seeds} done", flush=True)
     ref = float(np.nanmedian(ao))
